@@ -1,0 +1,85 @@
+"""Wall time of TSHIX (ours vs LKH via elkai) and of ergodic search, measured in one run.
+
+Usage: ``python benchmarks/search_speed.py [--repeats 5] [--seed 0]``
+
+For each N = 100..500 TSHIX plans ``repeats`` trajectories from a fixed 2-D exploration
+distribution; the tour length of our open-tour solver is compared with LKH-3 (elkai) on the
+same samples. Then one ergodic trajectory of the TSHIX (N = 300) length is generated in 2D and
+3D (x, y, rz). Times are medians of wall-clock seconds (``time.perf_counter``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from teachfit.models.exploration import ExplorationDistribution
+from teachfit.trajectories.ergodic import ergodic_metric, ergodic_trajectory
+from teachfit.trajectories.tshix import TshixPlanner, metric_weights
+from teachfit.trajectories.tsp import open_tour
+
+
+def _expl(dims: tuple[str, ...]) -> ExplorationDistribution:
+    mean = np.array([0.01, 0.005, 0.05])[: len(dims)]
+    cov = np.array([[1e-4, 2e-5, 0.0], [2e-5, 4e-5, 0.0], [0.0, 0.0, 0.01]])[
+        : len(dims), : len(dims)
+    ]
+    return ExplorationDistribution(dims, np.ones(1), mean[None], cov[None])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    print("TSHIX wall time (median of", args.repeats, "runs), tour length vs LKH (elkai, RUNS=1)")
+    print(
+        f"{'dims':>6} {'N':>4} {'TSHIX [ms]':>11} {'TSP ours [ms]':>14} {'LKH [ms]':>9} "
+        f"{'ratio med':>9} {'ratio max':>9}"
+    )
+    lengths = {}
+    for dims in (("x", "y"), ("x", "y", "rz")):
+        expl = _expl(dims)
+        planner = TshixPlanner(expl, speed=0.01)
+        w = metric_weights(dims, planner.length_scale)
+        for n in (100, 200, 300, 400, 500):
+            t_plan, t_ours, t_lkh, ratios = [], [], [], []
+            for r in range(args.repeats):
+                rng = np.random.default_rng(args.seed + r)
+                t0 = time.perf_counter()
+                tr = planner.plan(n, rng)
+                t_plan.append(time.perf_counter() - t0)
+                t0 = time.perf_counter()
+                ours = open_tour(tr.samples, weights=w, rng=np.random.default_rng(r))
+                t_ours.append(time.perf_counter() - t0)
+                t0 = time.perf_counter()
+                ref = open_tour(tr.samples, weights=w, solver="lkh")
+                t_lkh.append(time.perf_counter() - t0)
+                ratios.append(ours.length / ref.length)
+                if n == 300 and r == 0:
+                    lengths[dims] = (tr, planner.length_scale)
+            print(
+                f"{len(dims):>6} {n:>4} {1e3 * np.median(t_plan):>11.1f} "
+                f"{1e3 * np.median(t_ours):>14.1f} {1e3 * np.median(t_lkh):>9.0f} "
+                f"{np.median(ratios):>9.4f} {np.max(ratios):>9.4f}"
+            )
+    print("\nErgodic (SMC) trajectory of the TSHIX N=300 length")
+    for dims, (tr, ls) in lengths.items():
+        expl = _expl(dims)
+        length = tr.path_length(ls)
+        times = []
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            erg = ergodic_trajectory(expl, speed=0.01, length=length, length_scale=ls)
+            times.append(time.perf_counter() - t0)
+        e_tshix = ergodic_metric(tr.states, expl, t=tr.t)
+        print(
+            f"  D={len(dims)} length {length:.3f} m: {np.median(times):.3f} s wall; "
+            f"ergodic metric: ergodic {erg.meta['ergodic_metric']:.4f}, TSHIX {e_tshix:.4f}"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,63 @@
+"""Simulation speed: raw ``mj_step`` vs. the controller in the loop, in contact on a task."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from teachfit.robot.floating import FloatingToolRobot
+from teachfit.robot.interface import ImpedanceCommand
+from teachfit.tasks.base import Task
+
+
+@dataclass(frozen=True)
+class SimSpeed:
+    """Steps per second (wall clock), their ratio, and the real-time factor with control."""
+
+    raw_steps_per_s: float
+    controlled_steps_per_s: float
+    ratio: float
+    real_time_factor: float
+    contacts: int
+
+
+def _pressed_robot(task: Task) -> tuple[FloatingToolRobot, ImpedanceCommand]:
+    robot = FloatingToolRobot(task)
+    start = task.teacher_start(np.random.default_rng(0))
+    robot.reset(start)
+    cmd = ImpedanceCommand(
+        pos=start.pos,
+        quat=start.quat,
+        lin_vel=[0.01, 0.0, 0.0],
+        wrench_ff=[0, 0, -6.0, 0, 0, 0],
+        stiffness=[1500, 150, 100, 40, 40, 40],
+    )
+    robot.command(cmd)
+    robot.step(200)  # settle into contact
+    return robot, cmd
+
+
+def measure_sim_speed(task: Task, steps: int = 5000, repeats: int = 3) -> SimSpeed:
+    """Best-of-``repeats`` throughput of both loops, interleaved so load noise hits both."""
+    raw_best = ctl_best = 0.0
+    contacts = 0
+    for _ in range(repeats):
+        robot, cmd = _pressed_robot(task)
+        m, d = robot.model, robot.data
+        snapshot = (d.qpos.copy(), d.qvel.copy(), d.time)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            mujoco.mj_step(m, d)
+        raw_best = max(raw_best, steps / (time.perf_counter() - t0))
+        d.qpos[:], d.qvel[:], d.time = snapshot
+        mujoco.mj_forward(m, d)
+        robot.command(cmd)
+        contacts = int(d.ncon)
+        t0 = time.perf_counter()
+        robot.step(steps)
+        ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
+    rtf = ctl_best * robot.control_period
+    return SimSpeed(raw_best, ctl_best, ctl_best / raw_best, rtf, contacts)

@@ -1,0 +1,31 @@
+"""The ``teachfit`` command line (typer + rich)."""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import typer  # noqa: E402
+
+from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
+from teachfit.cli.main_cmds import register  # noqa: E402
+
+app = typer.Typer(
+    name="teachfit",
+    help="Teach robots tight-fit assembly from a few demonstrations and a few trials.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+)
+bench_app = typer.Typer(help="Benchmarks that print figures (speed, success rates).")
+app.add_typer(demo_app, name="demo")
+app.add_typer(bench_app, name="bench")
+register(app, bench_app)
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()
+
+
+__all__ = ["app", "main"]

@@ -1,0 +1,169 @@
+"""Cartesian impedance control with a superposed feed-forward wrench (seed A, eqs. 8-9).
+
+    f_c   = K_p e_p + D_p de_p + f_ff
+    tau_c = K_th e_th + D_th de_th + tau_ff
+
+with ``e_p = x_d(t) - x`` (m), ``e_th`` the rotation vector of ``q_d q^-1`` (rad, world frame),
+``de`` the twist errors, all in the world frame at the TCP. ``x_d(t)`` is extrapolated from the
+last command with its desired twist, so commands may arrive slower than the 1 kHz control rate.
+The commanded wrench is clipped to ``max_force`` / ``max_torque``; the desired speeds to
+``max_speed`` / ``max_ang_speed``. A robot turns the wrench into joint torques (``J^T f``) or,
+for the floating tool, applies it directly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from teachfit.errors import ControlError
+from teachfit.robot.interface import ImpedanceCommand
+
+
+@dataclass(frozen=True)
+class ImpedanceLimits:
+    """Safety limits of the impedance controller (N, N·m, m/s, rad/s)."""
+
+    max_force: float = 60.0
+    max_torque: float = 6.0
+    max_speed: float = 0.25
+    max_ang_speed: float = 1.5
+
+    def __post_init__(self) -> None:
+        for name in ("max_force", "max_torque", "max_speed", "max_ang_speed"):
+            if not getattr(self, name) > 0:
+                raise ControlError(f"{name} must be > 0, got {getattr(self, name)}")
+
+
+def critical_damping(stiffness: np.ndarray, mass: np.ndarray, ratio: float) -> np.ndarray:
+    """Damping ``D = 2 ratio M^1/2 sqrtm(M^-1/2 K M^-1/2) M^1/2`` for (6, 6) ``K``, (6,) ``M``."""
+    sm = np.sqrt(mass)
+    scaled = stiffness / np.outer(sm, sm)
+    w, v = np.linalg.eigh(scaled)
+    root = (v * np.sqrt(np.clip(w, 0.0, None))) @ v.T
+    return 2.0 * ratio * root * np.outer(sm, sm)
+
+
+def aligned_stiffness(
+    direction: np.ndarray,
+    along: float,
+    across: float,
+    z: float,
+    rotational: float | np.ndarray = 50.0,
+) -> np.ndarray:
+    """A (6, 6) stiffness that is ``along`` N/m in the x-y ``direction`` of motion, ``across``
+    N/m perpendicular to it in the plane, ``z`` N/m vertically, and ``rotational`` N·m/rad.
+
+    High stiffness along the motion tracks the search path; low stiffness across it lets the
+    part fall into a hole it passes over (seed A, Sec. III-D).
+    """
+    d = np.asarray(direction, dtype=float)[:2]
+    n = float(np.hypot(d[0], d[1]))
+    u = d / n if n > 1e-12 else np.array([1.0, 0.0])
+    k_xy = across * np.eye(2) + (along - across) * np.outer(u, u)
+    out = np.zeros((6, 6))
+    out[:2, :2] = k_xy
+    out[2, 2] = z
+    out[3:, 3:] = np.diag(np.broadcast_to(np.asarray(rotational, dtype=float), (3,)))
+    return out
+
+
+class CartesianImpedance:
+    """Cartesian impedance controller; see the module docstring for the law.
+
+    Parameters
+    ----------
+    apparent_mass : (6,) array
+        Apparent mass / inertia of the tool per axis (kg, kg·m²), used for critical damping.
+    limits : ImpedanceLimits
+    """
+
+    def __init__(self, apparent_mass: np.ndarray, limits: ImpedanceLimits | None = None) -> None:
+        m = np.asarray(apparent_mass, dtype=float).reshape(-1)
+        if m.shape != (6,) or not np.all(m > 0):
+            raise ControlError(f"apparent_mass must be 6 positive numbers, got {apparent_mass}")
+        self.mass = m
+        self.limits = limits or ImpedanceLimits()
+        # buffers allocated once; the per-tick path below allocates as little as possible
+        self._k = np.zeros((6, 6))
+        self._d = np.zeros((6, 6))
+        self._xd = np.zeros(3)
+        self._qd = np.array([1.0, 0.0, 0.0, 0.0])
+        self._vd = np.zeros(6)
+        self._ff = np.zeros(6)
+        self._t0 = 0.0
+        self._err = np.zeros(6)
+        self._derr = np.zeros(6)
+        self._qtmp = np.zeros(4)
+        self._rtmp = np.zeros(3)
+        self._spinning = False
+        self._has_cmd = False
+        self.last_wrench = np.zeros(6)
+
+    def reset(self) -> None:
+        self._has_cmd = False
+        self.last_wrench[:] = 0.0
+
+    def set_command(self, cmd: ImpedanceCommand, t: float) -> None:
+        """Adopt ``cmd`` at time ``t`` (s): gains are prepared here, not per tick."""
+        lim = self.limits
+        self._k[:] = cmd.stiffness
+        if cmd.damping is None:
+            self._d[:] = critical_damping(self._k, self.mass, cmd.damping_ratio)
+        else:
+            self._d[:] = cmd.damping
+        v = cmd.lin_vel
+        speed = float(np.linalg.norm(v))
+        self._vd[:3] = v if speed <= lim.max_speed else v * (lim.max_speed / speed)
+        w = cmd.ang_vel
+        spin = float(np.linalg.norm(w))
+        self._vd[3:] = w if spin <= lim.max_ang_speed else w * (lim.max_ang_speed / spin)
+        self._spinning = bool(np.any(self._vd[3:] != 0.0))
+        self._xd[:] = cmd.pos
+        self._qd[:] = cmd.quat
+        self._ff[:] = cmd.wrench_ff
+        self._t0 = t
+        self._has_cmd = True
+
+    def compute(
+        self,
+        t: float,
+        pos: np.ndarray,
+        quat: np.ndarray,
+        lin_vel: np.ndarray,
+        ang_vel: np.ndarray,
+    ) -> np.ndarray:
+        """Commanded wrench ``[f; tau]`` (6,) in the world frame at the TCP.
+
+        ``pos`` (3,), ``quat`` (4,) w-x-y-z, ``lin_vel`` and ``ang_vel`` (3,) in the world frame.
+        """
+        if not self._has_cmd:
+            raise ControlError("compute() called before set_command()")
+        dt = t - self._t0
+        err, derr = self._err, self._derr
+        np.subtract(self._xd, pos, out=err[:3])
+        err[:3] += self._vd[:3] * dt
+        qd = self._qd
+        if self._spinning:
+            qd = self._qtmp
+            qd[:] = self._qd
+            mujoco.mju_quatIntegrate(qd, self._vd[3:], dt)
+        # rotation vector r with q * exp(r) = q_d (tool frame), then expressed in the world
+        mujoco.mju_subQuat(self._rtmp, qd, quat)
+        mujoco.mju_rotVecQuat(err[3:], self._rtmp, quat)
+        np.subtract(self._vd[:3], lin_vel, out=derr[:3])
+        np.subtract(self._vd[3:], ang_vel, out=derr[3:])
+        w = self._k @ err
+        w += self._d @ derr
+        w += self._ff
+        lim = self.limits
+        fn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+        if fn > lim.max_force:
+            w[:3] *= lim.max_force / fn
+        tn = np.sqrt(w[3] * w[3] + w[4] * w[4] + w[5] * w[5])
+        if tn > lim.max_torque:
+            w[3:] *= lim.max_torque / tn
+        self.last_wrench = w
+        return w

@@ -1,0 +1,219 @@
+"""A simulated blind teacher: a "human with closed eyes" demonstrating a search.
+
+The teacher starts from a worst-case offset, presses the part onto the surface and moves the
+compliant robot kinesthetically: first towards where they *believe* the hole is (their belief
+is off by ``belief_sigma``), then in a deliberate search pattern around that belief (an
+outward spiral or a zig-zag raster) until the part drops in. Human-like noise is a slow random
+wander (an Ornstein-Uhlenbeck process) plus a small physiological tremor; for tasks with a
+rotational search DOF the teacher also wiggles the part about z around its belief. What is
+recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench at
+``record_rate``. Demonstrations that end at once or never are discarded, as in seed A.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from rich.progress import Progress
+
+from teachfit.demonstrations.dataset import Demonstration
+from teachfit.errors import TeachfitError
+from teachfit.execution.runner import ExecutionConfig, run_trajectory
+from teachfit.execution.setpoints import SetpointTrajectory
+from teachfit.pose import Pose, quat_from_rz
+from teachfit.robot.floating import FloatingToolRobot
+from teachfit.tasks.base import Task
+
+PATTERNS = ("spiral", "zigzag")
+
+
+@dataclass(frozen=True)
+class TeacherStyle:
+    """How the simulated teacher searches (m, m/s, s, rad, N, N/m, Hz)."""
+
+    pattern: str = "spiral"
+    speed: float = 0.012
+    belief_sigma: float = 0.003
+    spiral_pitch: float = 0.0015
+    wander_amplitude: float = 0.0005
+    wander_timescale: float = 0.5
+    tremor_amplitude: float = 0.00005
+    tremor_frequency: float = 9.0
+    rz_belief_sigma: float = 0.1
+    rz_wiggle: float = 0.2
+    rz_wiggle_frequency: float = 0.4
+    push_force: float = 6.0
+    arm_stiffness: float = 600.0
+    max_duration: float = 40.0
+    min_duration: float = 0.5
+    record_rate: float = 100.0
+
+    def __post_init__(self) -> None:
+        if self.pattern not in PATTERNS:
+            raise TeachfitError(f"teacher pattern must be one of {PATTERNS}, got {self.pattern!r}")
+        for name in ("speed", "spiral_pitch", "max_duration", "record_rate", "wander_timescale"):
+            if not getattr(self, name) > 0:
+                raise TeachfitError(f"teacher {name} must be > 0")
+        if self.min_duration >= self.max_duration:
+            raise TeachfitError("teacher min_duration must be below max_duration")
+
+
+class BlindTeacher:
+    """Records demonstrations of ``task`` with a simulated blind human (seeded)."""
+
+    def __init__(self, task: Task, style: TeacherStyle | None = None, seed: int = 0) -> None:
+        self.task = task
+        self.style = style or TeacherStyle()
+        self.rng = np.random.default_rng(seed)
+        self.robot = FloatingToolRobot(task, seed=int(self.rng.integers(2**31)))
+        self.has_rz = "rz" in task.search_dims
+
+    # ------------------------------------------------------------------------ planning
+    def _search_pattern(self, n: int, dt: float) -> np.ndarray:
+        """(n, 2) offsets around the belief, at the teacher's speed."""
+        st = self.style
+        s = st.speed * dt * np.arange(n)  # arc length
+        if st.pattern == "spiral":
+            # Archimedean spiral r = b theta, arc length ~ b theta^2 / 2
+            b = st.spiral_pitch / (2 * np.pi)
+            theta = np.sqrt(2 * s / b)
+            theta += self.rng.uniform(0, 2 * np.pi)
+            r = b * (theta - theta[0])
+            return np.column_stack([r * np.cos(theta), r * np.sin(theta)])
+        # zig-zag raster: rows spiral_pitch apart, growing width
+        width = 0.008
+        row_len = width + st.spiral_pitch
+        row = np.floor(s / row_len)
+        u = s - row * row_len
+        x = np.where(row % 2 == 0, u, row_len - u) - width / 2
+        y = row * st.spiral_pitch - width / 2
+        return np.column_stack([np.clip(x, -width / 2, width / 2), y])
+
+    def _noise(self, n: int, dt: float) -> np.ndarray:
+        """(n, 2) slow wander (Ornstein-Uhlenbeck) plus tremor, m."""
+        st = self.style
+        a = np.exp(-dt / st.wander_timescale)
+        sd = st.wander_amplitude * np.sqrt(1 - a * a)
+        w = np.zeros((n, 2))
+        kicks = self.rng.normal(0.0, sd, (n, 2))
+        for i in range(1, n):
+            w[i] = a * w[i - 1] + kicks[i]
+        phase = self.rng.uniform(0, 2 * np.pi, 2)
+        t = dt * np.arange(n)
+        tremor = st.tremor_amplitude * np.sin(2 * np.pi * st.tremor_frequency * t[:, None] + phase)
+        return w + tremor
+
+    def plan(self, start: Pose) -> SetpointTrajectory:
+        """The path the teacher's hand intends, world frame, for ``max_duration``."""
+        st, task = self.style, self.task
+        dt = 1.0 / st.record_rate
+        n = int(st.max_duration / dt) + 1
+        hole = task.hole2world.pos[:2]
+        belief = hole + self.rng.normal(0.0, st.belief_sigma, 2)
+        p0 = start.pos[:2]
+        approach_len = float(np.linalg.norm(belief - p0))
+        n_app = min(max(2, int(approach_len / st.speed / dt)), n - 1)
+        lam = np.linspace(0.0, 1.0, n_app)[:, None]
+        approach = p0 + lam * (belief - p0)
+        search = belief + self._search_pattern(n - n_app, dt)
+        xy = np.concatenate([approach, search])[:n] + self._noise(n, dt)
+        xy[0] = p0
+        t = dt * np.arange(n)
+        if self.has_rz:
+            period = float(getattr(task, "rz_period", 2 * np.pi))
+            rz0 = start.rz
+            target = task.hole2world.rz
+            target += period * np.round((rz0 - target) / period)
+            target += self.rng.normal(0.0, st.rz_belief_sigma)
+            rz = np.empty(n)
+            rz[:n_app] = rz0 + np.linspace(0.0, 1.0, n_app) * (target - rz0)
+            tt = t[n_app:] - t[n_app]
+            rz[n_app:] = target + st.rz_wiggle * np.sin(2 * np.pi * st.rz_wiggle_frequency * tt)
+            quat = quat_from_rz(rz)
+        else:
+            quat = np.tile(start.quat, (n, 1))
+        pos = np.column_stack([xy, np.full(n, task.surface_z)])
+        return SetpointTrajectory.from_path(t, pos, quat, name="teacher-plan")
+
+    # ----------------------------------------------------------------------- recording
+    def demonstrate(self, start: Pose | None = None) -> tuple[Demonstration | None, str]:
+        """One attempt. Returns ``(demo, "ok")`` or ``(None, why it was discarded)``."""
+        st = self.style
+        start = start or self.task.teacher_start(self.rng)
+        cfg = ExecutionConfig(
+            stiffness_along=st.arm_stiffness,
+            stiffness_across=st.arm_stiffness,
+            aligned=False,
+            push_force=st.push_force,
+            settle_time=0.0,
+            log_rate=st.record_rate,
+        )
+        plan = self.plan(start)
+        outcome, log = run_trajectory(self.robot, self.task, plan, start, cfg)
+        if not outcome.success:
+            return None, f"never reached the hole ({outcome.reason})"
+        if outcome.time_to_insertion < st.min_duration:
+            return None, f"ended at once ({outcome.time_to_insertion:.2f} s)"
+        demo = Demonstration(
+            t=log.t - log.t[0],
+            pos=log.pos,
+            quat=log.quat,
+            wrench=log.wrench,
+            task=self.task.name,
+            source="simulated-teacher",
+            frame="world",
+            child_frame="tcp",
+            meta={
+                "pattern": st.pattern,
+                "time_to_insertion": outcome.time_to_insertion,
+                "path_length": outcome.path_length,
+                "start": [float(v) for v in (*start.pos, *start.quat)],
+            },
+        )
+        return demo, "ok"
+
+    def record(
+        self,
+        n: int,
+        *,
+        max_attempts: int | None = None,
+        progress: bool = False,
+    ) -> tuple[list[Demonstration], list[str]]:
+        """Record ``n`` accepted demonstrations; returns them and the reasons for discards."""
+        if n <= 0:
+            raise TeachfitError(f"number of demonstrations must be positive, got {n}")
+        limit = max_attempts or 5 * n
+        demos: list[Demonstration] = []
+        discarded: list[str] = []
+        with Progress(disable=not progress, transient=True) as bar:
+            task_id = bar.add_task("recording demonstrations", total=n)
+            while len(demos) < n and len(demos) + len(discarded) < limit:
+                demo, why = self.demonstrate()
+                if demo is None:
+                    discarded.append(why)
+                    continue
+                name = f"{self.task.name}-teacher-{len(demos)}"
+                demos.append(Demonstration(**{**_fields(demo), "name": name}))
+                bar.advance(task_id)
+        if len(demos) < n:
+            raise TeachfitError(
+                f"only {len(demos)} of {n} demonstrations succeeded in {limit} attempts; "
+                f"discarded: {discarded}"
+            )
+        return demos, discarded
+
+
+def _fields(demo: Demonstration) -> dict[str, object]:
+    return {
+        "t": demo.t,
+        "pos": demo.pos,
+        "quat": demo.quat,
+        "wrench": demo.wrench,
+        "task": demo.task,
+        "source": demo.source,
+        "frame": demo.frame,
+        "child_frame": demo.child_frame,
+        "name": demo.name,
+        "meta": dict(demo.meta),
+    }

@@ -1,0 +1,59 @@
+"""Typed exceptions. Every error teachfit raises on purpose derives from :class:`TeachfitError`."""
+
+from __future__ import annotations
+
+
+class TeachfitError(Exception):
+    """Base class of all errors raised by teachfit on purpose (bad input, impossible requests)."""
+
+
+class TaskError(TeachfitError):
+    """Impossible or inconsistent task parameters (e.g. a peg wider than its hole)."""
+
+
+class DatasetError(TeachfitError):
+    """A demonstration file or import that cannot be read or is invalid.
+
+    Attributes name where the problem is, so that the message can point a user at it.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        path: str | None = None,
+        row: int | None = None,
+        column: str | None = None,
+    ) -> None:
+        self.path = path
+        self.row = row
+        self.column = column
+        where = []
+        if path is not None:
+            where.append(f"file {path}")
+        if row is not None:
+            where.append(f"row {row}")
+        if column is not None:
+            where.append(f"column {column!r}")
+        prefix = f"{', '.join(where)}: " if where else ""
+        super().__init__(prefix + message)
+
+
+class ControlError(TeachfitError):
+    """Invalid controller gains, limits or commands."""
+
+
+class SimulationDiverged(TeachfitError):
+    """The physics simulation produced NaN/inf or MuJoCo raised a warning that invalidates it."""
+
+
+class ModelError(TeachfitError):
+    """A learned model cannot be fitted or loaded (too few samples, wrong task or dimension)."""
+
+
+class PlanningError(TeachfitError):
+    """An invalid planning request (start in collision, wrong parts, empty demonstration)."""
+
+
+class RenderError(TeachfitError):
+    """Offscreen rendering is unavailable (no OpenGL / EGL / OSMesa)."""

@@ -1,0 +1,59 @@
+"""Success statistics with honest uncertainty."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import norm
+
+from teachfit.errors import TeachfitError
+
+
+def wilson_interval(successes: int, trials: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval for a binomial success rate.
+
+    ``(p + z²/2n ± z sqrt(p(1-p)/n + z²/4n²)) / (1 + z²/n)`` with ``p = successes / trials``.
+    """
+    if trials <= 0:
+        raise TeachfitError("wilson_interval needs at least one trial")
+    if not 0 <= successes <= trials:
+        raise TeachfitError(f"successes must be within [0, {trials}], got {successes}")
+    z = float(norm.ppf(0.5 + confidence / 2))
+    p = successes / trials
+    denom = 1 + z * z / trials
+    centre = (p + z * z / (2 * trials)) / denom
+    half = z * np.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+@dataclass(frozen=True)
+class SuccessSummary:
+    """Success count, Wilson 95 % interval and median time to insertion (s) of a batch."""
+
+    successes: int
+    trials: int
+    low: float
+    high: float
+    median_time: float
+
+    @property
+    def rate(self) -> float:
+        return self.successes / self.trials
+
+    def __str__(self) -> str:
+        t = "n/a" if np.isnan(self.median_time) else f"{self.median_time:.2f} s"
+        return (
+            f"{self.successes}/{self.trials} = {100 * self.rate:.0f} % "
+            f"[{100 * self.low:.0f}, {100 * self.high:.0f}] %, median time {t}"
+        )
+
+
+def summarize(successes: Sequence[bool], times: Sequence[float]) -> SuccessSummary:
+    """Summarise a batch of outcomes (``times`` of the successful ones are used)."""
+    ok = np.asarray(successes, dtype=bool)
+    ts = np.asarray(times, dtype=float)[ok]
+    lo, hi = wilson_interval(int(ok.sum()), int(ok.size))
+    med = float(np.median(ts)) if ts.size else float("nan")
+    return SuccessSummary(int(ok.sum()), int(ok.size), lo, hi, med)

@@ -1,0 +1,288 @@
+"""Exploration distribution p_e(s) over the demonstrated search states.
+
+    p_e(s) = Σ_k w_k N(s | μ_k, Σ_k),   s ∈ R^D (search frame; m for x, y, rad for rz)
+
+with K = 1 (maximum-likelihood Gaussian, the paper's model) or K chosen by BIC up to a cap
+(scikit-learn ``GaussianMixture``). Demonstrations often lie in a lower-dimensional subspace
+(a straight sweep; no rotation at all), so the covariances are regularised:
+
+    Σ_k <- Σ_k + diag((ρ σ_d)² + ε_d²)
+
+with σ_d the data's standard deviation per dimension, ρ a relative floor (default 0.05) and ε_d
+an absolute floor (0.1 mm for lengths, 1 mrad for angles). The floors are small compared with the
+data's spread, so the model stays well-posed yet only puts mass where the teacher searched.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from scipy.special import logsumexp
+from sklearn.mixture import GaussianMixture
+
+from teachfit.errors import ModelError
+
+#: Default absolute standard-deviation floor per kind of DOF (m for lengths, rad for angles).
+ABS_FLOOR = {"x": 1e-4, "y": 1e-4, "z": 1e-4, "rz": 1e-3}
+
+
+def _check_data(x: np.ndarray, what: str) -> np.ndarray:
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 2:
+        raise ModelError(f"{what}: expected a 2-D array (N, D), got shape {x.shape}")
+    n, d = x.shape
+    if not np.all(np.isfinite(x)):
+        raise ModelError(f"{what}: data contains NaN or inf")
+    if n < d + 1:
+        raise ModelError(f"{what}: need at least D + 1 = {d + 1} samples, got {n}")
+    if np.all(np.ptp(x, axis=0) == 0):
+        raise ModelError(f"{what}: all samples are identical (constant data)")
+    return x
+
+
+def fit_regularised_gmm(
+    x: np.ndarray,
+    abs_floor: np.ndarray,
+    *,
+    n_components: int | Literal["bic"] = 1,
+    max_components: int = 4,
+    rel_floor: float = 0.05,
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fit a regularised Gaussian mixture; returns ``(weights (K,), means (K,D), covs (K,D,D))``.
+
+    The fit runs on standardised data ``z_d = (x_d - mean_d) / scale_d`` with
+    ``scale_d = max(σ_d, ε_d)`` and scikit-learn's ``reg_covar = ρ²``; the covariances are mapped
+    back and ``diag(ε_d²)`` is added. With ``n_components="bic"`` K = 1..``max_components``
+    (at most N // (D + 1)) are fitted and the lowest BIC wins. K = 1 is the closed-form
+    maximum-likelihood estimate (mean, biased covariance).
+    """
+    x = _check_data(x, "fit")
+    n, d = x.shape
+    abs_floor = np.broadcast_to(np.asarray(abs_floor, dtype=float), (d,))
+    if rel_floor < 0 or np.any(abs_floor < 0):
+        raise ModelError("covariance floors must be non-negative")
+    centre = x.mean(axis=0)
+    scale = np.maximum(x.std(axis=0), np.maximum(abs_floor, 1e-300))
+    z = (x - centre) / scale
+    if n_components == "bic":
+        candidates = range(1, max(1, min(int(max_components), n // (d + 1))) + 1)
+    else:
+        if int(n_components) < 1 or int(n_components) > n:
+            raise ModelError(f"n_components must be in 1..{n}, got {n_components}")
+        candidates = [int(n_components)]
+    best: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
+    for k in candidates:
+        if k == 1:
+            w = np.ones(1)
+            mu = z.mean(axis=0, keepdims=True)
+            cov = (np.cov(z.T, bias=True).reshape(d, d) + rel_floor**2 * np.eye(d))[None]
+            if len(candidates) == 1:
+                best = (0.0, w, mu, cov)
+                break
+            logl = _mixture_logpdf(z, w, mu, cov).sum()
+            bic = -2.0 * logl + (d + d * (d + 1) / 2) * np.log(n)
+        else:
+            gm = GaussianMixture(
+                n_components=k,
+                covariance_type="full",
+                reg_covar=rel_floor**2,
+                random_state=seed,
+                n_init=1,
+            ).fit(z)
+            w, mu, cov, bic = gm.weights_, gm.means_, gm.covariances_, gm.bic(z)
+        if best is None or bic < best[0]:
+            best = (bic, w, mu, cov)
+    assert best is not None
+    _, w, mu, cov = best
+    means = centre + mu * scale
+    covs = cov * np.outer(scale, scale)[None] + np.diag(abs_floor**2)[None]
+    return np.asarray(w, dtype=float), means, covs
+
+
+def _mixture_logpdf(
+    x: np.ndarray, weights: np.ndarray, means: np.ndarray, covs: np.ndarray
+) -> np.ndarray:
+    """log Σ_k w_k N(x | μ_k, Σ_k) for x (M, D); returns (M,)."""
+    return logsumexp(component_logpdf(x, means, covs) + np.log(weights)[None], axis=1)
+
+
+def component_logpdf(x: np.ndarray, means: np.ndarray, covs: np.ndarray) -> np.ndarray:
+    """log N(x | μ_k, Σ_k) for x (M, D), means (K, D), covs (K, D, D); returns (M, K)."""
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    d = means.shape[1]
+    chol = np.linalg.cholesky(covs)  # (K, D, D)
+    diff = x[:, None, :] - means[None]  # (M, K, D)
+    sol = np.linalg.solve(chol[None], diff[..., None])[..., 0]  # (M, K, D)
+    logdet = 2.0 * np.log(np.diagonal(chol, axis1=1, axis2=2)).sum(axis=1)
+    return -0.5 * (np.sum(sol**2, axis=2) + logdet[None] + d * np.log(2.0 * np.pi))
+
+
+@dataclass(frozen=True)
+class ExplorationDistribution:
+    """Gaussian mixture p_e(s) over search states (search frame).
+
+    Attributes
+    ----------
+    dims : tuple of str
+        Search DOFs (length D), e.g. ``("x", "y", "rz")``.
+    weights : ndarray, shape (K,)
+        Mixture weights, positive, summing to 1.
+    means : ndarray, shape (K, D)
+        Component means (m, rad).
+    covs : ndarray, shape (K, D, D)
+        Component covariances, symmetric positive definite (m², m·rad, rad²).
+    """
+
+    dims: tuple[str, ...]
+    weights: np.ndarray
+    means: np.ndarray
+    covs: np.ndarray
+
+    def __post_init__(self) -> None:
+        w = np.asarray(self.weights, dtype=float)
+        mu = np.atleast_2d(np.asarray(self.means, dtype=float))
+        cov = np.asarray(self.covs, dtype=float).reshape(mu.shape[0], mu.shape[1], mu.shape[1])
+        k, d = mu.shape
+        if len(self.dims) != d or w.shape != (k,):
+            raise ModelError(
+                f"inconsistent shapes: dims {self.dims}, weights {w.shape}, means {mu.shape}"
+            )
+        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(mu)) and np.all(np.isfinite(cov))):
+            raise ModelError("exploration distribution has NaN or inf parameters")
+        if np.any(w <= 0) or abs(w.sum() - 1.0) > 1e-6:
+            raise ModelError("mixture weights must be positive and sum to 1")
+        if not np.allclose(cov, np.swapaxes(cov, 1, 2), rtol=1e-9, atol=1e-15):
+            raise ModelError("covariances must be symmetric")
+        try:
+            np.linalg.cholesky(cov)
+        except np.linalg.LinAlgError:
+            raise ModelError("covariances must be positive definite") from None
+        object.__setattr__(self, "dims", tuple(self.dims))
+        object.__setattr__(self, "weights", w / w.sum())
+        object.__setattr__(self, "means", mu)
+        object.__setattr__(self, "covs", cov)
+
+    @property
+    def dim(self) -> int:
+        """Number of search DOFs D."""
+        return len(self.dims)
+
+    @property
+    def n_components(self) -> int:
+        """Number of mixture components K."""
+        return self.weights.size
+
+    @property
+    def mean(self) -> np.ndarray:
+        """Mixture mean Σ_k w_k μ_k, shape (D,)."""
+        return self.weights @ self.means
+
+    @property
+    def cov(self) -> np.ndarray:
+        """Mixture covariance Σ_k w_k (Σ_k + μ_k μ_kᵀ) - μ μᵀ, shape (D, D)."""
+        m = self.mean
+        second = np.einsum(
+            "k,kij->ij", self.weights, self.covs + np.einsum("ki,kj->kij", self.means, self.means)
+        )
+        return second - np.outer(m, m)
+
+    def logpdf(self, s: np.ndarray) -> np.ndarray:
+        """log p_e(s) for s of shape (M, D) or (D,); returns (M,) or a scalar."""
+        s = np.asarray(s, dtype=float)
+        out = _mixture_logpdf(np.atleast_2d(s), self.weights, self.means, self.covs)
+        return out[0] if s.ndim == 1 else out
+
+    def pdf(self, s: np.ndarray) -> np.ndarray:
+        """p_e(s) (density in 1 / (m^n rad^r)) for s of shape (M, D) or (D,)."""
+        return np.exp(self.logpdf(s))
+
+    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """Draw ``n`` samples (n, D); component counts are multinomial in the weights."""
+        if not isinstance(n, int | np.integer) or n <= 0:
+            raise ModelError(f"number of samples must be a positive integer, got {n!r}")
+        counts = rng.multinomial(int(n), self.weights)
+        chol = np.linalg.cholesky(self.covs)
+        parts = [
+            self.means[k] + rng.standard_normal((c, self.dim)) @ chol[k].T
+            for k, c in enumerate(counts)
+            if c > 0
+        ]
+        out = np.concatenate(parts)
+        return out[rng.permutation(int(n))]
+
+    def bounding_box(self, n_sigma: float = 3.0) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned box ``(lo (D,), hi (D,))`` covering every component's μ ± n_sigma σ."""
+        sd = np.sqrt(np.diagonal(self.covs, axis1=1, axis2=2))
+        return (self.means - n_sigma * sd).min(axis=0), (self.means + n_sigma * sd).max(axis=0)
+
+    def scaled(self, factors: np.ndarray) -> ExplorationDistribution:
+        """The distribution of ``diag(factors) s`` (e.g. rz in metres via a length scale)."""
+        f = np.asarray(factors, dtype=float)
+        return ExplorationDistribution(
+            self.dims, self.weights, self.means * f, self.covs * np.outer(f, f)[None]
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready parameters (lists of floats)."""
+        return {
+            "dims": list(self.dims),
+            "weights": self.weights.tolist(),
+            "means": self.means.tolist(),
+            "covs": self.covs.tolist(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> ExplorationDistribution:
+        """Inverse of :meth:`to_dict`; raises ModelError on missing keys or bad values."""
+        try:
+            return cls(
+                tuple(d["dims"]), np.array(d["weights"]), np.array(d["means"]), np.array(d["covs"])
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"invalid exploration distribution: {exc}") from exc
+
+
+def fit_exploration(
+    states: np.ndarray,
+    dims: Sequence[str],
+    *,
+    n_components: int | Literal["bic"] = 1,
+    max_components: int = 4,
+    rel_floor: float = 0.05,
+    abs_floor: Sequence[float] | None = None,
+    seed: int = 0,
+) -> ExplorationDistribution:
+    """Fit p_e(s) to search states.
+
+    Parameters
+    ----------
+    states : ndarray, shape (N, D)
+        Search states (search frame), N >= D + 1, not all identical, finite.
+    dims : sequence of str
+        DOF names, length D.
+    n_components : int or "bic"
+        1 (default) = maximum-likelihood Gaussian; an int = that many components; "bic" = the
+        count in 1..max_components with the lowest Bayesian information criterion.
+    rel_floor, abs_floor
+        Regularisation (see module docstring); ``abs_floor`` defaults to :data:`ABS_FLOOR`.
+    seed : int
+        Seed of the EM initialisation (K > 1).
+    """
+    dims = tuple(dims)
+    x = _check_data(states, "exploration")
+    if x.shape[1] != len(dims):
+        raise ModelError(f"states have {x.shape[1]} columns but dims are {dims}")
+    floor = np.array([ABS_FLOOR.get(d, 1e-4) for d in dims]) if abs_floor is None else abs_floor
+    w, mu, cov = fit_regularised_gmm(
+        x,
+        np.asarray(floor, dtype=float),
+        n_components=n_components,
+        max_components=max_components,
+        rel_floor=rel_floor,
+        seed=seed,
+    )
+    return ExplorationDistribution(dims, w, mu, cov)

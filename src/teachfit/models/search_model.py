@@ -1,0 +1,215 @@
+"""SearchModel: what is learned from blind search demonstrations, and its file format.
+
+File format (JSON, UTF-8, no pickle)::
+
+    {
+      "format": "teachfit.search_model",
+      "version": 1,
+      "task": "peg2d",                  # task the demonstrations were recorded on
+      "dims": ["x", "y"],               # search DOFs, in this order everywhere below
+      "rate_hz": 100.0,                 # sample rate of the dynamics' steps Δs
+      "speed": 0.01,                    # median teacher speed in the search plane, m/s
+      "angular_speed": null,            # median |d rz/dt|, rad/s (null without rz)
+      "n_demos": 1,
+      "exploration": {"dims": [...], "weights": [K], "means": [K][D], "covs": [K][D][D]},
+      "dynamics": {"dims": [...], "weights": [K], "means": [K][2D], "covs": [K][2D][2D]}
+                  or null           # (no wrench recorded: no feed-forward)
+    }
+
+Units: m and rad for states and steps (steps per sample at ``rate_hz``), N and N m for actions.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from teachfit.errors import ModelError
+from teachfit.models.dynamics import DynamicsModel, fit_dynamics
+from teachfit.models.exploration import ExplorationDistribution, fit_exploration
+from teachfit.models.search_data import dims_for_task, search_data, validate_dims
+
+FORMAT = "teachfit.search_model"
+VERSION = 1
+
+
+@dataclass(frozen=True)
+class SearchModel:
+    """Exploration distribution + dynamics learned for one task.
+
+    Attributes
+    ----------
+    task : str
+    dims : tuple of str
+        Search DOFs (D).
+    exploration : ExplorationDistribution
+        p_e(s) in the search frame.
+    dynamics : DynamicsModel or None
+        Joint model over (Δs, a); None when the demonstrations had no wrench.
+    rate_hz : float
+        Sample rate at which Δs was taken.
+    speed : float
+        Median teacher speed in the search plane, m/s (> 0).
+    angular_speed : float or None
+        Median teacher |d rz / dt|, rad/s; None when rz is not searched.
+    n_demos : int
+    """
+
+    task: str
+    dims: tuple[str, ...]
+    exploration: ExplorationDistribution
+    dynamics: DynamicsModel | None
+    rate_hz: float
+    speed: float
+    angular_speed: float | None = None
+    n_demos: int = 1
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "dims", validate_dims(self.dims))
+        if self.exploration.dims != self.dims:
+            raise ModelError(f"exploration dims {self.exploration.dims} != model dims {self.dims}")
+        if self.dynamics is not None and self.dynamics.dims != self.dims:
+            raise ModelError(f"dynamics dims {self.dynamics.dims} != model dims {self.dims}")
+        if not (np.isfinite(self.rate_hz) and self.rate_hz > 0):
+            raise ModelError(f"rate_hz must be positive, got {self.rate_hz}")
+        if not (np.isfinite(self.speed) and self.speed > 0):
+            raise ModelError(f"teacher speed must be positive, got {self.speed}")
+        if self.n_demos < 1:
+            raise ModelError("n_demos must be >= 1")
+
+    @classmethod
+    def fit(
+        cls,
+        demos: Iterable[Any],
+        task: str,
+        dims: Sequence[str] | None = None,
+        *,
+        n_components: int | Literal["bic"] = 1,
+        max_components: int = 4,
+        dynamics_components: int | Literal["bic"] = 1,
+        rate_hz: float | None = None,
+        rel_floor: float = 0.05,
+        seed: int = 0,
+    ) -> SearchModel:
+        """Learn p_e and the dynamics from demonstrations (see :func:`search_data`).
+
+        ``dims`` defaults to the task's search DOFs. Raises ModelError for too few or
+        degenerate samples, or a teacher who never moved.
+        """
+        dims = dims_for_task(task) if dims is None else validate_dims(dims)
+        data = search_data(demos, dims, rate_hz=rate_hz)
+        expl = fit_exploration(
+            data.states,
+            dims,
+            n_components=n_components,
+            max_components=max_components,
+            rel_floor=rel_floor,
+            seed=seed,
+        )
+        dyn = None
+        if data.actions is not None:
+            dyn = fit_dynamics(
+                data.steps,
+                data.actions,
+                dims,
+                n_components=dynamics_components,
+                max_components=max_components,
+                rel_floor=rel_floor,
+                seed=seed,
+            )
+        if data.speed <= 0:
+            raise ModelError("the demonstrations never move in the search plane")
+        return cls(
+            task, dims, expl, dyn, data.rate_hz, data.speed, data.angular_speed, data.n_demos
+        )
+
+    def feedforward(self, velocity: np.ndarray) -> np.ndarray:
+        """Feed-forward wrench for desired search velocities (M, D) (m/s, rad/s).
+
+        The velocity is converted to a step at the model's rate, ``Δs* = v / rate_hz``, and
+        conditioned on (GMR). Zeros when there is no dynamics model. Returns (M, D), N and N m.
+        """
+        v = np.atleast_2d(np.asarray(velocity, dtype=float))
+        if self.dynamics is None:
+            return np.zeros_like(v)
+        return self.dynamics.feedforward(v / self.rate_hz)
+
+    def feedforward_along(self, t: np.ndarray, states: np.ndarray) -> np.ndarray:
+        """Feed-forward wrench (T, D) along a timed trajectory ``states`` (T, D) at ``t`` (T,)."""
+        return self.feedforward(
+            np.gradient(np.asarray(states, float), np.asarray(t, float), axis=0)
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON document described in the module docstring."""
+        return {
+            "format": FORMAT,
+            "version": VERSION,
+            "task": self.task,
+            "dims": list(self.dims),
+            "rate_hz": self.rate_hz,
+            "speed": self.speed,
+            "angular_speed": self.angular_speed,
+            "n_demos": self.n_demos,
+            "exploration": self.exploration.to_dict(),
+            "dynamics": None if self.dynamics is None else self.dynamics.to_dict(),
+        }
+
+    def save(self, path: str | Path) -> Path:
+        """Write the model as JSON; returns the path."""
+        path = Path(path)
+        path.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
+        return path
+
+    @classmethod
+    def from_dict(
+        cls, doc: Any, *, task: str | None = None, dims: Sequence[str] | None = None
+    ) -> SearchModel:
+        """Build from a parsed document, checking format, version, task and dims."""
+        if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+            raise ModelError(f"not a search model (format field must be {FORMAT!r})")
+        if doc.get("version") != VERSION:
+            raise ModelError(f"unsupported search model version {doc.get('version')!r}")
+        try:
+            got_dims = tuple(doc["dims"])
+            if task is not None and doc["task"] != task:
+                raise ModelError(f"model was learned for task {doc['task']!r}, not {task!r}")
+            if dims is not None and got_dims != tuple(dims):
+                raise ModelError(f"model has dims {got_dims}, expected {tuple(dims)}")
+            dyn = doc["dynamics"]
+            return cls(
+                task=str(doc["task"]),
+                dims=got_dims,
+                exploration=ExplorationDistribution.from_dict(doc["exploration"]),
+                dynamics=None if dyn is None else DynamicsModel.from_dict(dyn),
+                rate_hz=float(doc["rate_hz"]),
+                speed=float(doc["speed"]),
+                angular_speed=None if doc["angular_speed"] is None else float(doc["angular_speed"]),
+                n_demos=int(doc["n_demos"]),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelError(f"invalid search model document: {exc!r}") from exc
+
+    @classmethod
+    def load(
+        cls, path: str | Path, *, task: str | None = None, dims: Sequence[str] | None = None
+    ) -> SearchModel:
+        """Read a model written by :meth:`save`.
+
+        Raises ModelError if the file is missing, not JSON, another format or version, or was
+        learned for another ``task`` or ``dims`` than requested.
+        """
+        path = Path(path)
+        try:
+            doc = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ModelError(f"cannot read search model {path}: {exc}") from exc
+        try:
+            return cls.from_dict(doc, task=task, dims=dims)
+        except ModelError as exc:
+            raise ModelError(f"{path}: {exc}") from exc

@@ -1,0 +1,102 @@
+"""Rigid poses and the quaternion conventions used everywhere in teachfit.
+
+Quaternions are ``(w, x, y, z)`` (MuJoCo's order), unit norm. A pose ``tool2world`` maps tool
+coordinates to world coordinates: ``p_world = R(quat) @ p_tool + pos``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from teachfit.errors import TeachfitError
+
+IDENTITY_QUAT = np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def wxyz_to_rotation(quat: np.ndarray) -> Rotation:
+    """A scipy ``Rotation`` from ``(..., 4)`` quaternions in ``w, x, y, z`` order."""
+    q = np.asarray(quat, dtype=float)
+    return Rotation.from_quat(np.concatenate([q[..., 1:], q[..., :1]], axis=-1))
+
+
+def rotation_to_wxyz(rot: Rotation) -> np.ndarray:
+    """``(..., 4)`` quaternions in ``w, x, y, z`` order, with ``w >= 0``."""
+    q = rot.as_quat()
+    q = np.concatenate([q[..., 3:], q[..., :3]], axis=-1)
+    sign = np.where(q[..., :1] < 0, -1.0, 1.0)
+    return q * sign
+
+
+def quat_from_rz(angle: float | np.ndarray) -> np.ndarray:
+    """Quaternion(s) ``(..., 4)`` of a rotation by ``angle`` rad about the world z-axis."""
+    a = np.asarray(angle, dtype=float) / 2.0
+    zeros = np.zeros_like(a)
+    return np.stack([np.cos(a), zeros, zeros, np.sin(a)], axis=-1)
+
+
+def rz_from_quat(quat: np.ndarray) -> np.ndarray:
+    """Rotation about z (yaw, rad) of ``(..., 4)`` quaternions, by the z-y-x Euler convention."""
+    q = np.asarray(quat, dtype=float)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A rigid pose: position ``pos`` (3,) in metres and unit quaternion ``quat`` (4,) w-x-y-z."""
+
+    pos: np.ndarray
+    quat: np.ndarray = field(default_factory=lambda: IDENTITY_QUAT.copy())
+
+    def __post_init__(self) -> None:
+        pos = np.array(self.pos, dtype=float).reshape(-1)
+        quat = np.array(self.quat, dtype=float).reshape(-1)
+        if pos.shape != (3,) or quat.shape != (4,):
+            raise TeachfitError(f"Pose needs pos (3,) and quat (4,), got {pos.shape}, {quat.shape}")
+        if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(quat))):
+            raise TeachfitError("Pose contains NaN or inf")
+        norm = np.linalg.norm(quat)
+        if abs(norm - 1.0) > 1e-3:
+            raise TeachfitError(f"Pose quaternion must have unit norm, has {norm:.6f}")
+        quat = quat / norm
+        pos.setflags(write=False)
+        quat.setflags(write=False)
+        object.__setattr__(self, "pos", pos)
+        object.__setattr__(self, "quat", quat)
+
+    @property
+    def rotation(self) -> Rotation:
+        return wxyz_to_rotation(self.quat)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """Homogeneous transform (4, 4)."""
+        out = np.eye(4)
+        out[:3, :3] = self.rotation.as_matrix()
+        out[:3, 3] = self.pos
+        return out
+
+    @property
+    def rz(self) -> float:
+        return float(rz_from_quat(self.quat))
+
+    def compose(self, other: Pose) -> Pose:
+        """``self * other``: e.g. ``search2world.compose(tool2search) == tool2world``."""
+        rot = self.rotation
+        return Pose(
+            self.pos + rot.apply(np.array(other.pos)), rotation_to_wxyz(rot * other.rotation)
+        )
+
+    def inverse(self) -> Pose:
+        inv = self.rotation.inv()
+        return Pose(-inv.apply(np.array(self.pos)), rotation_to_wxyz(inv))
+
+    def translated(self, delta: np.ndarray) -> Pose:
+        return Pose(self.pos + np.asarray(delta, dtype=float), self.quat)
+
+    @classmethod
+    def from_xyz_rz(cls, x: float, y: float, z: float, rz: float = 0.0) -> Pose:
+        return cls(np.array([x, y, z]), quat_from_rz(rz))

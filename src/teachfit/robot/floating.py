@@ -1,0 +1,264 @@
+"""A floating tool: a 6-DOF body driven by a commanded wrench, with a wrist F/T sensor.
+
+This is the simulated robot behind :class:`~teachfit.robot.interface.Robot`. The tool body
+(free joint, gravity compensated like a torque-controlled arm's payload) carries the task's
+held part on a child body; MuJoCo force/torque sensors between the two play the wrist F/T
+sensor. Each control tick (one 1 ms physics step) the controller's wrench at the TCP is applied
+with ``mj_applyFT``.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from teachfit.control.base import Controller
+from teachfit.control.impedance import CartesianImpedance
+from teachfit.errors import ControlError, SimulationDiverged
+from teachfit.pose import Pose
+from teachfit.robot.interface import ImpedanceCommand, RobotState
+from teachfit.tasks.base import ContactParams, Task
+from teachfit.tasks.mjcf import SceneXml, fmt
+
+
+@dataclass(frozen=True)
+class FloatingToolParams:
+    """Tool dynamics and wrist sensor model.
+
+    ``mass`` (kg) and ``inertia`` (kg·m², diagonal) are the apparent inertia the controller
+    moves (a light arm's end-effector). ``ft_noise`` is the standard deviation of the white
+    noise on ``[f; tau]`` (N, N·m), ``ft_bias`` a constant offset; readings are tared at reset.
+    ``ft_cutoff`` (Hz) is the sensor's first-order low-pass filter, as on real F/T sensors
+    (ATI's digital filter): it also removes MuJoCo's tick-to-tick contact chatter in sliding.
+    """
+
+    mass: float = 1.0
+    inertia: tuple[float, float, float] = (0.004, 0.004, 0.004)
+    ft_noise: tuple[float, float] = (0.05, 0.002)
+    ft_bias: tuple[float, float, float, float, float, float] = (0.0,) * 6
+    ft_cutoff: float = 80.0
+    timestep: float = 0.001
+    contact: ContactParams = field(default_factory=ContactParams)
+
+    def __post_init__(self) -> None:
+        if not self.mass > 0 or min(self.inertia) <= 0:
+            raise ControlError("tool mass and inertia must be positive")
+        if min(self.ft_noise) < 0:
+            raise ControlError("ft_noise must be >= 0")
+        if not 0 < self.ft_cutoff:
+            raise ControlError("ft_cutoff must be > 0 Hz")
+        if not 0 < self.timestep <= 0.002:
+            raise ControlError("timestep must be within (0, 2 ms]")
+
+    @property
+    def apparent_mass(self) -> np.ndarray:
+        return np.array([self.mass] * 3 + list(self.inertia))
+
+
+def build_scene(task: Task, params: FloatingToolParams | None = None) -> str:
+    """MJCF of ``task``'s cell with a floating tool holding the task's part."""
+    params = params or FloatingToolParams()
+    contact = getattr(task, "contact", None) or params.contact
+    scene = SceneXml(model=f"teachfit-{task.name}", timestep=params.timestep)
+    scene.option.set("noslip_iterations", "0")
+    ET.SubElement(
+        scene.worldbody, "light", pos="0.3 -0.3 0.8", dir="-0.4 0.4 -1", diffuse=".8 .8 .8"
+    )
+    ET.SubElement(
+        scene.worldbody, "light", pos="-0.3 0.3 0.9", dir="0.3 -0.3 -1", diffuse=".4 .4 .4"
+    )
+    ET.SubElement(
+        scene.worldbody,
+        "geom",
+        name="floor",
+        type="plane",
+        size="0.5 0.5 0.01",
+        material="grid",
+        contype="0",
+        conaffinity="0",
+    )
+    task.add_fixture(scene, contact)
+    length = task.held_part_length
+    start = task.contact_pose([0.05, 0.0]).translated([0, 0, 0.02])
+    tool = ET.SubElement(scene.worldbody, "body", name="tool", pos=fmt(start.pos), gravcomp="1")
+    ET.SubElement(tool, "freejoint", name="tool_free")
+    ET.SubElement(
+        tool,
+        "inertial",
+        pos=fmt([0, 0, length + 0.02]),
+        mass=fmt(params.mass),
+        diaginertia=fmt(params.inertia),
+    )
+    ET.SubElement(tool, "site", name="tcp", size="0.002", rgba="0 1 0 1")
+    ET.SubElement(
+        tool,
+        "geom",
+        name="flange",
+        type="cylinder",
+        size=fmt([0.03, 0.01]),
+        pos=fmt([0, 0, length + 0.02]),
+        material="dark",
+        contype="0",
+        conaffinity="0",
+        mass="0",
+    )
+    part = ET.SubElement(tool, "body", name="held_part", gravcomp="1")
+    task.add_held_part(part, scene, contact)
+    ET.SubElement(part, "site", name="ft_site", pos=fmt([0, 0, length]), size="0.003")
+    ET.SubElement(scene.sensor, "force", name="ft_force", site="ft_site")
+    ET.SubElement(scene.sensor, "torque", name="ft_torque", site="ft_site")
+    return scene.to_string()
+
+
+class FloatingToolRobot:
+    """The simulated robot: MuJoCo floating tool + controller + wrist F/T sensor.
+
+    Implements :class:`~teachfit.robot.interface.Robot`. One control tick is one physics step.
+    """
+
+    def __init__(
+        self,
+        task: Task,
+        controller: Controller | None = None,
+        params: FloatingToolParams | None = None,
+        seed: int = 0,
+    ) -> None:
+        self.task = task
+        self.params = params or FloatingToolParams()
+        self.xml = build_scene(task, self.params)
+        self.model = mujoco.MjModel.from_xml_string(self.xml)
+        self.data = mujoco.MjData(self.model)
+        self.controller = controller or CartesianImpedance(self.params.apparent_mass)
+        self.rng = np.random.default_rng(seed)
+        m = self.model
+        self._body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "tool")
+        jnt = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "tool_free")
+        self._qpos_adr = int(m.jnt_qposadr[jnt])
+        self._qvel_adr = int(m.jnt_dofadr[jnt])
+        self._site_ft = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "ft_site")
+        f_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "ft_force")
+        t_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SENSOR, "ft_torque")
+        self._f_adr = int(m.sensor_adr[f_id])
+        self._t_adr = int(m.sensor_adr[t_id])
+        assert self._t_adr == self._f_adr + 3, "force and torque sensors must be adjacent"
+        self._ft_raw = self.data.sensordata[self._f_adr : self._f_adr + 6]
+        self._ft_filt = np.zeros(6)
+        self._ft_alpha = 1.0 - float(np.exp(-2 * np.pi * self.params.ft_cutoff * m.opt.timestep))
+        a, b = self._qpos_adr, self._qvel_adr
+        self._pos = self.data.qpos[a : a + 3]
+        self._quat = self.data.qpos[a + 3 : a + 7]
+        self._linvel = self.data.qvel[b : b + 3]
+        self._angvel_local = self.data.qvel[b + 3 : b + 6]
+        self._angvel = np.zeros(3)
+        self._tare = np.zeros(6)
+        self._warnings = 0
+        self._cmd: ImpedanceCommand | None = None
+
+    # ------------------------------------------------------------------ Robot protocol
+    @property
+    def control_period(self) -> float:
+        return float(self.model.opt.timestep)
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    def reset(self, pose: Pose) -> RobotState:
+        """Place the TCP at ``pose`` at rest, hold it, and tare the F/T sensor."""
+        mujoco.mj_resetData(self.model, self.data)
+        self._pos[:] = pose.pos
+        self._quat[:] = pose.quat
+        mujoco.mj_forward(self.model, self.data)
+        self._ft_filt[:] = self._ft_raw
+        self.controller.reset()
+        self.command(ImpedanceCommand.hold(pose))
+        self._tare[:] = self._raw_wrench()  # tared at rest in free space, like a real sensor
+        self._warnings = self._warning_count()
+        return self.state()
+
+    def command(self, cmd: ImpedanceCommand) -> None:
+        self._cmd = cmd
+        self.controller.set_command(cmd, self.data.time)
+
+    def step(self, n: int = 1) -> RobotState:
+        m, d = self.model, self.data
+        ctrl = self.controller
+        qfrc = d.qfrc_applied
+        body = self._body
+        pos, quat, linvel = self._pos, self._quat, self._linvel
+        angvel, angvel_local = self._angvel, self._angvel_local
+        raw, filt, alpha = self._ft_raw, self._ft_filt, self._ft_alpha
+        point = d.xpos[body]  # the tool frame origin is the TCP
+        for _ in range(n):
+            mujoco.mju_rotVecQuat(angvel, angvel_local, quat)
+            w = ctrl.compute(d.time, pos, quat, linvel, angvel)
+            qfrc[:] = 0.0
+            mujoco.mj_applyFT(m, d, w[:3], w[3:], point, body, qfrc)
+            mujoco.mj_step(m, d)
+            filt += alpha * (raw - filt)  # the sensor's low-pass filter
+        self._check_divergence()
+        return self.state()
+
+    def state(self) -> RobotState:
+        return RobotState(
+            t=float(self.data.time),
+            pos=self._pos.copy(),
+            quat=self._quat.copy(),
+            lin_vel=self._linvel.copy(),
+            ang_vel=self._angvel_world(),
+            wrench=self.measured_wrench(),
+        )
+
+    # ----------------------------------------------------------------------- sensors
+    def _angvel_world(self) -> np.ndarray:
+        out = np.zeros(3)
+        mujoco.mju_rotVecQuat(out, self._angvel_local, self._quat)
+        return out
+
+    def _raw_wrench(self) -> np.ndarray:
+        """Environment wrench on the held part at the TCP, world frame, untared and noiseless."""
+        d = self.data
+        rot = d.site_xmat[self._site_ft].reshape(3, 3)
+        f_site = self._ft_filt[:3]
+        t_site = self._ft_filt[3:]
+        # MuJoCo reports what the child exerts on the parent; the environment's wrench on the
+        # part balances it (quasi-statically), so flip the sign, then move the torque to the TCP.
+        f_env = -(rot @ f_site)
+        t_env_site = -(rot @ t_site)
+        lever = d.site_xpos[self._site_ft] - self._pos
+        t_env_tcp = t_env_site + np.cross(lever, f_env)
+        return np.concatenate([f_env, t_env_tcp])
+
+    def measured_wrench(self) -> np.ndarray:
+        """What the wrist F/T sensor reports: tared, biased, noisy (N, N·m, world, at TCP)."""
+        noise = np.concatenate(
+            [
+                self.rng.normal(0.0, self.params.ft_noise[0], 3),
+                self.rng.normal(0.0, self.params.ft_noise[1], 3),
+            ]
+        )
+        return self._raw_wrench() - self._tare + np.asarray(self.params.ft_bias) + noise
+
+    def true_contact_wrench(self) -> np.ndarray:
+        """Noise-free tared wrench (for tests and diagnostics)."""
+        return self._raw_wrench() - self._tare
+
+    # -------------------------------------------------------------------- divergence
+    def _warning_count(self) -> int:
+        return int(sum(w.number for w in self.data.warning))
+
+    def _check_divergence(self) -> None:
+        count = self._warning_count()
+        if count > self._warnings:
+            kinds = [
+                mujoco.mjtWarning(i).name for i, w in enumerate(self.data.warning) if w.number > 0
+            ]
+            self._warnings = count
+            raise SimulationDiverged(
+                f"MuJoCo warning(s) {kinds} at t={self.data.time:.3f} s: simulation invalid"
+            )
+        if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+            raise SimulationDiverged(f"NaN/inf in the state at t={self.data.time:.3f} s")

@@ -1,0 +1,51 @@
+import numpy as np
+import pytest
+
+from teachfit.errors import SimulationDiverged
+from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
+from teachfit.robot.interface import ImpedanceCommand, Robot
+from teachfit.tasks import get_task
+
+
+def test_is_a_robot_and_tares_at_reset():
+    task = get_task("peg2d")
+    robot = FloatingToolRobot(task, params=FloatingToolParams(ft_noise=(0.0, 0.0)))
+    assert isinstance(robot, Robot)
+    state = robot.reset(task.contact_pose([0.02, 0.0]).translated([0, 0, 0.01]))
+    assert np.allclose(state.wrench, 0.0, atol=1e-9)
+    assert robot.time == 0.0
+
+
+@pytest.mark.parametrize("push", [4.0, 10.0])
+def test_feedforward_force_is_read_back_by_the_wrist_sensor(push):
+    task = get_task("peg2d")
+    robot = FloatingToolRobot(task, params=FloatingToolParams(ft_noise=(0.0, 0.0)))
+    start = task.contact_pose([0.02, 0.01])
+    robot.reset(start)
+    robot.command(
+        ImpedanceCommand(
+            pos=start.pos, wrench_ff=[0, 0, -push, 0, 0, 0], stiffness=[500, 500, 0, 40, 40, 40]
+        )
+    )
+    state = robot.step(500)
+    assert state.wrench[2] == pytest.approx(push, rel=0.02)  # the surface pushes back
+    assert np.linalg.norm(state.wrench[:2]) < 0.05 * push
+
+
+def test_sensor_noise_and_bias_are_applied():
+    task = get_task("peg2d")
+    params = FloatingToolParams(ft_noise=(0.5, 0.0), ft_bias=(1.0, 0, 0, 0, 0, 0))
+    robot = FloatingToolRobot(task, params=params, seed=3)
+    robot.reset(task.contact_pose([0.02, 0.0]).translated([0, 0, 0.01]))
+    samples = np.array([robot.state().wrench for _ in range(400)])
+    assert samples[:, 0].mean() == pytest.approx(1.0, abs=0.1)
+    assert samples[:, 1].std() == pytest.approx(0.5, rel=0.15)
+
+
+def test_divergence_is_reported_not_crashed():
+    task = get_task("peg2d")
+    robot = FloatingToolRobot(task)
+    robot.reset(task.contact_pose([0.02, 0.0]))
+    robot.data.qvel[0] = np.nan
+    with pytest.raises(SimulationDiverged):
+        robot.step(5)

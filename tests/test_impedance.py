@@ -1,0 +1,72 @@
+import numpy as np
+import pytest
+
+from teachfit.control.impedance import (
+    CartesianImpedance,
+    ImpedanceLimits,
+    aligned_stiffness,
+    critical_damping,
+)
+from teachfit.errors import ControlError
+from teachfit.pose import quat_from_rz
+from teachfit.robot.floating import FloatingToolRobot
+from teachfit.robot.interface import ImpedanceCommand
+from teachfit.tasks import get_task
+
+
+def test_aligned_stiffness_is_high_along_and_low_across():
+    k = aligned_stiffness([1.0, 1.0], along=2000, across=100, z=300, rotational=40)
+    u = np.array([1.0, 1.0]) / np.sqrt(2)
+    v = np.array([-1.0, 1.0]) / np.sqrt(2)
+    assert u @ k[:2, :2] @ u == pytest.approx(2000)
+    assert v @ k[:2, :2] @ v == pytest.approx(100)
+    assert k[2, 2] == 300 and np.allclose(np.diag(k)[3:], 40)
+
+
+def test_critical_damping_matches_scalar_formula():
+    k = np.diag([400.0, 100.0, 900.0, 4.0, 9.0, 16.0])
+    m = np.array([1.0, 1.0, 4.0, 0.01, 0.01, 0.04])
+    d = critical_damping(k, m, 1.0)
+    assert np.allclose(np.diag(d), 2 * np.sqrt(np.diag(k) * m))
+
+
+def test_wrench_limits_hold():
+    ctrl = CartesianImpedance(np.ones(6), ImpedanceLimits(max_force=10, max_torque=1))
+    cmd = ImpedanceCommand(pos=[1.0, 0, 0], quat=quat_from_rz(1.0), stiffness=[1e4] * 6)
+    ctrl.set_command(cmd, 0.0)
+    w = ctrl.compute(0.0, np.zeros(3), np.array([1.0, 0, 0, 0]), np.zeros(3), np.zeros(3))
+    assert np.linalg.norm(w[:3]) == pytest.approx(10)
+    assert np.linalg.norm(w[3:]) == pytest.approx(1)
+    assert w[0] > 0 and w[5] > 0  # pulls towards the set-point
+
+
+def test_command_validation():
+    with pytest.raises(ControlError, match="NaN"):
+        ImpedanceCommand(pos=[np.nan, 0, 0])
+    with pytest.raises(ControlError, match="positive semi-definite"):
+        ImpedanceCommand(pos=[0, 0, 0], stiffness=[-1, 1, 1, 1, 1, 1])
+    with pytest.raises(ControlError, match="unit norm"):
+        ImpedanceCommand(pos=[0, 0, 0], quat=[1, 1, 0, 0])
+
+
+def test_tracks_a_moving_setpoint_in_free_space():
+    task = get_task("peg2d")
+    robot = FloatingToolRobot(task)
+    start = task.contact_pose([0.0, 0.0]).translated([0, 0, 0.05])  # well above the block
+    robot.reset(start)
+    v = np.array([0.02, -0.01, 0.0])
+    robot.command(ImpedanceCommand(pos=start.pos, lin_vel=v, stiffness=[2000] * 3 + [50] * 3))
+    state = robot.step(1000)
+    expected = start.pos + v * state.t
+    assert np.linalg.norm(state.pos - expected) < 1e-3  # < 1 mm lag at 2 cm/s
+    assert np.allclose(state.lin_vel, v, atol=2e-3)
+    assert np.linalg.norm(state.wrench[:3]) < 0.5  # nothing touched
+
+
+def test_velocity_limit_clips_the_setpoint_motion():
+    ctrl = CartesianImpedance(np.ones(6), ImpedanceLimits(max_speed=0.1, max_force=1e4))
+    ctrl.set_command(ImpedanceCommand(pos=np.zeros(3), lin_vel=[1.0, 0, 0]), 0.0)
+    w = ctrl.compute(1.0, np.zeros(3), np.array([1.0, 0, 0, 0]), np.zeros(3), np.zeros(3))
+    # after 1 s the set-point moved 0.1 m, not 1 m: force = K * 0.1 + D * 0.1
+    k = 1000.0
+    assert w[0] == pytest.approx(k * 0.1 + 2 * np.sqrt(k) * 0.1, rel=1e-6)
