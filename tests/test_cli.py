@@ -85,3 +85,21 @@ def test_bench_sim_prints_ratio():
 
 def test_console_script_installed():
     assert shutil.which("teachfit") is not None
+
+
+def test_learn_plan_run_search(tmp_path):
+    demos = tmp_path / "demos.h5"
+    assert invoke("demo", "record", "-n", "1", "--seed", "1", "--out", demos).exit_code == 0
+    model = tmp_path / "peg.model"
+    res = invoke("learn", "search", demos, "--out", model)
+    assert res.exit_code == 0, res.output
+    res = invoke("search", "plan", model, "--method", "tshix", "-n", "50", "--plot",
+                 tmp_path / "plan.png")
+    assert res.exit_code == 0, res.output
+    assert "ergodic metric" in res.output and (tmp_path / "plan.png").exists()
+    res = invoke("search", "run", "--task", "peg2d", "--model", model, "-n", "50",
+                 "--starts", "1", "--demo", f"{demos}:0")
+    assert res.exit_code == 0, res.output
+    assert "starts" in res.output
+    res = invoke("search", "run", "--task", "socket3d", "--model", model, "--starts", "1")
+    assert res.exit_code == 2  # a peg2d model for the socket task

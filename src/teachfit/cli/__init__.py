@@ -10,6 +10,7 @@ import typer  # noqa: E402
 
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
+from teachfit.cli.search_cmd import learn_search, search_app  # noqa: E402
 
 app = typer.Typer(
     name="teachfit",
@@ -20,6 +21,10 @@ app = typer.Typer(
 bench_app = typer.Typer(help="Benchmarks that print figures (speed, success rates).")
 app.add_typer(demo_app, name="demo")
 app.add_typer(bench_app, name="bench")
+learn_app = typer.Typer(help="Learn models from demonstrations or trials.", no_args_is_help=True)
+learn_app.command("search")(learn_search)
+app.add_typer(learn_app, name="learn")
+app.add_typer(search_app, name="search")
 register(app, bench_app)
 
 

@@ -34,8 +34,8 @@ class TeacherStyle:
 
     pattern: str = "spiral"
     speed: float = 0.012
-    belief_sigma: float = 0.003
-    spiral_pitch: float = 0.0015
+    belief_sigma: float = 0.005
+    spiral_pitch: float = 0.0025
     wander_amplitude: float = 0.0005
     wander_timescale: float = 0.5
     tremor_amplitude: float = 0.00005

@@ -1,0 +1,156 @@
+"""``teachfit learn search`` and ``teachfit search ...``: seed A's method from the CLI."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.progress import Progress
+from rich.table import Table
+
+from teachfit.cli.common import console, guarded
+from teachfit.errors import TeachfitError
+
+search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
+
+
+@guarded
+def learn_search(
+    demos: Annotated[Path, typer.Argument(help="HDF5 demonstrations of one task")],
+    out: Annotated[Path, typer.Option(help="model file to write (JSON)")] = Path("search.model"),
+    components: Annotated[str, typer.Option(help="GMM components: a number or 'bic'")] = "1",
+    seed: int = 0,
+) -> None:
+    """Learn the exploration distribution and the dynamics model from demonstrations."""
+    from teachfit.demonstrations.dataset import read_dataset
+    from teachfit.models.search_model import SearchModel
+
+    demo_list = read_dataset(demos)
+    tasks = {d.task for d in demo_list}
+    if len(tasks) != 1:
+        raise TeachfitError(f"{demos} mixes tasks {sorted(tasks)}; learn one task at a time")
+    n_comp: int | str = components if components == "bic" else int(components)
+    model = SearchModel.fit(demo_list, tasks.pop(), n_components=n_comp, seed=seed)
+    model.save(out)
+    e = model.exploration
+    console.print(
+        f"learned from {len(demo_list)} demonstration(s) of [bold]{model.task}[/]: "
+        f"dims {', '.join(model.dims)}, {e.n_components} component(s), "
+        f"mean {np.round(e.mean * 1e3, 1)} (mm/mrad), teacher speed {model.speed * 1e3:.1f} mm/s"
+        f"\nmodel -> {out}"
+    )
+
+
+@search_app.command("plan")
+@guarded
+def plan(
+    model_file: Annotated[Path, typer.Argument(help="model from 'teachfit learn search'")],
+    method: Annotated[str, typer.Option(help="tshix, ergodic, spiral or random-walk")] = "tshix",
+    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
+    seed: int = 0,
+    plot: Annotated[Path | None, typer.Option(help="figure to write")] = None,
+) -> None:
+    """Plan one search trajectory in the search frame and report its figures of merit."""
+    import time
+
+    from teachfit.execution.search import plan_search
+    from teachfit.models.search_model import SearchModel
+    from teachfit.trajectories.ergodic import ergodic_metric
+
+    model = SearchModel.load(model_file)
+    t0 = time.perf_counter()
+    traj = plan_search(model, method, n, np.random.default_rng(seed))
+    wall = time.perf_counter() - t0
+    metric = ergodic_metric(traj.states, model.exploration, t=traj.t)
+    console.print(
+        f"{method}: {traj.t.size} set-points, {traj.duration:.1f} s, path "
+        f"{traj.path_length() * 1e3:.0f} mm, ergodic metric {metric:.4f}, planned in "
+        f"{wall * 1e3:.0f} ms"
+    )
+    if plot is not None:
+        from teachfit.viz import search_figures as sf
+
+        if traj.itinerary is not None and traj.states.shape[1] == 2:
+            fig = sf.tshix_stages(traj, model.exploration)
+        elif traj.states.shape[1] == 3:
+            fig = sf.trajectory_3d(traj)
+        else:
+            fig = sf.planned_vs_executed(traj.states, traj.states, ("planned", "planned"))
+        sf.save(fig, plot)
+        console.print(f"figure -> {plot}")
+
+
+@search_app.command("run")
+@guarded
+def run(
+    task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
+    model_file: Annotated[Path, typer.Option("--model", help="learned model")] = Path(
+        "search.model"
+    ),
+    method: Annotated[str, typer.Option(help="tshix, ergodic, spiral or random-walk")] = "tshix",
+    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
+    starts: Annotated[int, typer.Option(help="number of start poses")] = 30,
+    protocol: Annotated[str, typer.Option(help="start protocol of the task")] = "table1",
+    feedforward: Annotated[bool, typer.Option(help="superpose the GMR feed-forward")] = True,
+    demo: Annotated[
+        str | None, typer.Option(help="demonstration whose start anchors the protocol (f.h5:0)")
+    ] = None,
+    seed: int = 0,
+    plot: Annotated[Path | None, typer.Option(help="figure of the executed paths")] = None,
+) -> None:
+    """Execute searches from the protocol's starts and print the success table.
+
+    Seed A's Table I starts lie in a 3 cm circle halfway between the demonstration's start and
+    the hole: pass the demonstration the model was learned from with ``--demo``.
+    """
+    from teachfit.execution.search import plan_search, run_search
+    from teachfit.metrics.stats import summarize
+    from teachfit.models.search_model import SearchModel
+    from teachfit.robot.floating import FloatingToolRobot
+    from teachfit.tasks.registry import load_task
+
+    the_task = load_task(task)
+    model = SearchModel.load(model_file, task=the_task.name)
+    rng = np.random.default_rng(seed)
+    demo_start = None
+    if demo is not None:
+        from teachfit.demonstrations.dataset import read_demo
+        from teachfit.pose import Pose
+
+        d = read_demo(demo)
+        demo_start = Pose(d.pos[0], d.quat[0])
+    start_poses = the_task.protocol_starts(protocol, starts, rng, demo_start)
+    robot = FloatingToolRobot(the_task, seed=seed)
+    fixed = plan_search(model, method, n, rng) if method == "ergodic" else None
+    outcomes, paths = [], []
+    with Progress(console=console, transient=True) as bar:
+        job = bar.add_task(f"{method} from {starts} starts", total=starts)
+        for i, start in enumerate(start_poses):
+            traj = fixed or plan_search(model, method, n, np.random.default_rng(seed * 1000 + i))
+            r = run_search(robot, the_task, model, start, traj, feedforward=feedforward)
+            outcomes.append(r.outcome)
+            paths.append((r.log.pos, r.outcome.success))
+            bar.advance(job)
+    s = summarize([o.success for o in outcomes], [o.time_to_insertion for o in outcomes])
+    table = Table(title=f"{method} on {the_task.name} ({protocol}, seed {seed})")
+    for col in ("starts", "successes", "rate [95 % CI]", "median time", "reasons"):
+        table.add_column(col, justify="right")
+    reasons = {}
+    for o in outcomes:
+        reasons[o.reason.split(":")[0]] = reasons.get(o.reason.split(":")[0], 0) + 1
+    t_med = "n/a" if np.isnan(s.median_time) else f"{s.median_time:.2f} s"
+    table.add_row(
+        str(s.trials),
+        str(s.successes),
+        f"{100 * s.rate:.0f} % [{100 * s.low:.0f}, {100 * s.high:.0f}]",
+        t_med,
+        ", ".join(f"{k} {v}" for k, v in reasons.items()),
+    )
+    console.print(table)
+    if plot is not None:
+        from teachfit.viz.figures import plot_executions
+
+        plot_executions(paths, plot, the_task, title=method)
+        console.print(f"figure -> {plot}")

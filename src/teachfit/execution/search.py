@@ -1,0 +1,139 @@
+"""Execute learned search trajectories (seed A): search frame -> world set-points + GMR
+feed-forward -> impedance runner, and the batch protocols used by the CLI and benchmarks.
+
+The search frame has its origin at the start pose; its axes are the world's (positions are
+only translated) and ``rz`` adds to the start's yaw, as in seed A where each demonstration is
+translated so that its first pose is the origin.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from teachfit.errors import TeachfitError
+from teachfit.execution.runner import ExecutionConfig, ExecutionLog, Outcome, run_trajectory
+from teachfit.execution.setpoints import SetpointTrajectory
+from teachfit.models.search_model import SearchModel
+from teachfit.pose import Pose, quat_from_rz
+from teachfit.robot.interface import Robot
+from teachfit.tasks.base import Task
+from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
+from teachfit.trajectories.baselines import archimedean_spiral, random_walk
+
+METHODS = ("tshix", "ergodic", "spiral", "random-walk")
+_WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rz": 5}
+
+
+def search_setpoints(
+    traj: SearchTrajectory,
+    task: Task,
+    start: Pose,
+    model: SearchModel | None = None,
+) -> SetpointTrajectory:
+    """World set-points for a search trajectory started at ``start``.
+
+    With ``model``, the feed-forward wrench is the GMR conditional mean of the action given the
+    planned step (seed A, Sec. III-C), mapped onto the searched wrench components.
+    """
+    states = np.asarray(traj.states, dtype=float)
+    dims = tuple(traj.dims)
+    if tuple(task.search_dims) != dims:
+        raise TeachfitError(
+            f"trajectory dims {dims} do not match task {task.name} {task.search_dims}"
+        )
+    n = states.shape[0]
+    pos = np.tile(np.array([start.pos[0], start.pos[1], task.surface_z]), (n, 1))
+    for j, d in enumerate(dims):
+        if d in ("x", "y", "z"):
+            pos[:, "xyz".index(d)] += states[:, j]
+    rz = start.rz + (states[:, dims.index("rz")] if "rz" in dims else 0.0)
+    quat = quat_from_rz(np.broadcast_to(rz, (n,))) if "rz" in dims else np.tile(start.quat, (n, 1))
+    ff = np.zeros((n, 6))
+    if model is not None and model.dynamics is not None:
+        actions = model.feedforward_along(traj.t, states)
+        for j, d in enumerate(dims):
+            ff[:, _WRENCH_INDEX[d]] = actions[:, j]
+    return SetpointTrajectory(traj.t, pos, quat, ff, name=traj.method)
+
+
+@dataclass(frozen=True)
+class SearchRun:
+    outcome: Outcome
+    log: ExecutionLog
+    trajectory: SearchTrajectory
+    setpoints: SetpointTrajectory
+
+
+def plan_search(
+    model: SearchModel,
+    method: str,
+    n_points: int,
+    rng: np.random.Generator,
+    *,
+    length: float | None = None,
+) -> SearchTrajectory:
+    """A search trajectory in the search frame by ``method`` (see :data:`METHODS`)."""
+    if n_points <= 0:
+        raise TeachfitError(f"number of points must be positive, got {n_points}")
+    dims = model.dims
+    if method == "tshix":
+        return TshixPlanner.from_model(model).plan(n_points, rng)
+    if method == "ergodic":
+        if length is None:
+            length = TshixPlanner.from_model(model).plan(n_points, rng).path_length()
+        return ergodic_trajectory(
+            model.exploration,
+            speed=model.speed,
+            length=length,
+            angular_speed=model.angular_speed,
+            start=np.zeros(len(dims)),
+        )
+    if method == "spiral":
+        return archimedean_spiral(dims, pitch=0.002, radius=0.02, speed=model.speed)
+    if method == "random-walk":
+        return random_walk(
+            dims, rng, n_steps=n_points, step_max=0.004, radius=0.02, speed=model.speed
+        )
+    raise TeachfitError(f"unknown search method {method!r}; choose from {METHODS}")
+
+
+def run_search(
+    robot: Robot,
+    task: Task,
+    model: SearchModel,
+    start: Pose,
+    traj: SearchTrajectory,
+    *,
+    feedforward: bool = True,
+    config: ExecutionConfig | None = None,
+) -> SearchRun:
+    """Execute one search trajectory from ``start``."""
+    setpoints = search_setpoints(traj, task, start, model if feedforward else None)
+    outcome, log = run_trajectory(robot, task, setpoints, start, config)
+    return SearchRun(outcome, log, traj, setpoints)
+
+
+def run_batch(
+    robot: Robot,
+    task: Task,
+    model: SearchModel,
+    starts: Sequence[Pose],
+    make_traj: Callable[[int], SearchTrajectory],
+    *,
+    feedforward: bool = True,
+    config: ExecutionConfig | None = None,
+    on_done: Callable[[SearchRun], None] | None = None,
+) -> list[SearchRun]:
+    """Run ``make_traj(i)`` from each start ``i``; ``on_done`` is called after each run."""
+    runs = []
+    for i, start in enumerate(starts):
+        run = run_search(
+            robot, task, model, start, make_traj(i), feedforward=feedforward, config=config
+        )
+        runs.append(run)
+        if on_done is not None:
+            on_done(run)
+    return runs

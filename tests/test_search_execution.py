@@ -1,0 +1,72 @@
+import numpy as np
+import pytest
+
+from teachfit.demonstrations.teacher import BlindTeacher
+from teachfit.errors import TeachfitError
+from teachfit.execution.search import plan_search, run_search, search_setpoints
+from teachfit.models.search_model import SearchModel
+from teachfit.pose import Pose
+from teachfit.robot.floating import FloatingToolRobot
+from teachfit.tasks import get_task
+from teachfit.trajectories import SearchTrajectory
+
+
+@pytest.fixture(scope="module")
+def peg_model():
+    task = get_task("peg2d")
+    demos, _ = BlindTeacher(task, seed=1).record(1)
+    return task, demos[0], SearchModel.fit(demos, task.name)
+
+
+def test_setpoints_translate_the_search_frame_and_add_yaw():
+    task = get_task("socket3d")
+    t = np.array([0.0, 1.0, 2.0])
+    states = np.array([[0.0, 0.0, 0.0], [0.01, -0.002, 0.1], [0.02, 0.0, -0.2]])
+    traj = SearchTrajectory(t, states, ("x", "y", "rz"), "test")
+    start = Pose.from_xyz_rz(0.003, 0.004, task.surface_z, 0.3)
+    sp = search_setpoints(traj, task, start)
+    assert np.allclose(sp.pos[:, :2], states[:, :2] + [0.003, 0.004])
+    assert np.allclose(sp.pos[:, 2], task.surface_z)
+    yaw = 2 * np.arctan2(sp.quat[:, 3], sp.quat[:, 0])
+    assert np.allclose(yaw, 0.3 + states[:, 2])
+    assert np.allclose(sp.wrench_ff, 0.0)  # no model: no feed-forward
+    with pytest.raises(TeachfitError, match="dims"):
+        search_setpoints(traj, get_task("peg2d"), start)
+
+
+def test_feedforward_from_the_dynamics_model(peg_model):
+    task, _, model = peg_model
+    traj = plan_search(model, "tshix", 30, np.random.default_rng(0))
+    start = task.contact_pose([0.02, 0.0])
+    sp = search_setpoints(traj, task, start, model)
+    expected = model.feedforward_along(traj.t, traj.states)
+    assert np.allclose(sp.wrench_ff[:, :2], expected)
+    assert np.allclose(sp.wrench_ff[:, 2:], 0.0)
+    # the teacher pushed against friction: the action points along the motion on average
+    vel = np.gradient(traj.states, traj.t, axis=0)
+    assert np.mean(np.sum(vel * expected, axis=1)) > 0
+
+
+def test_search_finds_the_hole_from_the_demo_start(peg_model):
+    task, demo, model = peg_model
+    robot = FloatingToolRobot(task)
+    start = Pose(demo.pos[0], demo.quat[0])
+    successes = 0
+    for seed in range(2):
+        traj = plan_search(model, "tshix", 300, np.random.default_rng(seed))
+        run = run_search(robot, task, model, start, traj)
+        successes += run.outcome.success
+        assert run.log.pos.shape[0] > 10
+    assert successes >= 1
+
+
+def test_methods_and_bad_input(peg_model):
+    _, _, model = peg_model
+    rng = np.random.default_rng(0)
+    for method in ("ergodic", "spiral", "random-walk"):
+        traj = plan_search(model, method, 50, rng)
+        assert traj.states.shape[1] == 2 and traj.duration > 1.0
+    with pytest.raises(TeachfitError, match="positive"):
+        plan_search(model, "tshix", 0, rng)
+    with pytest.raises(TeachfitError, match="unknown search method"):
+        plan_search(model, "telepathy", 10, rng)
