@@ -103,3 +103,8 @@ def test_learn_plan_run_search(tmp_path):
     assert "starts" in res.output
     res = invoke("search", "run", "--task", "socket3d", "--model", model, "--starts", "1")
     assert res.exit_code == 2  # a peg2d model for the socket task
+
+
+def test_bench_search_names_missing_tables():
+    res = invoke("bench", "search", "--table", "7")
+    assert res.exit_code == 2 and "available" in res.output
