@@ -1,0 +1,281 @@
+"""Adaptive Cartesian impedance control (METHODS.md B; Yang et al. T-RO 2011, Cartesian form).
+
+Per control period ``T`` and element-wise per task coordinate ``i`` (x, y, z, rx, ry, rz in the
+world frame at the TCP), with ``e = x_d - x`` (m, rad: rotation vector) and ``de = dx_d - dx``
+(m/s, rad/s):
+
+    eps        = de + kappa e                                     (adaptive tracking error)
+    F_ff(t)    = F_ff(t-T) + alpha (eps - gamma_a F_ff(t-T))      (adaptive feed-forward)
+    K_a(t)     = K_a(t-T)  + beta  (eps e - gamma_b K_a(t-T))     (adaptive stiffness)
+    K          = K_cmd + diag(K_a)
+    D          = D_cmd + diag(2 xi sqrt(m) (sqrt(K_cmd,ii + K_a) - sqrt(K_cmd,ii)))
+    w          = K e + D de + F_d + F_ff                          (N, N·m at the TCP)
+
+``K_cmd`` / ``D_cmd`` / ``F_d`` come from the :class:`~teachfit.robot.interface.ImpedanceCommand`
+(``F_d = wrench_ff``, the skill's own feed-forward). Every tick the increments are clipped to
+``dF_max T`` / ``dK_max T`` and the states to ``|F_ff| <= F_max``, ``K_cmd,ii + K_a <= K_max``;
+the output wrench is clipped like the fixed-gain controller's (:class:`ImpedanceLimits`).
+The rate limits bound the *adaptation*; a step in the commanded stiffness is the skill's own
+choice (a command may cut ``K_a`` at once so that ``K_cmd,ii + K_a <= K_max`` still holds).
+
+Choice (documented here because the reconstruction is silent on it): the *command's stiffness
+is the initial and minimum stiffness*. The adaptive part ``K_a >= 0`` is added on top of it and
+forgetting pulls ``K_a`` back to zero, i.e. ``K`` back to what the skill asked for; a skill thus
+states the compliance it needs and adaptation only stiffens where errors persist. Adapted
+``F_ff`` and ``K_a`` survive new commands (adaptation across a skill is the point) and are
+cleared by :meth:`AdaptiveImpedance.reset`.
+
+The law is written by hand: it is a handful of element-wise updates specific to this
+controller, not something a library provides.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import mujoco
+import numpy as np
+
+from teachfit.control.adaptive_params import (
+    AdaptiveLimits,
+    AdaptiveParams,
+    MetaBounds,
+    meta_bounds,
+)
+from teachfit.control.impedance import ImpedanceLimits, critical_damping
+from teachfit.errors import ControlError
+from teachfit.robot.interface import ImpedanceCommand
+
+__all__ = ["AdaptiveImpedance", "AdaptiveLimits", "AdaptiveParams", "MetaBounds", "meta_bounds"]
+
+
+class AdaptiveImpedance:
+    """Adaptive Cartesian impedance controller; see the module docstring for the law.
+
+    Implements :class:`~teachfit.control.base.Controller`.
+
+    Parameters
+    ----------
+    apparent_mass : (6,) array
+        Apparent mass / inertia per axis (kg, kg·m²), for damping from stiffness.
+    params : AdaptiveParams
+        Meta-parameters. ``alpha gamma_a < 1`` and ``beta gamma_b < 1`` are required (else the
+        discrete forgetting overshoots and oscillates).
+    limits : AdaptiveLimits
+        Stiffness / feed-forward limits and rate limits of the adaptation.
+    impedance_limits : ImpedanceLimits
+        Output wrench and desired-speed limits, as for the fixed-gain controller.
+    period : float
+        Control period ``T`` (s); the controller advances one adaptation step per
+        :meth:`compute` call, which a robot makes once per tick.
+    damping_ratio : float or None
+        ``xi`` for the adaptive damping term; ``None`` uses each command's ``damping_ratio``.
+    """
+
+    def __init__(
+        self,
+        apparent_mass: np.ndarray | Sequence[float],
+        params: AdaptiveParams | None = None,
+        limits: AdaptiveLimits | None = None,
+        impedance_limits: ImpedanceLimits | None = None,
+        period: float = 0.001,
+        damping_ratio: float | None = None,
+    ) -> None:
+        m = np.asarray(apparent_mass, dtype=float).reshape(-1)
+        if m.shape != (6,) or not np.all(m > 0):
+            raise ControlError(f"apparent_mass must be 6 positive numbers, got {apparent_mass}")
+        if not period > 0:
+            raise ControlError(f"period must be > 0 s, got {period}")
+        if damping_ratio is not None and not damping_ratio >= 0:
+            raise ControlError(f"damping_ratio must be >= 0, got {damping_ratio}")
+        self.mass = m
+        self.params = params or AdaptiveParams()
+        self.limits = limits or AdaptiveLimits()
+        self.impedance_limits = impedance_limits or ImpedanceLimits()
+        self.period = float(period)
+        self.damping_ratio = damping_ratio
+        p, lim = self.params, self.limits
+        self._alpha = np.array(p.alpha)
+        self._beta = np.array(p.beta)
+        self._gamma_a = np.array(p.gamma_a)
+        self._gamma_b = np.array(p.gamma_b)
+        self._kappa = np.array(p.kappa)
+        if np.any(self._alpha * self._gamma_a >= 1) or np.any(self._beta * self._gamma_b >= 1):
+            raise ControlError("alpha*gamma_a and beta*gamma_b must be < 1 per coordinate")
+        self._k_max = np.array(lim.k_max)
+        self._dk_step = np.array(lim.dk_max) * self.period
+        self._f_max = np.array(lim.f_max)
+        self._df_step = np.array(lim.df_max) * self.period
+        self._neg_f_max = -self._f_max
+        self._neg_df_step = -self._df_step
+        self._neg_dk_step = -self._dk_step
+        self._sqrt_m2 = 2.0 * np.sqrt(m)
+        # state and per-tick buffers, allocated once (compute() runs at 1 kHz)
+        self._ff_adapt = np.zeros(6)
+        self._k_adapt = np.zeros(6)
+        self._k0 = np.zeros((6, 6))
+        self._k0_diag = np.zeros(6)
+        self._sqrt_k0 = np.zeros(6)
+        self._k_room = np.zeros(6)
+        self._d0 = np.zeros((6, 6))
+        self._xi = 1.0
+        self._xd = np.zeros(3)
+        self._qd = np.array([1.0, 0.0, 0.0, 0.0])
+        self._vd = np.zeros(6)
+        self._fd = np.zeros(6)
+        self._t0 = 0.0
+        self._err = np.zeros(6)
+        self._derr = np.zeros(6)
+        self._eps = np.zeros(6)
+        self._step = np.zeros(6)
+        self._tmp = np.zeros(6)
+        self._qtmp = np.zeros(4)
+        self._rtmp = np.zeros(3)
+        self._spinning = False
+        self._has_cmd = False
+        self.last_wrench = np.zeros(6)
+
+    # ------------------------------------------------------------------------ inspection
+    @property
+    def feedforward(self) -> np.ndarray:
+        """Adapted feed-forward wrench ``F_ff`` (6,) (N, N·m), a copy."""
+        return self._ff_adapt.copy()
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        """Current diagonal stiffness ``K_cmd,ii + K_a`` (6,) (N/m, N·m/rad), a copy."""
+        return self._k0_diag + self._k_adapt
+
+    @property
+    def stiffness_adapt(self) -> np.ndarray:
+        """Adaptive stiffness ``K_a`` (6,) on top of the command's, a copy."""
+        return self._k_adapt.copy()
+
+    @property
+    def damping(self) -> np.ndarray:
+        """Current diagonal damping (6,) (N·s/m, N·m·s/rad)."""
+        return np.diag(self._d0) + self._adaptive_damping(np.zeros(6))
+
+    # ------------------------------------------------------------------ Controller protocol
+    def reset(self) -> None:
+        """Forget the adapted ``F_ff`` and ``K_a`` and the last command."""
+        self._ff_adapt[:] = 0.0
+        self._k_adapt[:] = 0.0
+        self._has_cmd = False
+        self.last_wrench = np.zeros(6)
+
+    def set_command(self, cmd: ImpedanceCommand, t: float) -> None:
+        """Adopt ``cmd`` at time ``t`` (s); its stiffness is the floor of the adapted one.
+
+        Raises :class:`ControlError` if a diagonal stiffness exceeds ``k_max``.
+        """
+        diag = np.diag(cmd.stiffness)
+        if np.any(diag > self._k_max):
+            raise ControlError(
+                f"command stiffness {diag.tolist()} exceeds k_max {self._k_max.tolist()}"
+            )
+        ilim = self.impedance_limits
+        self._k0[:] = cmd.stiffness
+        self._k0_diag[:] = diag
+        np.sqrt(diag, out=self._sqrt_k0)
+        np.subtract(self._k_max, diag, out=self._k_room)
+        np.minimum(self._k_adapt, self._k_room, out=self._k_adapt)
+        self._xi = cmd.damping_ratio if self.damping_ratio is None else self.damping_ratio
+        if cmd.damping is None:
+            self._d0[:] = critical_damping(self._k0, self.mass, cmd.damping_ratio)
+        else:
+            self._d0[:] = cmd.damping
+        v = cmd.lin_vel
+        speed = float(np.linalg.norm(v))
+        self._vd[:3] = v if speed <= ilim.max_speed else v * (ilim.max_speed / speed)
+        w = cmd.ang_vel
+        spin = float(np.linalg.norm(w))
+        self._vd[3:] = w if spin <= ilim.max_ang_speed else w * (ilim.max_ang_speed / spin)
+        self._spinning = bool(np.any(self._vd[3:] != 0.0))
+        self._xd[:] = cmd.pos
+        self._qd[:] = cmd.quat
+        self._fd[:] = cmd.wrench_ff
+        self._t0 = t
+        self._has_cmd = True
+
+    def _adaptive_damping(self, out: np.ndarray) -> np.ndarray:
+        """``2 xi sqrt(m) (sqrt(K_cmd,ii + K_a) - sqrt(K_cmd,ii))`` into ``out`` (6,)."""
+        np.add(self._k0_diag, self._k_adapt, out=out)
+        np.sqrt(out, out=out)
+        out -= self._sqrt_k0
+        out *= self._sqrt_m2
+        out *= self._xi
+        return out
+
+    def compute(
+        self,
+        t: float,
+        pos: np.ndarray,
+        quat: np.ndarray,
+        lin_vel: np.ndarray,
+        ang_vel: np.ndarray,
+    ) -> np.ndarray:
+        """Adapt once (one period ``T``) and return the wrench ``[f; tau]`` (6,), world, TCP.
+
+        ``pos`` (3,), ``quat`` (4,) w-x-y-z, ``lin_vel`` and ``ang_vel`` (3,) in the world frame.
+        """
+        if not self._has_cmd:
+            raise ControlError("compute() called before set_command()")
+        # errors exactly as in CartesianImpedance (x_d extrapolated with the desired twist)
+        dt = t - self._t0
+        err, derr, eps, step, tmp = self._err, self._derr, self._eps, self._step, self._tmp
+        np.subtract(self._xd, pos, out=err[:3])
+        err[:3] += self._vd[:3] * dt
+        qd = self._qd
+        if self._spinning:
+            qd = self._qtmp
+            qd[:] = self._qd
+            mujoco.mju_quatIntegrate(qd, self._vd[3:], dt)
+        mujoco.mju_subQuat(self._rtmp, qd, quat)
+        mujoco.mju_rotVecQuat(err[3:], self._rtmp, quat)
+        np.subtract(self._vd[:3], lin_vel, out=derr[:3])
+        np.subtract(self._vd[3:], ang_vel, out=derr[3:])
+        # eps = de + kappa e
+        np.multiply(self._kappa, err, out=eps)
+        eps += derr
+        # F_ff += clip(alpha (eps - gamma_a F_ff), +-dF_max T), then clip to +-F_max
+        np.multiply(self._gamma_a, self._ff_adapt, out=step)
+        np.subtract(eps, step, out=step)
+        step *= self._alpha
+        # (np.minimum/np.maximum: several times cheaper than np.clip at this size)
+        np.minimum(step, self._df_step, out=step)
+        np.maximum(step, self._neg_df_step, out=step)
+        ff = self._ff_adapt
+        ff += step
+        np.minimum(ff, self._f_max, out=ff)
+        np.maximum(ff, self._neg_f_max, out=ff)
+        # K_a += clip(beta (eps e - gamma_b K_a), +-dK_max T), then clip to [0, K_max - K_cmd]
+        np.multiply(self._gamma_b, self._k_adapt, out=step)
+        np.multiply(eps, err, out=tmp)
+        tmp -= step
+        tmp *= self._beta
+        np.minimum(tmp, self._dk_step, out=tmp)
+        np.maximum(tmp, self._neg_dk_step, out=tmp)
+        ka = self._k_adapt
+        ka += tmp
+        np.minimum(ka, self._k_room, out=ka)
+        np.maximum(ka, 0.0, out=ka)
+        # w = K e + D de + F_d + F_ff
+        w = self._k0 @ err
+        w += self._d0 @ derr
+        np.multiply(self._k_adapt, err, out=tmp)
+        w += tmp
+        self._adaptive_damping(tmp)
+        tmp *= derr
+        w += tmp
+        w += self._fd
+        w += self._ff_adapt
+        ilim = self.impedance_limits
+        fn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+        if fn > ilim.max_force:
+            w[:3] *= ilim.max_force / fn
+        tn = np.sqrt(w[3] * w[3] + w[4] * w[4] + w[5] * w[5])
+        if tn > ilim.max_torque:
+            w[3:] *= ilim.max_torque / tn
+        self.last_wrench = w
+        return w

@@ -1,0 +1,37 @@
+"""Meta-learning of skill parameters: ask/tell learners, resumable studies, parallel trials."""
+
+from teachfit.learning.base import (
+    Candidate,
+    Finished,
+    Learner,
+    LearningError,
+    ParamDomain,
+    ParamSpace,
+    TrialResult,
+)
+from teachfit.learning.bo import BayesOpt
+from teachfit.learning.cmaes import CMAES
+from teachfit.learning.lhs import LatinHypercube
+from teachfit.learning.pso import PSO
+from teachfit.learning.runner import RunReport, run_study
+from teachfit.learning.study import METHODS, Study, StudyMismatchError, make_learner
+
+__all__ = [
+    "CMAES",
+    "METHODS",
+    "PSO",
+    "BayesOpt",
+    "Candidate",
+    "Finished",
+    "LatinHypercube",
+    "Learner",
+    "LearningError",
+    "ParamDomain",
+    "ParamSpace",
+    "RunReport",
+    "Study",
+    "StudyMismatchError",
+    "TrialResult",
+    "make_learner",
+    "run_study",
+]

@@ -1,0 +1,267 @@
+"""What every learner shares: a box-bounded parameter space and the ask/tell protocol.
+
+A :class:`ParamSpace` names the learned parameters and their :class:`ParamDomain`
+``[low, high]`` in physical units. Learners search the unit cube ``u in [0, 1]^d``:
+
+    x_i = low_i + u_i (high_i - low_i)                       (linear domain)
+    x_i = exp(log low_i + u_i (log high_i - log low_i))      (``log=True``, low_i > 0)
+
+so that one step size means the same for every parameter. A learner hands out
+:class:`Candidate` s (a unique ``key`` and a unit-cube point ``u``) with :meth:`Learner.ask` and is
+told each one's cost with :meth:`Learner.tell`. Costs are minimised; a failed execution is told
+with a penalty cost and ``feasible=False``. :meth:`Learner.restore` rebuilds a fresh learner's
+state from finished trials (e.g. read back from a study database), after which asking continues
+where the learner stood: finished keys are never handed out again.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from teachfit.errors import TeachfitError
+
+
+class LearningError(TeachfitError):
+    """Invalid learning set-up: parameter space, values outside it, learner options, studies."""
+
+
+@dataclass(frozen=True)
+class ParamDomain:
+    """The closed interval ``[low, high]`` a learned parameter lives in (physical units).
+
+    ``log=True`` searches it on a logarithmic scale (needs ``low > 0``).
+    """
+
+    low: float
+    high: float
+    log: bool = False
+
+    def __post_init__(self) -> None:
+        low, high = float(self.low), float(self.high)
+        if not (math.isfinite(low) and math.isfinite(high)) or not low < high:
+            raise LearningError(f"a domain needs finite low < high, got [{self.low}, {self.high}]")
+        if self.log and not low > 0:
+            raise LearningError(f"a log domain needs low > 0, got {low}")
+        object.__setattr__(self, "low", low)
+        object.__setattr__(self, "high", high)
+
+    def contains(self, value: float) -> bool:
+        return self.low <= value <= self.high
+
+    def to_unit(self, value: float) -> float:
+        if self.log:
+            lo, hi = math.log(self.low), math.log(self.high)
+            return (math.log(value) - lo) / (hi - lo)
+        return (value - self.low) / (self.high - self.low)
+
+    def from_unit(self, u: float) -> float:
+        u = min(max(float(u), 0.0), 1.0)
+        if self.log:
+            lo, hi = math.log(self.low), math.log(self.high)
+            return min(max(math.exp(lo + u * (hi - lo)), self.low), self.high)
+        return self.low + u * (self.high - self.low)
+
+
+@dataclass(frozen=True)
+class ParamSpace:
+    """Named parameter domains, in a fixed order (the order of the unit-cube coordinates)."""
+
+    domains: Mapping[str, ParamDomain]
+
+    def __post_init__(self) -> None:
+        doms = dict(self.domains)
+        if not doms:
+            raise LearningError("a parameter space needs at least one parameter")
+        for name, dom in doms.items():
+            if not isinstance(name, str) or not name:
+                raise LearningError(f"parameter names must be non-empty strings, got {name!r}")
+            if not isinstance(dom, ParamDomain):
+                raise LearningError(f"parameter {name!r}: domain must be a ParamDomain")
+        object.__setattr__(self, "domains", doms)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(self.domains)
+
+    @property
+    def dim(self) -> int:
+        return len(self.domains)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.domains)
+
+    def validate(self, values: Mapping[str, float]) -> dict[str, float]:
+        """``values`` as floats, checked: every name known, present, inside its domain."""
+        unknown = sorted(set(values) - set(self.domains))
+        if unknown:
+            raise LearningError(f"unknown parameter(s) {unknown}; known: {list(self.names)}")
+        missing = [n for n in self.names if n not in values]
+        if missing:
+            raise LearningError(f"missing parameter(s) {missing}")
+        out = {}
+        for name, dom in self.domains.items():
+            v = float(values[name])
+            if not dom.contains(v):
+                raise LearningError(f"parameter {name!r} = {v} outside [{dom.low}, {dom.high}]")
+            out[name] = v
+        return out
+
+    def to_unit(self, values: Mapping[str, float]) -> np.ndarray:
+        """Physical values -> unit-cube point (d,) (validated)."""
+        vals = self.validate(values)
+        return np.array([dom.to_unit(vals[n]) for n, dom in self.domains.items()])
+
+    def from_unit(self, u: Sequence[float] | np.ndarray) -> dict[str, float]:
+        """Unit-cube point (d,) -> physical values (clipped into the domains)."""
+        arr = np.asarray(u, dtype=float).reshape(-1)
+        if arr.shape != (self.dim,):
+            raise LearningError(f"expected a point of {self.dim} coordinates, got {arr.shape}")
+        return {n: dom.from_unit(x) for (n, dom), x in zip(self.domains.items(), arr, strict=True)}
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-able description (stored with a study, compared on resume)."""
+        return {n: [d.low, d.high, d.log] for n, d in self.domains.items()}
+
+    @classmethod
+    def from_json(cls, data: Mapping[str, Sequence[Any]]) -> ParamSpace:
+        return cls({n: ParamDomain(float(v[0]), float(v[1]), bool(v[2])) for n, v in data.items()})
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """A point handed out by a learner: unique ``key`` and unit-cube coordinates ``u`` (d,)."""
+
+    key: str
+    u: tuple[float, ...]
+
+    @classmethod
+    def of(cls, key: str, u: Sequence[float] | np.ndarray) -> Candidate:
+        arr = np.clip(np.asarray(u, dtype=float).reshape(-1), 0.0, 1.0)
+        return cls(key, tuple(float(x) for x in arr))
+
+
+@dataclass(frozen=True)
+class Finished:
+    """A finished trial as a learner needs it for :meth:`Learner.restore`."""
+
+    candidate: Candidate
+    cost: float
+    feasible: bool = True
+
+
+@dataclass(frozen=True)
+class TrialResult:
+    """What one trial's objective returns: cost (minimised), feasibility, extra numbers."""
+
+    cost: float
+    feasible: bool = True
+    info: Mapping[str, float] = field(default_factory=dict)
+
+
+@runtime_checkable
+class Learner(Protocol):
+    """Ask/tell black-box minimiser over a :class:`ParamSpace` (unit cube inside)."""
+
+    space: ParamSpace
+
+    def ask(self) -> Candidate | None:
+        """The next candidate, or ``None`` if none can be handed out before pending tells
+        arrive (a population-based learner waiting for its generation) or ever again."""
+        ...
+
+    def tell(self, candidate: Candidate, cost: float, feasible: bool = True) -> None:
+        """Report a finished candidate's (finite) cost; ``candidate.u`` is taken as evaluated."""
+        ...
+
+    def restore(self, finished: Sequence[Finished]) -> None:
+        """On a fresh learner: adopt previously finished trials as if told, in their order."""
+        ...
+
+
+class GenerationalLearner:
+    """Base of population learners (CMA-ES, PSO): generations of keyed candidates.
+
+    Subclasses implement :meth:`_new_generation` (unit points of the next generation) and
+    :meth:`_end_generation` (update from the whole generation's points and costs). Candidates
+    of one generation may be told in any order; the next generation starts once all are told.
+    :meth:`restore` replays generations, substituting every stored trial's point and cost for
+    the member with the same key, so the state rebuilt equals the one the killed run had for
+    the completed generations, and only the unfinished members of the current one are asked.
+    """
+
+    space: ParamSpace
+
+    def __init__(self, space: ParamSpace) -> None:
+        self.space = space
+        self._gen = -1
+        self._members: list[Candidate] = []
+        self._told: dict[str, tuple[Candidate, float]] = {}
+        self._queue: list[Candidate] = []
+        self._restored: dict[str, Finished] = {}
+
+    # ----------------------------------------------------------------------- subclass API
+    def _new_generation(self) -> list[np.ndarray]:
+        raise NotImplementedError
+
+    def _end_generation(self, points: list[np.ndarray], costs: list[float]) -> None:
+        raise NotImplementedError
+
+    def _key(self, gen: int, k: int) -> str:
+        return f"g{gen}m{k}"
+
+    # ----------------------------------------------------------------------- mechanics
+    def _start_generation(self) -> None:
+        self._gen += 1
+        points = self._new_generation()
+        self._members = [Candidate.of(self._key(self._gen, k), p) for k, p in enumerate(points)]
+        self._told = {}
+        self._queue = []
+        for cand in self._members:
+            # members finished before a restart are told from the store, not asked again
+            done = self._restored.pop(cand.key, None)
+            if done is None:
+                self._queue.append(cand)
+            else:
+                self._record(done.candidate, done.cost)
+
+    def _record(self, candidate: Candidate, cost: float) -> None:
+        keys = [m.key for m in self._members]
+        if candidate.key not in keys:
+            raise LearningError(f"candidate {candidate.key!r} is not of the current generation")
+        if candidate.key in self._told:
+            raise LearningError(f"candidate {candidate.key!r} was already told")
+        if not math.isfinite(cost):
+            raise LearningError(f"cost of {candidate.key!r} must be finite, got {cost}")
+        self._told[candidate.key] = (candidate, float(cost))
+        if len(self._told) == len(self._members):
+            points = [np.asarray(self._told[k][0].u) for k in keys]
+            costs = [self._told[k][1] for k in keys]
+            self._end_generation(points, costs)
+            self._members = []
+
+    def ask(self) -> Candidate | None:
+        if not self._members:
+            self._start_generation()
+        return self._queue.pop(0) if self._queue else None
+
+    def tell(self, candidate: Candidate, cost: float, feasible: bool = True) -> None:
+        self._record(candidate, cost)
+
+    def restore(self, finished: Sequence[Finished]) -> None:
+        if self._gen >= 0:
+            raise LearningError("restore() needs a fresh learner")
+        self._restored = {f.candidate.key: f for f in finished}
+        while self._restored:
+            self._start_generation()
+            if self._members:  # the generation the run stopped in
+                break
+        if self._restored:
+            raise LearningError(
+                f"stored trials {sorted(self._restored)[:5]} do not fit this learner's "
+                "generations (other population size or options?)"
+            )

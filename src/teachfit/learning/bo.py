@@ -1,0 +1,102 @@
+"""Bayesian optimisation through Optuna's GP sampler, behind the ask/tell interface.
+
+``optuna.samplers.GPSampler`` fits a Gaussian process (Matern 5/2 kernel with automatic
+relevance determination, as in the paper's spearmint set-up) and maximises log expected
+improvement, batch-aware (qLogEI) for trials still running in other workers. Failed trials are
+handled as *constraints* (Optuna's constrained EI: one constraint, ``> 0`` when the trial
+failed), so the GP learns where failures are rather than fitting penalty costs alone; the
+penalty cost is still told as the objective value. The GP sampler needs PyTorch; without it,
+construction raises :class:`~teachfit.learning.base.LearningError` unless another Optuna
+sampler is passed in.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from collections.abc import Sequence
+
+import optuna
+from optuna.distributions import FloatDistribution
+
+from teachfit.learning.base import Candidate, Finished, LearningError, ParamSpace
+
+_CONSTRAINT = "failure"
+
+
+class BayesOpt:
+    """Bayesian optimisation learner.
+
+    Parameters
+    ----------
+    space : ParamSpace
+    seed : int
+    n_startup : int
+        Trials sampled independently at random before the GP takes over.
+    constraints : bool
+        Model failures as a constraint (default) or only through their penalty cost.
+    sampler : optuna.samplers.BaseSampler or None
+        Override the sampler (tests, or a machine without PyTorch); ``None`` = ``GPSampler``.
+    """
+
+    def __init__(
+        self,
+        space: ParamSpace,
+        seed: int = 0,
+        n_startup: int = 10,
+        constraints: bool = True,
+        sampler: optuna.samplers.BaseSampler | None = None,
+    ) -> None:
+        if n_startup < 1:
+            raise LearningError(f"n_startup must be >= 1, got {n_startup}")
+        if sampler is None:
+            if importlib.util.find_spec("torch") is None:
+                raise LearningError(
+                    "Bayesian optimisation uses Optuna's GPSampler, which needs PyTorch: "
+                    "install torch (CPU build) or choose another method"
+                )
+            sampler = optuna.samplers.GPSampler(
+                seed=seed, n_startup_trials=n_startup, warn_independent_sampling=False
+            )
+        self.space = space
+        self.constraints = constraints
+        optuna.logging.set_verbosity(optuna.logging.WARNING)
+        self._study = optuna.create_study(direction="minimize", sampler=sampler)
+        # the sampler sees unit-cube coordinates u0..u{d-1}; log scales live in the space
+        self._dists = {f"u{i}": FloatDistribution(0.0, 1.0) for i in range(space.dim)}
+        self._running: dict[str, optuna.trial.Trial] = {}
+        self._known: set[str] = set()
+        self._counter = 0
+
+    def ask(self) -> Candidate | None:
+        trial = self._study.ask(self._dists)
+        while f"b{self._counter}" in self._known:
+            self._counter += 1
+        key = f"b{self._counter}"
+        self._counter += 1
+        self._known.add(key)
+        self._running[key] = trial
+        return Candidate.of(key, [trial.params[f"u{i}"] for i in range(self.space.dim)])
+
+    def tell(self, candidate: Candidate, cost: float, feasible: bool = True) -> None:
+        trial = self._running.pop(candidate.key, None)
+        if trial is None:
+            raise LearningError(f"candidate {candidate.key!r} is not pending")
+        if self.constraints:
+            trial.set_constraint(_CONSTRAINT, 0.0 if feasible else 1.0)
+        self._study.tell(trial, float(cost))
+
+    def restore(self, finished: Sequence[Finished]) -> None:
+        if self._running or len(self._study.trials):
+            raise LearningError("restore() needs a fresh learner")
+        for f in finished:
+            self._known.add(f.candidate.key)
+            self._study.add_trial(
+                optuna.trial.create_trial(
+                    params={f"u{i}": float(u) for i, u in enumerate(f.candidate.u)},
+                    distributions=self._dists,
+                    value=float(f.cost),
+                    constraints=(
+                        {_CONSTRAINT: 0.0 if f.feasible else 1.0} if self.constraints else None
+                    ),
+                )
+            )

@@ -1,0 +1,230 @@
+"""Run a study's trials in parallel worker processes until its budget is used.
+
+Trials run in a :class:`concurrent.futures.ProcessPoolExecutor` (default: one worker per core)
+or, with ``workers=0``, in this process. Each finished trial is stored at once
+(:meth:`~teachfit.learning.study.Study.tell`). Faults end the trial, not the study:
+
+* the objective raises, or returns a non-finite cost (a diverging simulation): the trial is
+  stored as failed with the study's penalty cost;
+* a worker process dies (segfault, ``os._exit``, out of memory): the pool breaks and every
+  trial running in it is lost. If only one was running, it is the culprit and fails; else the
+  lost trials are re-run one at a time in a fresh pool, which finds the culprit and completes
+  the innocent ones (they had not finished, so nothing is repeated).
+
+SIGINT / SIGTERM: the first one stops asking for new trials and lets the running ones finish
+and be stored, then :func:`run_study` returns with ``interrupted=True``; a second one aborts at
+once (running trials are dropped and asked anew on resume) by raising ``KeyboardInterrupt``.
+A ``KeyboardInterrupt`` raised by the objective itself aborts the same way.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from collections.abc import Callable, Mapping
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass
+from typing import Any
+
+from teachfit.learning.base import Candidate, LearningError, TrialResult
+from teachfit.learning.study import Study
+
+#: what an objective may return: a cost, ``(cost, feasible)`` or a TrialResult
+Objective = Callable[[Mapping[str, float]], "TrialResult | float | tuple[float, bool]"]
+
+
+@dataclass(frozen=True)
+class RunReport:
+    """What one :func:`run_study` call did (``wall_s`` in seconds)."""
+
+    restored: int
+    finished: int
+    failed: int
+    interrupted: bool
+    wall_s: float
+
+    @property
+    def trials_per_s(self) -> float:
+        return self.finished / self.wall_s if self.wall_s > 0 else math.nan
+
+
+def _as_result(value: object) -> TrialResult:
+    if isinstance(value, TrialResult):
+        return value
+    if isinstance(value, tuple) and len(value) == 2:
+        return TrialResult(float(value[0]), bool(value[1]))
+    return TrialResult(float(value))  # type: ignore[arg-type]
+
+
+def evaluate(objective: Objective, params: Mapping[str, float]) -> tuple[TrialResult | None, str]:
+    """Run one trial; ``(result, "")`` or ``(None, error message)``. Runs in a worker."""
+    try:
+        result = _as_result(objective(params))
+    except Exception as exc:  # any failure of the trial is that trial's, not the study's
+        return None, f"{type(exc).__name__}: {exc}"
+    if not math.isfinite(result.cost):
+        return None, f"non-finite cost {result.cost} (diverged)"
+    return result, ""
+
+
+def _worker_init() -> None:
+    # Ctrl-C reaches the whole process group; only the main process decides what it means
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class _Signals:
+    """First SIGINT/SIGTERM: ask to stop; second: KeyboardInterrupt. Restored on exit."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.enabled = enabled and threading.current_thread() is threading.main_thread()
+        self.stop = False
+        self._old: dict[int, Any] = {}
+
+    def _handle(self, signum: int, frame: object) -> None:
+        if self.stop:
+            raise KeyboardInterrupt
+        self.stop = True
+
+    def __enter__(self) -> _Signals:
+        if self.enabled:
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+
+
+def _kill_pool(pool: ProcessPoolExecutor) -> None:
+    pool.shutdown(wait=False, cancel_futures=True)
+    # the executor has no public way to end running workers; its process table is the only one
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
+
+
+def run_study(
+    study: Study,
+    objective: Objective,
+    budget: int,
+    workers: int | None = None,
+    handle_signals: bool = True,
+    mp_context: str | None = None,
+) -> RunReport:
+    """Run trials of ``study`` until it holds ``budget`` finished trials (restored included).
+
+    ``objective(params)`` gets physical parameter values and returns a cost, ``(cost,
+    feasible)`` or a :class:`TrialResult`; with workers it must be picklable (a module-level
+    function or a :func:`functools.partial` of one). ``workers=None``: one per core; ``0``: in
+    this process (no crash isolation). Stops early if the learner has nothing left to ask.
+    """
+    if budget < 0:
+        raise LearningError(f"budget must be >= 0, got {budget}")
+    n_workers = (os.cpu_count() or 1) if workers is None else int(workers)
+    if n_workers < 0:
+        raise LearningError(f"workers must be >= 0, got {workers}")
+    t0 = time.perf_counter()
+    restored = study.n_finished
+    failed = 0
+
+    def store(cand: Candidate, result: TrialResult | None, error: str) -> None:
+        nonlocal failed
+        rec = study.tell(cand, result, error)
+        failed += rec.outcome == "error"
+
+    with _Signals(handle_signals) as sig:
+        if n_workers == 0:
+            while not sig.stop and study.n_finished < budget:
+                cand = study.ask()
+                if cand is None:
+                    break
+                store(cand, *evaluate(objective, study.params_of(cand)))
+        else:
+            _run_pool(study, objective, budget, n_workers, sig, store, mp_context)
+        interrupted = sig.stop
+    return RunReport(
+        restored=restored,
+        finished=study.n_finished - restored,
+        failed=failed,
+        interrupted=interrupted,
+        wall_s=time.perf_counter() - t0,
+    )
+
+
+def _run_pool(
+    study: Study,
+    objective: Objective,
+    budget: int,
+    n_workers: int,
+    sig: _Signals,
+    store: Callable[[Candidate, TrialResult | None, str], None],
+    mp_context: str | None,
+) -> None:
+    ctx = multiprocessing.get_context(mp_context) if mp_context else None
+
+    def new_pool() -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(n_workers, mp_context=ctx, initializer=_worker_init)
+
+    pool = new_pool()
+    pending: dict[Future[tuple[TrialResult | None, str]], Candidate] = {}
+    suspects: list[Candidate] = []  # trials lost in a broken pool, re-run one at a time
+    retry: list[Candidate] = []  # asked but never started (submitted to a broken pool)
+    try:
+        while True:
+            while not sig.stop and study.n_finished + len(pending) < budget:
+                if suspects:
+                    if pending:
+                        break
+                    cand: Candidate | None = suspects.pop(0)
+                elif retry:
+                    cand = retry.pop(0)
+                else:
+                    cand = study.ask()  # None: a population waits for its tells, or exhausted
+                    if cand is None:
+                        break
+                try:
+                    fut = pool.submit(evaluate, objective, study.params_of(cand))
+                except BrokenProcessPool:  # broke before we saw it: submit it again later
+                    retry.insert(0, cand)
+                    break
+                pending[fut] = cand
+                if suspects or len(pending) >= n_workers:
+                    break
+            if not pending:
+                if (suspects or retry) and not sig.stop and study.n_finished < budget:
+                    continue
+                break  # stopped, budget used, or the learner has nothing more to ask
+            done, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
+            broken: list[Candidate] = []
+            for fut in done:
+                cand = pending.pop(fut)
+                try:
+                    result, error = fut.result()
+                except BrokenProcessPool:
+                    broken.append(cand)
+                    continue
+                store(cand, result, error)
+            if broken:
+                # every other running trial is lost with the pool: collect them too
+                for fut, cand in list(pending.items()):
+                    try:
+                        result, error = fut.result()
+                        store(cand, result, error)
+                    except BrokenProcessPool:
+                        broken.append(cand)
+                pending.clear()
+                pool.shutdown(wait=True)
+                pool = new_pool()
+                if len(broken) == 1:
+                    store(broken[0], None, "worker process crashed")
+                else:
+                    suspects = broken + suspects
+    except BaseException:
+        _kill_pool(pool)
+        raise
+    pool.shutdown(wait=True)
