@@ -8,6 +8,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import typer  # noqa: E402
 
+from teachfit.cli import plan_cmd  # noqa: E402
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
 from teachfit.cli.search_cmd import learn_search, search_app  # noqa: E402
@@ -25,6 +26,10 @@ learn_app = typer.Typer(help="Learn models from demonstrations or trials.", no_a
 learn_app.command("search")(learn_search)
 app.add_typer(learn_app, name="learn")
 app.add_typer(search_app, name="search")
+app.add_typer(plan_cmd.parts_app, name="parts")
+app.command("plan")(plan_cmd.plan)
+demo_app.command("synth")(plan_cmd.demo_synth)
+bench_app.command("planning")(plan_cmd.bench_planning_cmd)
 register(app, bench_app)
 
 

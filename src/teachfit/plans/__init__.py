@@ -1,0 +1,49 @@
+"""Motion planning guided by demonstrated key poses (METHODS.md C).
+
+Parametric parts (:mod:`.parts`), mesh-mesh collision (:mod:`.collision`), synthetic
+demonstrations (:mod:`.synth`), key-pose ranking (:mod:`.keyposes`) and the planner loop
+(:mod:`.planner`). Poses are ``L2G``: the moving part ``L`` in the fixed part's frame ``G``.
+"""
+
+from teachfit.plans.collision import CollisionChecker, pose_to_matrix
+from teachfit.plans.keyposes import PARAMS, KeyPoses, pose_parameters, rank_key_poses
+from teachfit.plans.parts import (
+    PARTS,
+    Assembly,
+    LGrooveParams,
+    PaperResult,
+    TenonParams,
+    build_assembly,
+    pose_from_xyz_rpy,
+)
+from teachfit.plans.planner import (
+    PLANNERS,
+    MotionPlanner,
+    PlannerConfig,
+    PlanResult,
+    matrix_to_state,
+)
+from teachfit.plans.synth import nominal_keyframes, synth_demo
+
+__all__ = [
+    "PARAMS",
+    "PARTS",
+    "PLANNERS",
+    "Assembly",
+    "CollisionChecker",
+    "KeyPoses",
+    "LGrooveParams",
+    "MotionPlanner",
+    "PaperResult",
+    "PlanResult",
+    "PlannerConfig",
+    "TenonParams",
+    "build_assembly",
+    "matrix_to_state",
+    "nominal_keyframes",
+    "pose_from_xyz_rpy",
+    "pose_parameters",
+    "pose_to_matrix",
+    "rank_key_poses",
+    "synth_demo",
+]

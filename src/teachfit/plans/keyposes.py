@@ -1,0 +1,197 @@
+"""Candidate key poses from a demonstration and their ranking (METHODS.md C, paper Fig. 6).
+
+The demonstration's most violently changing pose parameter (pitch, for the L) is fitted with a
+polynomial over time; its derivative at each candidate key pose ranks the candidates by
+descending magnitude, so the most decisive poses are inserted into the planner first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from teachfit.errors import PlanningError
+
+__all__ = ["PARAMS", "KeyPoses", "pose_parameters", "rank_key_poses", "select_candidates"]
+
+PARAMS: tuple[str, ...] = ("x", "y", "z", "roll", "pitch", "yaw")
+"""Pose parameters: position of ``L`` in ``G`` (m) and extrinsic x-y-z Euler angles (rad)."""
+
+
+def pose_parameters(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
+    """(T, 6) ``[x, y, z, roll, pitch, yaw]`` (m, rad; angles unwrapped over time).
+
+    Parameters
+    ----------
+    pos : (T, 3) positions in m. quat : (T, 4) quaternions w-x-y-z.
+    """
+    quat = np.asarray(quat, dtype=float)
+    rpy = Rotation.from_quat(quat[:, [1, 2, 3, 0]]).as_euler("xyz")
+    return np.concatenate([np.asarray(pos, dtype=float), np.unwrap(rpy, axis=0)], axis=1)
+
+
+def select_candidates(
+    pos: np.ndarray,
+    quat: np.ndarray,
+    n: int,
+    *,
+    char_length: float = 0.1,
+    eligible: np.ndarray | None = None,
+) -> np.ndarray:
+    """Indices (n,) of candidate key poses, evenly spaced along the demonstration's pose path.
+
+    Parameters
+    ----------
+    pos : (T, 3) m. quat : (T, 4) w-x-y-z.
+    n : int
+        Number of candidates wanted.
+    char_length : float
+        Rotations count as the displacement (m) of a point this far away.
+    eligible : (T,) bool, optional
+        Samples a key pose may be taken from (the paper's "important area", where the parts
+        are close); the path length is measured over them only. All samples when None or
+        when fewer than ``n`` are eligible.
+
+    Returns
+    -------
+    (<= n,) int, increasing and unique; the first and last samples are never chosen.
+    """
+    if n < 1:
+        raise PlanningError(f"need at least one candidate key pose, got n={n}")
+    step = np.diff(pose_parameters(pos, quat), axis=0)
+    step[:, 3:] *= char_length  # 1 rad of rotation moves the part's far end by char_length
+    length = np.concatenate([[0.0], np.linalg.norm(step, axis=1)])
+    mask = np.ones(len(length), dtype=bool)
+    mask[[0, -1]] = False
+    if eligible is not None and np.count_nonzero(np.asarray(eligible) & mask) >= n:
+        mask &= np.asarray(eligible, dtype=bool)
+    s = np.cumsum(np.where(mask, length, 0.0))
+    if len(s) < 3 or s[-1] <= 0:
+        raise PlanningError("demonstration does not move: no key poses to take from it")
+    lo, hi = s[mask].min(), s[mask].max()
+    targets = lo + (hi - lo) * (np.arange(n) + 0.5) / n
+    where = np.flatnonzero(mask)
+    idx = where[np.clip(np.searchsorted(s[where], targets), 0, len(where) - 1)]
+    return np.unique(idx)
+
+
+@dataclass(frozen=True, eq=False)
+class KeyPoses:
+    """Ranked candidate key poses of one demonstration.
+
+    Attributes
+    ----------
+    indices : (K,) int
+        Demonstration sample index of each candidate, increasing (time order).
+    t : (K,) float
+        Their time stamps (s).
+    L2G : (K, 4, 4) float
+        Their poses of ``L`` in ``G``.
+    param : str
+        Ranked parameter (one of :data:`PARAMS`).
+    values : (K,) float
+        That parameter at the candidates (m or rad).
+    derivative : (K,) float
+        Derivative of the fitted polynomial at the candidates (m/s or rad/s).
+    order : (K,) int
+        Candidate positions (into the arrays above) by descending ``|derivative|``: ``order[0]``
+        is inserted into the planner first.
+    poly : np.polynomial.Polynomial
+        The fitted polynomial, parameter value as a function of time (s).
+    demo_t, demo_values : (T,) float
+        The demonstration's time stamps and the parameter over them (for figures).
+    """
+
+    indices: np.ndarray
+    t: np.ndarray
+    L2G: np.ndarray
+    param: str
+    values: np.ndarray
+    derivative: np.ndarray
+    order: np.ndarray
+    poly: np.polynomial.Polynomial
+    demo_t: np.ndarray
+    demo_values: np.ndarray
+
+    @property
+    def ranks(self) -> np.ndarray:
+        """(K,) int rank of each candidate, 1 = inserted first."""
+        ranks = np.empty(len(self.order), dtype=int)
+        ranks[self.order] = np.arange(1, len(self.order) + 1)
+        return ranks
+
+
+def rank_key_poses(
+    t: np.ndarray,
+    pos: np.ndarray,
+    quat: np.ndarray,
+    n_candidates: int,
+    *,
+    param: str = "auto",
+    degree: int = 7,
+    char_length: float = 0.1,
+    eligible: np.ndarray | None = None,
+) -> KeyPoses:
+    """Select candidate key poses of a demonstration and rank them.
+
+    Parameters
+    ----------
+    t : (T,) s. pos : (T, 3) m. quat : (T, 4) w-x-y-z.
+        The demonstration, ``L2G`` over time.
+    n_candidates : int
+        Number of candidate key poses (paper: 6 for the L, 11 for the tenon).
+    param : str
+        One of :data:`PARAMS`, or ``"auto"`` for the parameter with the largest range
+        (positions divided by ``char_length``, so that they compare with angles in rad).
+    degree : int
+        Polynomial degree, lowered to ``T - 1`` for short demonstrations.
+    char_length : float
+        Characteristic length (m) of the moving part.
+    eligible : (T,) bool, optional
+        Samples candidates may be taken from, see :func:`select_candidates`.
+
+    Raises
+    ------
+    PlanningError
+        Fewer than two poses, unknown parameter, or a motionless demonstration.
+    """
+    t = np.asarray(t, dtype=float)
+    pos = np.asarray(pos, dtype=float)
+    quat = np.asarray(quat, dtype=float)
+    if t.ndim != 1 or len(t) < 2 or pos.shape != (len(t), 3) or quat.shape != (len(t), 4):
+        raise PlanningError(
+            f"a demonstration needs at least 2 poses with matching shapes, got t {t.shape}, "
+            f"pos {pos.shape}, quat {quat.shape}"
+        )
+    values6 = pose_parameters(pos, quat)
+    if param == "auto":
+        spread = np.ptp(values6, axis=0)
+        spread[:3] /= char_length
+        param = PARAMS[int(np.argmax(spread))]
+    if param not in PARAMS:
+        raise PlanningError(f"unknown pose parameter {param!r}; use one of {PARAMS} or 'auto'")
+    column = values6[:, PARAMS.index(param)]
+    idx = select_candidates(pos, quat, n_candidates, char_length=char_length, eligible=eligible)
+    # numpy's Polynomial.fit maps time onto [-1, 1] internally, which keeps the fit well
+    # conditioned for any demonstration length.
+    poly = np.polynomial.Polynomial.fit(t, column, deg=int(min(degree, len(t) - 1)))
+    derivative = poly.deriv()(t[idx])
+    order = np.argsort(-np.abs(derivative), kind="stable")
+    rot = Rotation.from_quat(quat[idx][:, [1, 2, 3, 0]]).as_matrix()
+    L2G = np.tile(np.eye(4), (len(idx), 1, 1))
+    L2G[:, :3, :3] = rot
+    L2G[:, :3, 3] = pos[idx]
+    return KeyPoses(
+        indices=idx,
+        t=t[idx],
+        L2G=L2G,
+        param=param,
+        values=column[idx],
+        derivative=derivative,
+        order=order,
+        poly=poly,
+        demo_t=t,
+        demo_values=column,
+    )

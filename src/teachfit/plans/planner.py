@@ -1,0 +1,440 @@
+"""Motion planning of the moving part's 6-DOF pose guided by demonstrated key poses.
+
+The loop of the paper (METHODS.md C, Fig. 7): plan from the initial to the final pose with
+RRT-Connect (OMPL, SE(3), mesh-mesh validity in Python); when an attempt finds no path within
+``te`` seconds, insert the next ranked key pose and plan segment by segment. Each segment first
+tries the straight motion, and solved segments are reused by later attempts. A key pose in
+collision is replaced by the nearest collision-free pose sampled around it. The final path is
+shortcut and smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
+
+States are ``(7,)`` arrays ``[x, y, z, qw, qx, qy, qz]``: ``L2G`` in m and a unit quaternion.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import ompl.base as ob
+import ompl.geometric as og
+import ompl.util as ou
+from scipy.spatial.transform import Rotation, Slerp
+
+from teachfit.errors import PlanningError
+from teachfit.plans.collision import CollisionChecker, pose_to_matrix
+from teachfit.plans.keyposes import KeyPoses, rank_key_poses
+from teachfit.plans.parts import Assembly
+
+__all__ = ["PLANNERS", "MotionPlanner", "PlanResult", "PlannerConfig", "matrix_to_state"]
+
+ou.setLogLevel(ou.LogLevel.LOG_ERROR)
+
+PLANNERS: dict[str, Callable[[ob.SpaceInformation], ob.Planner]] = {
+    "RRTConnect": og.RRTConnect,
+    "RRT": og.RRT,
+    "RRTstar": og.RRTstar,
+    "KPIECE1": og.KPIECE1,
+    "BKPIECE1": og.BKPIECE1,
+    "LBKPIECE1": og.LBKPIECE1,
+    "PRM": og.PRM,
+}
+"""OMPL geometric planners selectable by name."""
+
+
+def matrix_to_state(T: np.ndarray) -> np.ndarray:
+    """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform."""
+    q = Rotation.from_matrix(np.asarray(T)[:3, :3]).as_quat()
+    return np.array([*np.asarray(T)[:3, 3], q[3], q[0], q[1], q[2]])
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Settings of :class:`MotionPlanner`.
+
+    Attributes
+    ----------
+    planner : str
+        OMPL planner, a key of :data:`PLANNERS` (paper: a RRT-Connect variant).
+    te : float
+        Time budget (s) of one attempt; when exceeded the next key pose is inserted. The paper
+        used 5 s with Panda3D's collision checks in Python; t_e is in effect a budget of
+        samples, and our coal checks are orders of magnitude faster, so the default is 0.02 s.
+    resolution : float
+        Longest motion (m; rotations count as the motion of the part's farthest vertex) that
+        OMPL checks without an intermediate state.
+    verify_resolution : float
+        Same, for the final dense verification of the path.
+    shortcut : bool
+        Shortcut the path (OMPL's ``reduceVertices``).
+    smooth_steps : int
+        B-spline smoothing passes (OMPL's ``smoothBSpline``); 0 disables smoothing.
+    repair_samples : int
+        Samples per radius when looking for the collision-free pose nearest a key pose.
+    first_key_poses : int
+        Number of ranked key poses in the first attempt (paper: 0).
+    key_region : float or None
+        Candidate key poses are taken where the demonstrated part is closer than this (m) to
+        the fixed part (the paper's "important area"); 0 takes them anywhere, None uses the
+        assembly's ``key_region``.
+    """
+
+    planner: str = "RRTConnect"
+    te: float = 0.02
+    resolution: float = 0.0005
+    verify_resolution: float = 0.0005
+    shortcut: bool = True
+    smooth_steps: int = 2
+    repair_samples: int = 64
+    first_key_poses: int = 0
+    key_region: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.planner not in PLANNERS:
+            raise PlanningError(f"unknown planner {self.planner!r}; known: {', '.join(PLANNERS)}")
+        if not self.te > 0 or not self.resolution > 0 or not self.verify_resolution > 0:
+            raise PlanningError("te, resolution and verify_resolution must be > 0")
+        if (
+            self.smooth_steps < 0
+            or self.repair_samples < 1
+            or self.first_key_poses < 0
+            or (self.key_region is not None and self.key_region < 0)
+        ):
+            raise PlanningError(
+                "smooth_steps, repair_samples, first_key_poses, key_region must be >= 0"
+            )
+
+
+@dataclass(frozen=True, eq=False)
+class PlanResult:
+    """Outcome of one planning query.
+
+    Attributes
+    ----------
+    success : bool
+        A path was found and passed dense verification.
+    path : (N, 7) float
+        States ``[x, y, z, qw, qx, qy, qz]`` of ``L2G`` from start to goal (empty on failure).
+    time_s : float
+        Planning time (s): ranking the key poses and the attempts, up to a collision-free path
+        (what the paper's Table I reports).
+    total_s : float
+        Wall time of the whole query including shortcutting, smoothing and verification (s).
+    attempts : int
+        Attempts made (each with one more key pose than the previous).
+    used_key_poses, candidates, replaced_key_poses : int
+        Key poses in the successful attempt, candidates available, key poses that were in
+        collision and were replaced.
+    collision_checks : int
+        Collision checks made.
+    planner : str
+        OMPL planner used.
+    message : str
+        Why it failed, or ``"ok"``.
+    key_poses : KeyPoses or None
+        The ranked candidates (None without demonstration).
+    """
+
+    success: bool
+    path: np.ndarray
+    time_s: float
+    total_s: float
+    attempts: int
+    used_key_poses: int
+    candidates: int
+    replaced_key_poses: int
+    collision_checks: int
+    planner: str
+    message: str
+    key_poses: KeyPoses | None = None
+
+    def L2G(self) -> np.ndarray:
+        """(N, 4, 4) path as homogeneous transforms."""
+        return np.array([pose_to_matrix(s[:3], s[3:]) for s in self.path]).reshape(-1, 4, 4)
+
+
+class MotionPlanner:
+    """Plans ``L2G`` from ``asm.start`` to ``asm.goal``, optionally guided by a demonstration.
+
+    Parameters
+    ----------
+    asm : Assembly
+        The parts, start and goal poses, and sampling bounds.
+    config : PlannerConfig
+        Planner settings.
+
+    Raises
+    ------
+    PlanningError
+        Degenerate meshes, or start or goal pose in collision.
+    """
+
+    def __init__(self, asm: Assembly, config: PlannerConfig | None = None) -> None:
+        self.asm = asm
+        self.config = config or PlannerConfig()
+        self.checker = CollisionChecker(asm.moving, asm.fixed)
+        region = self.config.key_region
+        self.key_region = asm.key_region if region is None else region
+        self._near = CollisionChecker(asm.moving, asm.fixed, margin=self.key_region)
+        self.start = matrix_to_state(asm.start)
+        self.goal = matrix_to_state(asm.goal)
+        for label, state in (("start", self.start), ("goal", self.goal)):
+            if self._collides(state):
+                depth = self.checker.distance(pose_to_matrix(state[:3], state[3:]))
+                raise PlanningError(
+                    f"{label} pose of {asm.task} is in collision (distance {depth:.2e} m)"
+                )
+        # radius of the moving part about its frame origin: converts rotations to motions
+        self.radius = float(np.linalg.norm(asm.moving.vertices, axis=1).max())
+        self.space = ob.SE3StateSpace()
+        bounds = ob.RealVectorBounds(3)
+        for i in range(3):
+            bounds.setLow(i, float(asm.bounds[0, i]))
+            bounds.setHigh(i, float(asm.bounds[1, i]))
+        self.space.setBounds(bounds)
+        # weight rotations by the part's radius, so the SE(3) metric approximates how far the
+        # part's farthest point moves (a plain sum of metres and radians would not)
+        self.space.setSubspaceWeight(1, self.radius)
+        self.si = ob.SpaceInformation(self.space)
+        checker = self.checker
+
+        def valid(s: ob.State) -> bool:
+            r = s.rotation()
+            return not checker.collides_xyzq(s.getX(), s.getY(), s.getZ(), r.w, r.x, r.y, r.z)
+
+        self._valid = valid  # OMPL keeps a reference; keep ours alive as long as the planner
+        self.si.setStateValidityChecker(valid)
+        self.si.setStateValidityCheckingResolution(
+            self.config.resolution / self.space.getMaximumExtent()
+        )
+        self.si.setup()
+
+    # -- states -------------------------------------------------------------------------------
+    def _collides(self, s: np.ndarray) -> bool:
+        return self.checker.collides_xyzq(*(float(v) for v in s))
+
+    def _to_ompl(self, s: np.ndarray) -> ob.State:
+        state = self.space.allocState()
+        state.setXYZ(float(s[0]), float(s[1]), float(s[2]))
+        r = state.rotation()
+        q = s[3:] / np.linalg.norm(s[3:])
+        r.w, r.x, r.y, r.z = (float(v) for v in q)
+        return state
+
+    @staticmethod
+    def _from_ompl(state: ob.State) -> np.ndarray:
+        r = state.rotation()
+        return np.array([state.getX(), state.getY(), state.getZ(), r.w, r.x, r.y, r.z])
+
+    def _distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Motion bound (m) between state a (7,) and states b (N, 7)."""
+        dot = np.clip(np.abs(b[:, 3:] @ a[3:]), 0.0, 1.0)
+        return np.linalg.norm(b[:, :3] - a[:3], axis=1) + self.radius * 2 * np.arccos(dot)
+
+    # -- key poses ----------------------------------------------------------------------------
+    def repair(self, state: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
+        """Nearest collision-free pose sampled around ``state`` (itself when free).
+
+        Samples Gaussian perturbations at growing radii (0.5 mm and 0.5 deg, doubling) and
+        returns the valid sample nearest to ``state``; None when none is found up to 16 mm.
+        """
+        if not self._collides(state):
+            return state
+        lo, hi = self.asm.bounds
+        for level in range(6):
+            sigma_p, sigma_r = 0.0005 * 2**level, np.radians(0.5) * 2**level
+            n = self.config.repair_samples
+            dp = rng.normal(0.0, sigma_p, (n, 3))
+            dr = Rotation.from_rotvec(rng.normal(0.0, sigma_r, (n, 3)))
+            base = Rotation.from_quat(state[[4, 5, 6, 3]])
+            q = (dr * base).as_quat()[:, [3, 0, 1, 2]]
+            cand = np.concatenate([state[:3] + dp, q], axis=1)
+            inside = np.all((cand[:, :3] >= lo) & (cand[:, :3] <= hi), axis=1)
+            cand = cand[inside]
+            free = np.array([not self._collides(c) for c in cand], dtype=bool)
+            if free.any():
+                ok = cand[free]
+                return ok[int(np.argmin(self._distance(state, ok)))]
+        return None
+
+    # -- segments -----------------------------------------------------------------------------
+    def _plan_segment(self, a: np.ndarray, b: np.ndarray, budget: float) -> np.ndarray | None:
+        sa, sb = self._to_ompl(a), self._to_ompl(b)
+        if self.si.checkMotion(sa, sb):
+            return np.stack([a, b])
+        if budget <= 1e-3:
+            return None
+        ss = og.SimpleSetup(self.si)
+        # ompl 2.0.1 crashes if SimpleSetup.setup() runs before start and goal are set; solve()
+        # calls setup() itself, so set them first and never call setup() explicitly.
+        ss.setStartAndGoalStates(sa, sb)
+        ss.setPlanner(PLANNERS[self.config.planner](self.si))
+        ss.solve(float(budget))
+        if not ss.haveExactSolutionPath():
+            return None
+        path = ss.getSolutionPath()
+        return np.array([self._from_ompl(path.getState(i)) for i in range(path.getStateCount())])
+
+    # -- public -------------------------------------------------------------------------------
+    def plan(
+        self, demo: object | None = None, *, te: float | None = None, seed: int = 0
+    ) -> PlanResult:
+        """Plan from start to goal, inserting ranked key poses of ``demo`` as needed.
+
+        Parameters
+        ----------
+        demo : Demonstration or None
+            Demonstration of ``L2G`` for this task (``frame="G"``, ``child_frame="L"``); None
+            plans without one (a single attempt of ``te`` seconds).
+        te : float, optional
+            Budget (s) per attempt; defaults to ``config.te``.
+        seed : int
+            Seed of the key-pose repair sampling (OMPL's own sampler is seeded per process).
+
+        Raises
+        ------
+        PlanningError
+            Demonstration of another task, or with fewer than two poses.
+        """
+        t0 = time.perf_counter()
+        checks0 = self.checker.n_checks
+        te = self.config.te if te is None else float(te)
+        if not te > 0:
+            raise PlanningError(f"te must be > 0 s, got {te!r}")
+        rng = np.random.default_rng(seed)
+        keys: KeyPoses | None = None
+        if demo is not None:
+            keys = self._rank(demo)
+        n_cand = 0 if keys is None else len(keys.indices)
+        repaired: dict[int, np.ndarray | None] = {}
+        solved: dict[tuple[int, int], np.ndarray] = {}
+        failed: dict[tuple[int, int], float] = {}
+        attempts = 0
+        for k in range(min(self.config.first_key_poses, n_cand), n_cand + 1):
+            chosen = [] if keys is None else sorted(int(i) for i in keys.order[:k])
+            for i in chosen:
+                if i not in repaired:
+                    repaired[i] = self.repair(matrix_to_state(keys.L2G[i]), rng)
+            ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
+            states = {-1: self.start, n_cand: self.goal} | {i: repaired[i] for i in ids[1:-1]}
+            attempts += 1
+            ta = time.perf_counter()
+            pieces = []
+            for a, b in zip(ids[:-1], ids[1:], strict=True):
+                if (a, b) in solved:
+                    pieces.append(solved[(a, b)])
+                    continue
+                budget = te - (time.perf_counter() - ta)
+                if failed.get((a, b), -1.0) * 1.5 >= budget:
+                    break  # failed before with as much time: insert another key pose
+                seg = self._plan_segment(states[a], states[b], budget)
+                if seg is None:
+                    failed[(a, b)] = budget
+                    break
+                solved[(a, b)] = seg
+                pieces.append(seg)
+            else:
+                path = np.concatenate([pieces[0]] + [p[1:] for p in pieces[1:]])
+                t_plan = time.perf_counter() - t0
+                path = self._finish(path)
+                n_replaced = sum(
+                    1
+                    for i in chosen
+                    if repaired[i] is None
+                    or not np.array_equal(repaired[i], matrix_to_state(keys.L2G[i]))
+                )
+                return PlanResult(
+                    success=path is not None,
+                    path=np.empty((0, 7)) if path is None else path,
+                    time_s=t_plan,
+                    total_s=time.perf_counter() - t0,
+                    attempts=attempts,
+                    used_key_poses=len(chosen),
+                    candidates=n_cand,
+                    replaced_key_poses=n_replaced,
+                    collision_checks=self.checker.n_checks - checks0,
+                    planner=self.config.planner,
+                    message="ok" if path is not None else "path failed dense verification",
+                    key_poses=keys,
+                )
+        return PlanResult(
+            success=False,
+            path=np.empty((0, 7)),
+            time_s=time.perf_counter() - t0,
+            total_s=time.perf_counter() - t0,
+            attempts=attempts,
+            used_key_poses=n_cand,
+            candidates=n_cand,
+            replaced_key_poses=sum(1 for v in repaired.values() if v is None),
+            collision_checks=self.checker.n_checks - checks0,
+            planner=self.config.planner,
+            message=f"no path within te={te} s per attempt after {attempts} attempt(s)",
+            key_poses=keys,
+        )
+
+    def _rank(self, demo: object) -> KeyPoses:
+        task = getattr(demo, "task", None)
+        if task != self.asm.task:
+            raise PlanningError(
+                f"demonstration is for task {task!r}, but the parts are {self.asm.task!r}"
+            )
+        t = np.asarray(getattr(demo, "t", []), dtype=float)
+        if t.ndim != 1 or len(t) < 2:
+            raise PlanningError(f"demonstration has {t.size} pose(s); need at least 2")
+        pos = np.asarray(demo.pos, dtype=float)  # type: ignore[attr-defined]
+        quat = np.asarray(demo.quat, dtype=float)  # type: ignore[attr-defined]
+        eligible = None
+        if self.key_region > 0 and pos.shape == (len(t), 3) and quat.shape == (len(t), 4):
+            eligible = np.array(
+                [self._near.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True)]
+            )
+        return rank_key_poses(
+            t,
+            pos,
+            quat,
+            self.asm.n_candidates,
+            param=self.asm.key_param,
+            char_length=self.radius,
+            eligible=eligible,
+        )
+
+    def _finish(self, path: np.ndarray) -> np.ndarray | None:
+        """Shortcut and smooth ``path`` with OMPL, then verify densely; None if unverifiable."""
+        cfg = self.config
+        if (cfg.shortcut or cfg.smooth_steps > 0) and len(path) > 2:
+            geo = og.PathGeometric(self.si, [self._to_ompl(s) for s in path])
+            simplifier = og.PathSimplifier(self.si)
+            if cfg.shortcut:
+                simplifier.reduceVertices(geo)
+            if cfg.smooth_steps > 0:
+                simplifier.smoothBSpline(geo, cfg.smooth_steps)
+            smooth = np.array(
+                [self._from_ompl(geo.getState(i)) for i in range(geo.getStateCount())]
+            )
+            if self.verify(smooth):
+                return smooth
+        return path if self.verify(path) else None
+
+    def densify(self, path: np.ndarray, resolution: float | None = None) -> np.ndarray:
+        """Interpolate ``path`` (N, 7) so no part point moves more than ``resolution`` (m) a step.
+
+        Positions are interpolated linearly and orientations by slerp (as OMPL's SE(3) does).
+        """
+        res = self.config.verify_resolution if resolution is None else resolution
+        out = [path[:1]]
+        for a, b in zip(path[:-1], path[1:], strict=True):
+            n = max(int(np.ceil(self._distance(a, b[None])[0] / res)), 1)
+            s = np.linspace(0.0, 1.0, n + 1)[1:]
+            rots = Rotation.from_quat(np.stack([a[[4, 5, 6, 3]], b[[4, 5, 6, 3]]]))
+            q = Slerp([0.0, 1.0], rots)(s).as_quat()[:, [3, 0, 1, 2]]
+            out.append(np.concatenate([a[:3] + s[:, None] * (b[:3] - a[:3]), q], axis=1))
+        return np.concatenate(out)
+
+    def verify(self, path: np.ndarray) -> bool:
+        """True when every state of the densified ``path`` is collision-free and inside bounds."""
+        dense = self.densify(path)
+        lo, hi = self.asm.bounds
+        if np.any(dense[:, :3] < lo - 1e-9) or np.any(dense[:, :3] > hi + 1e-9):
+            return False
+        return not any(self._collides(s) for s in dense)

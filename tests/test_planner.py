@@ -1,0 +1,104 @@
+"""Demonstration-guided motion planning (OMPL RRT-Connect over SE(3))."""
+
+import dataclasses
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from teachfit.errors import PlanningError
+from teachfit.plans import MotionPlanner, PlannerConfig, build_assembly, synth_demo
+
+
+@pytest.fixture(scope="module")
+def lgroove():
+    asm = build_assembly("l-groove")
+    return asm, MotionPlanner(asm)
+
+
+def _check_path(planner, result):
+    path = result.path
+    assert np.allclose(path[0], planner.start, atol=1e-9)
+    assert np.allclose(path[-1], planner.goal, atol=1e-9) or np.allclose(
+        path[-1], planner.goal * np.r_[1, 1, 1, -1, -1, -1, -1], atol=1e-9
+    )
+    dense = planner.densify(path, 0.0005)
+    assert not any(planner.checker.collides_xyzq(*s) for s in dense)
+
+
+def test_l_groove_with_demonstration_succeeds_fast(lgroove):
+    asm, planner = lgroove
+    result = planner.plan(synth_demo(asm, 0), seed=0)
+    assert result.success, result.message
+    assert 1 <= result.used_key_poses <= result.candidates == 6
+    assert result.time_s < 2.0
+    _check_path(planner, result)
+
+
+def test_tenon_with_demonstration_succeeds():
+    asm = build_assembly("tenon")
+    planner = MotionPlanner(asm, PlannerConfig(smooth_steps=0))
+    result = planner.plan(synth_demo(asm, 1), seed=1)
+    assert result.success, result.message
+    assert result.candidates == 11 and result.used_key_poses >= 1
+    _check_path(planner, result)
+
+
+def test_without_demonstration_a_short_budget_fails_cleanly(lgroove):
+    _, planner = lgroove
+    result = planner.plan(None, te=0.05)
+    assert not result.success
+    assert result.path.shape == (0, 7)
+    assert "no path" in result.message
+    assert result.candidates == 0
+
+
+def test_colliding_key_pose_is_replaced_by_nearby_free_pose(lgroove):
+    asm, planner = lgroove
+    state = planner.goal.copy()
+    state[1] += 0.0025  # 1 mm into the groove's side wall
+    assert planner._collides(state)
+    fixed = planner.repair(state, np.random.default_rng(0))
+    assert fixed is not None and not planner._collides(fixed)
+    assert np.linalg.norm(fixed[:3] - state[:3]) < 0.01
+
+
+def test_demonstration_of_other_parts_raises(lgroove):
+    _, planner = lgroove
+    demo = synth_demo(build_assembly("tenon"), 0)
+    with pytest.raises(PlanningError, match="tenon"):
+        planner.plan(demo)
+
+
+@pytest.mark.parametrize("n", [0, 1])
+def test_empty_or_single_pose_demonstration_raises(lgroove, n):
+    _, planner = lgroove
+    demo = SimpleNamespace(
+        task="l-groove",
+        t=np.arange(n, dtype=float),
+        pos=np.zeros((n, 3)),
+        quat=np.tile([1.0, 0, 0, 0], (n, 1)),
+    )
+    with pytest.raises(PlanningError, match="at least 2"):
+        planner.plan(demo)
+
+
+@pytest.mark.parametrize("which", ["start", "goal"])
+def test_start_or_goal_in_collision_raises(lgroove, which):
+    asm, _ = lgroove
+    pose = asm.goal.copy()
+    pose[2, 3] -= 0.01
+    with pytest.raises(PlanningError, match=f"{which} pose .* in collision"):
+        MotionPlanner(dataclasses.replace(asm, **{which: pose}))
+
+
+def test_planner_selection_and_bad_config():
+    with pytest.raises(PlanningError, match="unknown planner"):
+        PlannerConfig(planner="DDRRT")
+    with pytest.raises(PlanningError):
+        PlannerConfig(te=0.0)
+    asm = build_assembly("tenon")
+    planner = MotionPlanner(asm, PlannerConfig(planner="RRT", te=0.2, smooth_steps=0))
+    result = planner.plan(synth_demo(asm, 2), seed=2)
+    assert result.planner == "RRT"
+    assert result.success, result.message
