@@ -42,7 +42,7 @@ from teachfit.control.adaptive_params import (
     MetaBounds,
     meta_bounds,
 )
-from teachfit.control.impedance import ImpedanceLimits, critical_damping
+from teachfit.control.impedance import ImpedanceLimits, clipped_twist, critical_damping
 from teachfit.errors import ControlError
 from teachfit.robot.interface import ImpedanceCommand
 
@@ -185,12 +185,7 @@ class AdaptiveImpedance:
             self._d0[:] = critical_damping(self._k0, self.mass, cmd.damping_ratio)
         else:
             self._d0[:] = cmd.damping
-        v = cmd.lin_vel
-        speed = float(np.linalg.norm(v))
-        self._vd[:3] = v if speed <= ilim.max_speed else v * (ilim.max_speed / speed)
-        w = cmd.ang_vel
-        spin = float(np.linalg.norm(w))
-        self._vd[3:] = w if spin <= ilim.max_ang_speed else w * (ilim.max_ang_speed / spin)
+        self._vd[:] = clipped_twist(cmd, ilim)
         self._spinning = bool(np.any(self._vd[3:] != 0.0))
         self._xd[:] = cmd.pos
         self._qd[:] = cmd.quat

@@ -37,6 +37,16 @@ class ImpedanceLimits:
                 raise ControlError(f"{name} must be > 0, got {getattr(self, name)}")
 
 
+def clipped_twist(cmd: ImpedanceCommand, limits: ImpedanceLimits) -> np.ndarray:
+    """The command's desired twist (6,) with speeds clipped to ``max_speed``/``max_ang_speed``."""
+    out = np.concatenate([cmd.lin_vel, cmd.ang_vel])
+    for sl, cap in ((slice(0, 3), limits.max_speed), (slice(3, 6), limits.max_ang_speed)):
+        norm = float(np.linalg.norm(out[sl]))
+        if norm > cap:
+            out[sl] *= cap / norm
+    return out
+
+
 def critical_damping(stiffness: np.ndarray, mass: np.ndarray, ratio: float) -> np.ndarray:
     """Damping ``D = 2 ratio M^1/2 sqrtm(M^-1/2 K M^-1/2) M^1/2`` for (6, 6) ``K``, (6,) ``M``."""
     sm = np.sqrt(mass)
@@ -114,12 +124,7 @@ class CartesianImpedance:
             self._d[:] = critical_damping(self._k, self.mass, cmd.damping_ratio)
         else:
             self._d[:] = cmd.damping
-        v = cmd.lin_vel
-        speed = float(np.linalg.norm(v))
-        self._vd[:3] = v if speed <= lim.max_speed else v * (lim.max_speed / speed)
-        w = cmd.ang_vel
-        spin = float(np.linalg.norm(w))
-        self._vd[3:] = w if spin <= lim.max_ang_speed else w * (lim.max_ang_speed / spin)
+        self._vd[:] = clipped_twist(cmd, lim)
         self._spinning = bool(np.any(self._vd[3:] != 0.0))
         self._xd[:] = cmd.pos
         self._qd[:] = cmd.quat
