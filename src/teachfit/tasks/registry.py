@@ -6,10 +6,15 @@ from pathlib import Path
 
 from teachfit.errors import TaskError
 from teachfit.tasks.base import Task
+from teachfit.tasks.key import Key
+from teachfit.tasks.peg import AluminiumPeg
 from teachfit.tasks.peg2d import Peg2D
+from teachfit.tasks.puzzle import Puzzle
 from teachfit.tasks.socket3d import Socket3D
 
-TASKS: dict[str, type[Task]] = {Peg2D.name: Peg2D, Socket3D.name: Socket3D}
+TASKS: dict[str, type[Task]] = {
+    cls.name: cls for cls in (Peg2D, Socket3D, Puzzle, Key, AluminiumPeg)
+}
 
 
 def get_task(name: str, **overrides: object) -> Task:

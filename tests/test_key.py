@@ -1,0 +1,117 @@
+"""The ``key`` task: a flat blade into a narrow chamfered slot."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from scipy.spatial import ConvexHull
+
+from teachfit.errors import TaskError
+from teachfit.pose import Pose
+from teachfit.robot.floating import FloatingToolRobot, build_scene
+from teachfit.robot.interface import ImpedanceCommand
+from teachfit.tasks import Key, KeyParams, get_task
+from teachfit.tasks.prism_geometry import beyond_edge_block, rectangle
+
+STIFF = [300, 300, 300, 50, 50, 50]
+
+
+@pytest.fixture(scope="module")
+def task() -> Key:
+    t = get_task("key")
+    assert isinstance(t, Key)
+    return t
+
+
+@pytest.fixture(scope="module")
+def robot(task: Key) -> FloatingToolRobot:
+    return FloatingToolRobot(task)
+
+
+def push(robot: FloatingToolRobot, x: float, y: float, rz: float, steps: int = 800) -> Pose:
+    """Start 2 mm above the entry at (x, y, rz) in the hole frame and push down softly."""
+    start = robot.task.hole2world.compose(Pose.from_xyz_rz(x, y, 0.002, rz))
+    robot.reset(start)
+    robot.command(ImpedanceCommand(pos=start.pos - [0, 0, 0.03], quat=start.quat, stiffness=STIFF))
+    return robot.step(steps).pose
+
+
+def test_scene_is_four_chamfered_walls(task: Key) -> None:
+    model = mujoco.MjModel.from_xml_string(build_scene(task))
+    names = {model.geom(i).name for i in range(model.ngeom)}
+    walls = {f"slot_wall_{s}" for s in ("east", "west", "north", "south")}
+    assert walls | {"fixture_base", "key_blade", "key_bow"} <= names
+    assert Key.rz_period == pytest.approx(np.pi)
+
+
+def test_chamfered_walls_leave_the_slot_open() -> None:
+    # four pieces over a 2 x 2 cm plate around a 7.3 x 2.3 mm slot, 1 cm tall, no chamfer:
+    # their union is the plate minus the slot; by inclusion-exclusion the corner overlaps count
+    hx, hy, hw, h = 0.00365, 0.00115, 0.01, 0.01
+    sides = [((1.0, 0.0), hx), ((-1.0, 0.0), hx), ((0.0, 1.0), hy), ((0.0, -1.0), hy)]
+    vols = [
+        ConvexHull(beyond_edge_block(rectangle(hw, hw), np.array(n), d, 0.0, h)).volume
+        for n, d in sides
+    ]
+    overlaps = 4 * (hw - hx) * (hw - hy) * h
+    assert sum(vols) - overlaps == pytest.approx((4 * hw * hw - 4 * hx * hy) * h, rel=1e-9)
+    v = beyond_edge_block(rectangle(hw, hw), np.array([0.0, 1.0]), hy, 0.0, h, chamfer=0.0008)
+    assert v[np.isclose(v[:, 1], hy), 2].max() == pytest.approx(h - 0.0008)  # chamfer bottom
+    assert v[:, 2].max() == pytest.approx(h)
+
+
+@pytest.mark.parametrize("rz", [0.0, np.pi])
+def test_aligned_key_enters(robot, task, rz) -> None:
+    pose = push(robot, 0.0, 0.0, rz)
+    assert task.insertion_depth(pose) > task.params.slot_depth - 2e-4
+    assert task.is_inserted(pose)
+
+
+@pytest.mark.parametrize("offset", [(0.001, 0.0), (0.0, 0.001)])
+def test_chamfers_guide_a_1mm_offset_in(robot, task, offset) -> None:
+    assert task.is_inserted(push(robot, *offset, 0.0))
+
+
+@pytest.mark.parametrize("offset", [(0.0025, 0.0), (0.0, 0.0025), (-0.002, 0.002)])
+def test_offset_key_is_blocked(robot, task, offset) -> None:
+    pose = push(robot, *offset, 0.0)
+    assert task.insertion_depth(pose) < 2e-4  # rests on the lock face
+    assert not task.is_inserted(pose)
+
+
+@pytest.mark.parametrize("deg", [5.0, 25.0])
+def test_rotated_key_is_blocked(robot, task, deg) -> None:
+    pose = push(robot, 0.0, 0.0, np.deg2rad(deg))
+    assert task.insertion_depth(pose) < task.params.slot_chamfer + 0.001  # in the chamfer at most
+    assert not task.is_inserted(pose)
+
+
+def test_is_inserted_with_symmetry(task: Key) -> None:
+    z = task.surface_z - 0.015
+    assert task.is_inserted(Pose.from_xyz_rz(0, 0, z, np.pi))
+    assert not task.is_inserted(Pose.from_xyz_rz(0, 0, z, np.pi / 2))
+    assert not task.is_inserted(Pose.from_xyz_rz(0.0006, 0, z, 0.0))
+    assert task.slot_half_size == pytest.approx((0.00365, 0.00115))
+
+
+@pytest.mark.parametrize(
+    ("overrides", "match"),
+    [
+        ({"clearance": 0.0}, "clearance must be > 0"),
+        ({"clearance": 0.003}, "no tight fit"),
+        ({"blade_thickness": 0.008}, "flat blade"),
+        ({"blade_chamfer": 0.001}, "blade_chamfer"),
+        ({"slot_chamfer": -0.001}, "slot_chamfer"),
+        ({"block_half_width": 0.006, "demo_offset": 0.001}, "rim"),
+        ({"slot_depth": 0.039}, "slot bottom"),
+        ({"success_depth": 0.021}, "deeper than the slot"),
+        ({"blade_length": 0.0205}, "bow stays above"),
+        ({"bow_width": 0.005}, "bow"),
+        ({"demo_offset": 0.018}, "off the lock face"),
+        ({"friction": -0.1}, "friction"),
+    ],
+)
+def test_impossible_parameters(overrides, match) -> None:
+    with pytest.raises(TaskError, match=f"key: .*{match}"):
+        KeyParams(**overrides)
