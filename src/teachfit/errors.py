@@ -57,3 +57,17 @@ class PlanningError(TeachfitError):
 
 class RenderError(TeachfitError):
     """Offscreen rendering is unavailable (no OpenGL / EGL / OSMesa)."""
+
+
+class CaptureError(TeachfitError):
+    """Video capture of a demonstration failed: bad rig/marker file, unreadable or mismatched
+    videos, markers never seen."""
+
+
+class SkillError(TeachfitError):
+    """An invalid skill: graph, condition, primitive or parameter; names the node when one is
+    at fault (``node`` attribute)."""
+
+    def __init__(self, message: str, *, node: str | None = None) -> None:
+        self.node = node
+        super().__init__(f"node {node!r}: {message}" if node is not None else message)

@@ -8,7 +8,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import typer  # noqa: E402
 
-from teachfit.cli import plan_cmd  # noqa: E402
+from teachfit.cli import plan_cmd, skill_cmd  # noqa: E402
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
 from teachfit.cli.search_cmd import learn_search, search_app  # noqa: E402
@@ -30,6 +30,7 @@ app.add_typer(plan_cmd.parts_app, name="parts")
 app.command("plan")(plan_cmd.plan)
 demo_app.command("synth")(plan_cmd.demo_synth)
 bench_app.command("planning")(plan_cmd.bench_planning_cmd)
+app.add_typer(skill_cmd.skill_app, name="skill")
 register(app, bench_app)
 
 

@@ -1,0 +1,146 @@
+"""``teachfit skill show|run``: the skill graph, and executions of a skill on a task."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from teachfit.cli.common import console, guarded
+
+skill_app = typer.Typer(
+    help="Manipulation skills (seed B): show a skill's graph, run it on a task.",
+    no_args_is_help=True,
+)
+
+_SKILL = typer.Argument(help="built-in skill name or a skill .toml")
+_CONTROLLER = typer.Option(help="controller: adaptive (seed B) or impedance")
+
+
+def _num(v: float) -> str:
+    return f"{v:.4g}"
+
+
+@skill_app.command("show")
+@guarded
+def show(
+    skill: Annotated[str, _SKILL] = "peg-in-hole",
+    plot: Annotated[Path | None, typer.Option(help="draw the graph to this image")] = None,
+    controller: Annotated[str, _CONTROLLER] = "adaptive",
+    toml: Annotated[Path | None, typer.Option(help="write the skill as TOML here")] = None,
+) -> None:
+    """Print a skill's primitives, transitions, conditions and parameters."""
+    from teachfit.skills.library import get_skill
+    from teachfit.skills.loader import skill_to_toml
+
+    sk = get_skill(skill, controller)
+    console.print(f"[bold]{sk.name}[/]: {sk.doc}\ntask frame: {sk.frame}")
+    nodes = Table(title="primitives (nodes)", title_justify="left")
+    for col in ("node", "primitive", "error exit"):
+        nodes.add_column(col)
+    for node in sk.nodes + ((sk.recovery,) if sk.recovery else ()):
+        tag = " (recovery)" if node is sk.recovery else " (start)" if node.name == sk.start else ""
+        nodes.add_row(node.name + tag, node.primitive.describe(),
+                      node.error.describe() if node.error else "-")
+    console.print(nodes)
+    trs = Table(title="transitions", title_justify="left")
+    for col in ("from", "to", "when"):
+        trs.add_column(col)
+    for tr in sk.transitions:
+        trs.add_row(tr.source, tr.target, tr.condition.describe())
+    console.print(trs)
+    console.print(f"pre: {sk.pre.describe() if sk.pre else 'always'}")
+    console.print(f"success: {sk.success.describe()}\nerror: {sk.error.describe()}")
+    ctx = Table(title="context parameters (set by the task)", title_justify="left")
+    for col in ("name", "value", "unit", "meaning"):
+        ctx.add_column(col)
+    for name, p in sk.params.context.items():
+        ctx.add_row(name, _num(p.value), p.unit, p.doc)
+    console.print(ctx)
+    lrn = Table(title="learned parameters", title_justify="left")
+    for col in ("name", "default", "low", "high", "unit", "meaning"):
+        lrn.add_column(col)
+    for name, p in sk.params.learned.items():
+        scale = " (log)" if p.domain.log else ""
+        lrn.add_row(name, _num(p.default), _num(p.domain.low), _num(p.domain.high) + scale,
+                    p.unit, p.doc)
+    console.print(lrn)
+    if toml is not None:
+        toml.parent.mkdir(parents=True, exist_ok=True)
+        toml.write_text(skill_to_toml(sk))
+        console.print(f"skill -> {toml}")
+    if plot is not None:
+        from teachfit.viz.skill_figures import plot_skill_graph
+
+        console.print(f"graph -> {plot_skill_graph(sk, plot)}")
+
+
+@skill_app.command("run")
+@guarded
+def run(
+    skill: Annotated[str, _SKILL] = "peg-in-hole",
+    task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
+    params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
+    controller: Annotated[str, _CONTROLLER] = "adaptive",
+    seed: Annotated[int, typer.Option(help="seed of the hole estimate, starts, noise")] = 0,
+    starts: Annotated[int, typer.Option(help="number of start poses")] = 4,
+    render: Annotated[Path | None, typer.Option(help="render one execution to this mp4")] = None,
+    render_start: Annotated[int, typer.Option(help="which execution to render")] = 0,
+    plot: Annotated[Path | None, typer.Option(help="plot the traces to this image")] = None,
+    fps: int = 25,
+    width: int = 640,
+    height: int = 480,
+) -> None:
+    """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
+    from teachfit.errors import SkillError
+    from teachfit.skills.library import get_skill
+    from teachfit.skills.params import read_params_toml
+    from teachfit.skills.trial import SkillTrial, peg_in_hole_setup
+    from teachfit.tasks.registry import load_task
+
+    if starts < 1:
+        raise SkillError(f"--starts must be >= 1, got {starts}")
+    if render is not None and not 0 <= render_start < starts:
+        raise SkillError(f"--render-start must be within [0, {starts - 1}]")
+    the_task = load_task(task)
+    setup = peg_in_hole_setup(the_task, seed, starts, controller, get_skill(skill, controller))
+    learned = None
+    if params is not None:
+        learned = read_params_toml(params, setup.skill.params, setup.skill.users())
+    trial = SkillTrial(setup, controller, seed=seed)
+    est = setup.task2world.inverse().compose(the_task.hole2world)
+    console.print(
+        f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate off by "
+        f"({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, yaw {est.rz:+.3f} rad"
+    )
+    with console.status(f"running {starts} execution(s)"):
+        out = trial(learned)
+    table = Table(title="executions", title_justify="left")
+    for col in ("#", "outcome", "inserted", "cost (s)", "contact (s)", "end (s)", "nodes"):
+        table.add_column(col)
+    for i, (tr, ok, cost) in enumerate(zip(out.traces, out.successes, out.costs, strict=True)):
+        path = " > ".join(v.node for v in tr.visits)
+        table.add_row(str(i), "[green]success[/]" if ok else f"[red]{tr.outcome}[/]",
+                      str(tr.inserted), f"{cost:.3f}", f"{tr.t_first_contact:.2f}",
+                      f"{tr.t_end:.2f}", path)
+    console.print(table)
+    steps = sum(tr.steps for tr in out.traces)
+    wall = sum(tr.wall_s for tr in out.traces)
+    console.print(
+        f"trial: {sum(out.successes)}/{len(out.successes)} succeeded, cost {out.cost:.3f} s; "
+        f"{wall / len(out.traces):.3f} s wall per execution, {steps / wall:,.0f} sim steps/s"
+    )
+    if plot is not None:
+        from teachfit.viz.skill_figures import plot_traces
+
+        console.print(f"traces -> {plot_traces(out.traces, plot)}")
+    if render is not None:
+        from teachfit.viz.video import render_motion
+
+        log = out.traces[render_start].log
+        with console.status("rendering"):
+            path = render_motion(the_task, log.t, log.pos, log.quat, render, fps=fps,
+                                 width=width, height=height)
+        console.print(f"video -> {path}")

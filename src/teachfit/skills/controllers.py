@@ -1,0 +1,71 @@
+"""The controller a skill runs on, and the adaptive controller's meta-parameters as learned
+skill parameters.
+
+Seed B learns the adaptive impedance controller's meta-parameters together with the skill's
+own. Per coordinate group ``g`` in ``t`` (x, y, z) and ``r`` (rx, ry, rz) they are
+``alpha_g``, ``beta_g``, ``gamma_a_g``, ``gamma_b_g`` (see
+:mod:`teachfit.control.adaptive`), each in a log domain ``[bound * 1e-3, bound]`` whose upper
+bound follows from the system limits by
+:func:`~teachfit.control.adaptive_params.meta_bounds` (largest tolerated errors 10 mm /
+0.1 m/s and 0.1 rad / 1 rad/s, control period 1 ms). The fixed-gain controller has none.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from teachfit.control.adaptive import AdaptiveImpedance
+from teachfit.control.adaptive_params import AdaptiveLimits, AdaptiveParams, meta_bounds
+from teachfit.control.base import Controller
+from teachfit.control.impedance import CartesianImpedance
+from teachfit.errors import SkillError
+from teachfit.learning.base import ParamDomain
+from teachfit.skills.params import LearnedParam
+
+CONTROLLERS = ("adaptive", "impedance")
+_META = ("alpha", "beta", "gamma_a", "gamma_b")
+_UNITS = {"alpha": "N/(m/s)/tick", "beta": "N/m/(m²/s)/tick", "gamma_a": "(m/s)/N",
+          "gamma_b": "(m²/s)/(N/m)"}
+#: largest tolerated errors behind the meta-parameter bounds (translation, rotation)
+E_MAX = (0.01,) * 3 + (0.1,) * 3
+DE_MAX = (0.1,) * 3 + (1.0,) * 3
+
+
+def controller_params(kind: str, period: float = 0.001) -> dict[str, LearnedParam]:
+    """The learned controller parameters of ``kind`` (empty for ``"impedance"``)."""
+    if kind not in CONTROLLERS:
+        raise SkillError(f"unknown controller {kind!r}; known: {list(CONTROLLERS)}")
+    if kind == "impedance":
+        return {}
+    bounds = meta_bounds(AdaptiveLimits(), period, E_MAX, DE_MAX)
+    defaults = AdaptiveParams()
+    out = {}
+    for meta in _META:
+        hi, default = getattr(bounds, meta), getattr(defaults, meta)
+        for g, i in (("t", 0), ("r", 3)):
+            dom = ParamDomain(hi[i] * 1e-3, hi[i], log=True)
+            val = float(np.clip(default[i], dom.low, dom.high))
+            out[f"{meta}_{g}"] = LearnedParam(val, dom, _UNITS[meta],
+                                             f"adaptive controller {meta}, group {g}")
+    return out
+
+
+def make_controller(
+    kind: str, values: Mapping[str, float], apparent_mass: np.ndarray, period: float = 0.001
+) -> Controller:
+    """A controller of ``kind``; ``values`` supplies the adaptive meta-parameters (those it
+    lacks, e.g. for a skill that does not learn them, keep :class:`AdaptiveParams`' defaults)."""
+    if kind == "impedance":
+        return CartesianImpedance(apparent_mass)
+    if kind != "adaptive":
+        raise SkillError(f"unknown controller {kind!r}; known: {list(CONTROLLERS)}")
+    defaults = AdaptiveParams()
+    kwargs = {}
+    for meta in _META:
+        d = getattr(defaults, meta)
+        t = float(values.get(f"{meta}_t", d[0]))
+        r = float(values.get(f"{meta}_r", d[3]))
+        kwargs[meta] = (t,) * 3 + (r,) * 3
+    return AdaptiveImpedance(apparent_mass, AdaptiveParams(**kwargs), period=period)

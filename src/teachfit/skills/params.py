@@ -1,0 +1,179 @@
+"""Skill parameters: context parameters set by the task, learned parameters with domains.
+
+Following seed B (Sec. III), the parameter set ``P`` of a skill splits into ``P_C``, fixed by
+the context of the task (estimated hole pose, depth, approach height, region of interest,
+system limits), and ``P_L``, the parameters to learn, each inside a domain derived from system
+and safety limits. The learned domains form a :class:`~teachfit.learning.base.ParamSpace`, so a
+learner consumes a skill's space directly.
+
+Primitive and condition fields are :data:`Value` s: a number, or a reference to a parameter by
+name (``"force"``), optionally negated (``"-lateral_offset"``). References are resolved once
+per execution, never in the control loop.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from teachfit.errors import SkillError
+from teachfit.learning.base import ParamDomain, ParamSpace
+
+#: a literal number or a (possibly negated) parameter name
+Value = float | str
+
+
+def ref_name(value: Value) -> str | None:
+    """The parameter a :data:`Value` refers to, or ``None`` for a literal."""
+    if isinstance(value, bool):
+        raise SkillError(f"a value must be a number or a parameter name, got {value!r}")
+    if isinstance(value, int | float):
+        return None
+    if isinstance(value, str) and value.lstrip("-"):
+        return value[1:] if value.startswith("-") else value
+    raise SkillError(f"a value must be a number or a parameter name, got {value!r}")
+
+
+def resolve(value: Value, values: Mapping[str, float]) -> float:
+    """A :data:`Value` as a float, looking references up in ``values``."""
+    name = ref_name(value)
+    if name is None:
+        return float(value)
+    if name not in values:
+        raise SkillError(f"unknown parameter {name!r}")
+    v = float(values[name])
+    return -v if isinstance(value, str) and value.startswith("-") else v
+
+
+@dataclass(frozen=True)
+class ContextParam:
+    """A parameter the task context fixes (``value`` in ``unit``)."""
+
+    value: float
+    unit: str = ""
+    doc: str = ""
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(float(self.value)):
+            raise SkillError(f"context value must be finite, got {self.value}")
+        object.__setattr__(self, "value", float(self.value))
+
+
+@dataclass(frozen=True)
+class LearnedParam:
+    """A parameter to learn: a ``default`` inside its ``domain`` (``unit``)."""
+
+    default: float
+    domain: ParamDomain
+    unit: str = ""
+    doc: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "default", float(self.default))
+
+
+@dataclass(frozen=True)
+class SkillParams:
+    """The context and learned parameters of a skill (names unique across both)."""
+
+    context: Mapping[str, ContextParam] = field(default_factory=dict)
+    learned: Mapping[str, LearnedParam] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        ctx, lrn = dict(self.context), dict(self.learned)
+        both = sorted(set(ctx) & set(lrn))
+        if both:
+            raise SkillError(f"parameter(s) {both} are both context and learned")
+        for name in [*ctx, *lrn]:
+            if not name.isidentifier():
+                raise SkillError(f"parameter names must be identifiers, got {name!r}")
+        object.__setattr__(self, "context", ctx)
+        object.__setattr__(self, "learned", lrn)
+
+    @property
+    def names(self) -> set[str]:
+        return set(self.context) | set(self.learned)
+
+    @property
+    def space(self) -> ParamSpace:
+        """The learned parameters' domains, in declaration order."""
+        return ParamSpace({n: p.domain for n, p in self.learned.items()})
+
+    @property
+    def defaults(self) -> dict[str, float]:
+        """Default learned values."""
+        return {n: p.default for n, p in self.learned.items()}
+
+    def with_context(self, values: Mapping[str, float]) -> SkillParams:
+        """A copy with context values replaced (unknown or learned names are errors)."""
+        bad = sorted(set(values) - set(self.context))
+        if bad:
+            raise SkillError(f"unknown context parameter(s) {bad}; known: {sorted(self.context)}")
+        ctx = {
+            n: ContextParam(float(values[n]), p.unit, p.doc) if n in values else p
+            for n, p in self.context.items()
+        }
+        return SkillParams(ctx, self.learned)
+
+    def check_learned(
+        self, values: Mapping[str, float], users: Mapping[str, Iterable[str]] | None = None
+    ) -> dict[str, float]:
+        """Validated learned values: unknown names and values outside a domain are errors.
+
+        Missing names take their defaults. ``users`` maps a parameter to the nodes using it,
+        so that an out-of-domain error names them.
+        """
+        unknown = sorted(set(values) - set(self.learned))
+        if unknown:
+            ctx = [n for n in unknown if n in self.context]
+            hint = f" ({ctx} are context parameters set by the task)" if ctx else ""
+            raise SkillError(
+                f"unknown learned parameter(s) {unknown}{hint}; known: {list(self.learned)}"
+            )
+        out = self.defaults
+        for name, v in values.items():
+            x = float(v)
+            dom = self.learned[name].domain
+            if not (math.isfinite(x) and dom.contains(x)):
+                nodes = sorted((users or {}).get(name, ()))
+                where = f" (used by node(s) {nodes})" if nodes else ""
+                raise SkillError(
+                    f"parameter {name!r} = {x} is outside its domain [{dom.low}, {dom.high}]"
+                    f"{where}",
+                    node=nodes[0] if len(nodes) == 1 else None,
+                )
+            out[name] = x
+        return out
+
+    def all_values(self, learned: Mapping[str, float]) -> dict[str, float]:
+        """Context values merged with (already validated) learned values."""
+        out = {n: p.value for n, p in self.context.items()}
+        out.update(learned)
+        return out
+
+
+def read_params_toml(
+    path: str | Path, params: SkillParams, users: Mapping[str, Iterable[str]] | None = None
+) -> dict[str, float]:
+    """Learned values from a TOML file: a flat table or a ``[params]`` table.
+
+    Every name must be a learned parameter of the skill and lie inside its domain; missing
+    names keep their defaults. Errors name the file (and, given ``users`` -- e.g.
+    ``Skill.users()`` -- the nodes using an out-of-domain parameter).
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise SkillError(f"cannot read parameter file {path}: {exc}") from exc
+    data = data.get("params", data)
+    bad = {k: v for k, v in data.items() if isinstance(v, bool) or not isinstance(v, int | float)}
+    if bad:
+        raise SkillError(f"{path}: parameter values must be numbers, got {bad}")
+    try:
+        return params.check_learned(data, users)
+    except SkillError as exc:
+        raise SkillError(f"{path}: {exc}") from exc

@@ -1,0 +1,216 @@
+"""The peg-in-hole skill of seed B (Sec. III-A, Fig. 3) and its context from a task.
+
+Task frame: the *estimated* hole frame (origin at the estimated hole entry, z out of the
+surface); the lateral move runs along its +x. Five primitives:
+
+1. ``approach``  trapezoidal profile to ``(-lateral_offset, 0, approach_height)``, tilted by
+   ``tilt`` about the task y-axis so that the tool axis leans back (towards -x) and the
+   trailing rim of the part is its lowest point.
+2. ``contact``   down at ``v_contact`` until the surface pushes back ``f_contact``.
+3. ``lateral``   along +x at ``v_lateral`` pressing ``f_push``, compliant across the motion,
+   until constrained: the lowest rim has dropped over the hole edge (``drop_depth`` below
+   the entry) or the part is wedged (the environment resists the motion with ``f_lateral``,
+   or the part stopped moving).
+4. ``align``     rotate upright into the estimated hole orientation (the nearest yaw modulo
+   the part's symmetry ``rz_period``) keeping contact with ``f_push``.
+5. ``insert``    push with the learned ``force`` while the set-point sinks to ``depth``,
+   superposing translational (``a_t``, ``f_t``) and rotational (``a_r``, ``f_r``)
+   oscillations.
+
+Success: ``depth`` reached below the estimated entry. Error: the time limit ``t_max`` (from
+the skill start), a force above ``f_max``, per-node time limits, leaving the region of
+interest ``roi`` around the estimated hole axis. Recovery: retract ``retract_height`` up.
+Speeds scale with the learned ``speed_factor`` (accelerations with its square).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from teachfit.errors import SkillError
+from teachfit.learning.base import ParamDomain
+from teachfit.pose import Pose
+from teachfit.skills.conditions import (
+    Any_,
+    DepthAbove,
+    Done,
+    ForceAbove,
+    LateralAbove,
+    RemainingBelow,
+    SpeedBelow,
+    TimeAbove,
+)
+from teachfit.skills.controllers import controller_params
+from teachfit.skills.graph import Node, Skill, Transition
+from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
+from teachfit.skills.primitive import Insert, Move, MoveTo
+from teachfit.tasks.base import Task
+
+NAME = "peg-in-hole"
+
+#: context defaults (units in the table); a task overrides some (see :func:`hole_context`)
+CONTEXT: dict[str, ContextParam] = {
+    "depth": ContextParam(0.0105, "m", "insertion depth below the estimated entry"),
+    "approach_height": ContextParam(0.005, "m", "TCP height of the approach pose"),
+    "lateral_offset": ContextParam(0.003, "m", "approach pose before the hole, along -x"),
+    "roi": ContextParam(0.012, "m", "region of interest: radius around the hole axis"),
+    "rz_period": ContextParam(0.0, "rad", "symmetry of the part about z (0: none)"),
+    "v_max": ContextParam(0.1, "m/s", "translational speed limit"),
+    "a_max": ContextParam(1.0, "m/s²", "translational acceleration limit"),
+    "w_max": ContextParam(1.0, "rad/s", "rotational speed limit"),
+    "dw_max": ContextParam(8.0, "rad/s²", "rotational acceleration limit"),
+    "v_contact": ContextParam(0.03, "m/s", "speed towards the surface"),
+    "v_lateral": ContextParam(0.015, "m/s", "speed of the lateral move"),
+    "v_insert": ContextParam(0.03, "m/s", "sinking speed of the set-point when inserting"),
+    "f_contact": ContextParam(3.0, "N", "force that marks contact with the surface"),
+    "f_push": ContextParam(4.0, "N", "pressing force while moving laterally and aligning"),
+    "f_lateral": ContextParam(4.0, "N", "resistance that marks a constrained lateral move"),
+    "drop_depth": ContextParam(0.001, "m", "depth below the entry that marks a caught part"),
+    "v_still": ContextParam(0.002, "m/s", "lateral speed below which the part is stuck"),
+    "f_max": ContextParam(50.0, "N", "safety limit of the contact force"),
+    "t_max": ContextParam(5.0, "s", "time limit of the skill (error condition)"),
+    "t_approach": ContextParam(2.0, "s", "time limit of approach"),
+    "t_contact": ContextParam(1.5, "s", "time limit of contact"),
+    "t_lateral": ContextParam(1.5, "s", "time limit of the lateral move"),
+    "t_align": ContextParam(1.0, "s", "time limit of align"),
+    "retract_height": ContextParam(0.01, "m", "recovery: retract this far up"),
+}
+
+#: learned parameters: default and domain from system / safety limits
+LEARNED: dict[str, LearnedParam] = {
+    "force": LearnedParam(8.0, ParamDomain(2.0, 20.0), "N", "insertion force F"),
+    "speed_factor": LearnedParam(0.7, ParamDomain(0.25, 1.0), "", "scales speeds"),
+    "tilt": LearnedParam(0.1, ParamDomain(0.0, 0.3), "rad", "initial tilt against the hole"),
+    "a_t": LearnedParam(4e-4, ParamDomain(0.0, 1.5e-3), "m", "translational amplitude"),
+    "f_t": LearnedParam(2.0, ParamDomain(0.5, 4.0), "Hz", "translational frequency"),
+    "a_r": LearnedParam(0.02, ParamDomain(0.0, 0.1), "rad", "rotational amplitude (z)"),
+    "f_r": LearnedParam(1.0, ParamDomain(0.5, 2.0), "Hz", "rotational frequency"),
+}
+
+_STIFF_FREE = (2000.0, 2000.0, 2000.0, 80.0, 80.0, 80.0)
+
+
+def build(controller: str = "adaptive") -> Skill:
+    """The peg-in-hole skill with default context; ``controller`` adds its meta-parameters
+    (``"adaptive"``) to the learned ones."""
+    learned = dict(LEARNED) | controller_params(controller)
+    params = SkillParams(dict(CONTEXT), learned)
+    fast = dict(v_max="v_max", a_max="a_max", w_max="w_max", dw_max="dw_max",
+                speed_factor="speed_factor")
+    roi = LateralAbove("roi")
+    nodes = (
+        Node("approach", MoveTo(goal=("-lateral_offset", 0.0, "approach_height"), yaw=0.0,
+                                tilt="-tilt", rz_period="rz_period", stiffness=_STIFF_FREE,
+                                **fast),
+             TimeAbove("t_approach"), "trapezoidal profile to the approach pose"),
+        Node("contact", Move(direction=(0.0, 0.0, -1.0), speed="v_contact",
+                             speed_factor="speed_factor",
+                             stiffness=(2000.0, 2000.0, 1500.0, 80.0, 80.0, 80.0)),
+             TimeAbove("t_contact") | roi, "down until contact"),
+        Node("lateral", Move(direction=(1.0, 0.0, 0.0), speed="v_lateral",
+                             speed_factor="speed_factor", push="f_push",
+                             stiffness=(1500.0, 300.0, 300.0, 80.0, 80.0, 80.0)),
+             TimeAbove("t_lateral") | roi, "sideways until constrained"),
+        Node("align", MoveTo(yaw=0.0, tilt=0.0, rz_period="rz_period", push="f_push",
+                             stiffness=(300.0, 300.0, 300.0, 80.0, 80.0, 80.0), **fast),
+             TimeAbove("t_align") | roi, "rotate into the hole orientation in contact"),
+        Node("insert", Insert(force="force", depth="depth", sink="v_insert", a_t="a_t",
+                              f_t="f_t", a_r="a_r", f_r="f_r",
+                              stiffness=(400.0, 400.0, 200.0, 30.0, 30.0, 20.0)),
+             roi, "push with oscillations"),
+    )
+    constrained = Any_((ForceAbove("f_lateral", axis="-x"), DepthAbove("drop_depth"),
+                        TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1)))
+    transitions = (
+        Transition("approach", "contact", Done() & RemainingBelow(0.001)),
+        Transition("contact", "lateral", ForceAbove("f_contact", axis="+z")),
+        Transition("lateral", "align", constrained),
+        Transition("align", "insert", Done()),
+    )
+    recovery = Node("retract", MoveTo(goal=(0.0, 0.0, "retract_height"), relative=True,
+                                      stiffness=_STIFF_FREE, **fast),
+                    TimeAbove(1.0), "retract upwards")
+    return Skill(
+        name=NAME, nodes=nodes, transitions=transitions, start="approach", params=params,
+        success=DepthAbove("depth"),
+        error=TimeAbove("t_max", scope="skill") | ForceAbove("f_max", axis="norm"),
+        pre=~ForceAbove("f_contact", axis="norm"), recovery=recovery,
+        doc="seed B's peg-in-hole: approach, contact, lateral move until constrained, align, "
+        "insert with oscillations",
+    )
+
+
+# ------------------------------------------------------------------------------ context
+@dataclass(frozen=True)
+class HoleContext:
+    """What the task context gives the skill: the estimated hole frame, the true goal and
+    context parameter values."""
+
+    hole2world_est: Pose
+    goal2world: Pose
+    values: dict[str, float]
+
+
+#: error of the hole-pose estimate when a task has no ``estimated_hole`` of its own
+#: (standard deviations: x, y (m), z (m), rz (rad)) -- a taught pose, seed B: < 1 mm
+HOLE_ERROR = (0.0007, 0.0002, 0.02)
+
+
+def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
+    """The task's ``estimated_hole(rng)`` if it has one, else the true hole pose with Gaussian
+    error :data:`HOLE_ERROR` (yaw error only for parts whose yaw matters)."""
+    est = getattr(task, "estimated_hole", None)
+    if callable(est):
+        pose = est(rng)
+        if not isinstance(pose, Pose):
+            raise SkillError(f"{task.name}.estimated_hole must return a Pose, got {pose!r}")
+        return pose
+    s_xy, s_z, s_rz = HOLE_ERROR
+    yaw_matters = "rz" in getattr(task, "search_dims", ()) or getattr(task, "rz_period", 0) > 0
+    err = Pose.from_xyz_rz(*rng.normal(0.0, s_xy, 2), rng.normal(0.0, s_z),
+                           rng.normal(0.0, s_rz) if yaw_matters else 0.0)
+    return task.hole2world.compose(err)
+
+
+def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
+    """Context for ``task``: estimated hole pose, goal depth, approach height above the
+    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping."""
+    hole = task.hole2world
+    est = estimate_hole(task, rng)
+    above = float(task.surface_z - hole.pos[2])  # surface above the hole entry (valleys)
+    depth = float(task.success_depth) + 0.0005
+    hole_depth = getattr(task, "hole_depth", None)
+    if isinstance(hole_depth, int | float):
+        depth = min(depth, float(hole_depth))
+    values = {
+        "depth": depth,
+        "approach_height": above + 0.005,
+        "drop_depth": 0.001 - above,  # 1 mm below the surface around the hole
+        "rz_period": float(getattr(task, "rz_period", 0.0) or 0.0),
+    }
+    values.update(dict(getattr(task, "skill_context", {}) or {}))
+    goal = hole.compose(Pose(np.array([0.0, 0.0, -float(task.success_depth)])))
+    return HoleContext(est, goal, values)
+
+
+def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:
+    """``n`` slightly different start poses above the hole: the task's own seed-B starts
+    (``skill_starts(rng)``, four, or its ``"skill"`` protocol for other ``n``) if it has them,
+    else 25 mm above the surface at +-4 mm around the true hole (corners of a square, 1 mm
+    jitter), yaw jitter +-0.05 rad where the yaw matters."""
+    own = getattr(task, "skill_starts", None)
+    if callable(own):
+        starts = list(own(rng))
+        return starts if len(starts) == n else task.protocol_starts("skill", n, rng)
+    hole = task.hole2world
+    yaw_matters = "rz" in getattr(task, "search_dims", ()) or getattr(task, "rz_period", 0) > 0
+    out = []
+    for i in range(n):
+        ang = np.pi / 4 + i * np.pi / 2
+        xy = 0.004 * np.array([np.cos(ang), np.sin(ang)]) + rng.normal(0.0, 0.001, 2)
+        z = task.surface_z - hole.pos[2] + 0.025
+        rz = rng.uniform(-0.05, 0.05) if yaw_matters else 0.0
+        out.append(hole.compose(Pose.from_xyz_rz(xy[0], xy[1], z, rz)))
+    return out

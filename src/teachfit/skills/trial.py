@@ -1,0 +1,119 @@
+"""A learning trial (seed B, Sec. V): one parameter set evaluated from several start poses.
+
+An experiment fixes the task, the estimated hole pose (taught once, with its error) and the
+start poses (four slightly different ones) in a :class:`SkillSetup`; each trial then runs the
+skill with one set of learned values from every start and reports the mean cost:
+
+    cost = (1 / n) sum_i q_i            (q_i from :class:`~teachfit.skills.metric.LearningMetric`)
+
+:class:`SkillTrial` keeps one simulated robot across trials (building the MuJoCo model is
+the slow part) and installs a fresh controller per execution, built from the adaptive
+meta-parameters among the learned values.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from teachfit.learning.base import TrialResult
+from teachfit.pose import Pose
+from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
+from teachfit.skills import peg_in_hole
+from teachfit.skills.controllers import make_controller
+from teachfit.skills.executor import ExecConfig, ExecutionTrace, execute
+from teachfit.skills.graph import Skill
+from teachfit.skills.metric import LearningMetric
+from teachfit.tasks.base import Task
+
+
+@dataclass(frozen=True)
+class SkillSetup:
+    """Everything fixed within an experiment: the skill (context set), the task, the
+    estimated hole frame (task frame), the true goal pose and the start poses."""
+
+    skill: Skill
+    task: Task
+    task2world: Pose
+    goal2world: Pose
+    starts: tuple[Pose, ...]
+
+
+def peg_in_hole_setup(
+    task: Task, seed: int = 0, n_starts: int = 4, controller: str = "adaptive",
+    skill: Skill | None = None,
+) -> SkillSetup:
+    """The peg-in-hole set-up for ``task``: hole estimate and starts drawn from ``seed``."""
+    rng = np.random.default_rng(seed)
+    ctx = peg_in_hole.hole_context(task, rng)
+    base = skill if skill is not None else peg_in_hole.build(controller)
+    starts = peg_in_hole.default_starts(task, n_starts, rng)
+    return SkillSetup(base.with_context(ctx.values), task, ctx.hole2world_est, ctx.goal2world,
+                      tuple(starts))
+
+
+@dataclass(frozen=True)
+class TrialOutcome:
+    """One trial: per-start ``(success, cost)`` and the traces, mean ``cost`` (s)."""
+
+    successes: tuple[bool, ...]
+    costs: tuple[float, ...]
+    traces: tuple[ExecutionTrace, ...]
+
+    @property
+    def cost(self) -> float:
+        return float(np.mean(self.costs))
+
+    @property
+    def success_rate(self) -> float:
+        return float(np.mean(self.successes))
+
+    def as_result(self) -> TrialResult:
+        """For :mod:`teachfit.learning`: mean cost, feasible if any start succeeded."""
+        return TrialResult(self.cost, any(self.successes),
+                           {"success_rate": self.success_rate,
+                            "wall_s": float(sum(t.wall_s for t in self.traces))})
+
+
+class SkillTrial:
+    """Callable ``learned values -> TrialOutcome`` for one :class:`SkillSetup`.
+
+    Parameters
+    ----------
+    setup : the experiment's fixed part.
+    controller : ``"adaptive"`` (seed B) or ``"impedance"``.
+    metric : defaults to ``LearningMetric(time_limit = the skill's t_max)``.
+    config : executor settings.
+    seed : the robot's sensor-noise seed.
+    """
+
+    def __init__(
+        self, setup: SkillSetup, controller: str = "adaptive",
+        metric: LearningMetric | None = None, config: ExecConfig | None = None,
+        robot_params: FloatingToolParams | None = None, seed: int = 0,
+    ) -> None:
+        self.setup = setup
+        self.controller = controller
+        t_max = setup.skill.params.context.get("t_max")
+        self.metric = metric or LearningMetric(time_limit=t_max.value if t_max else 5.0)
+        self.config = config or ExecConfig()
+        self.robot = FloatingToolRobot(setup.task, params=robot_params, seed=seed)
+
+    def run(self, learned: Mapping[str, float] | None, start: Pose) -> ExecutionTrace:
+        """One execution from ``start`` (values validated; defaults fill gaps)."""
+        s = self.setup
+        values = s.skill.resolve(learned)
+        self.robot.controller = make_controller(
+            self.controller, values, self.robot.params.apparent_mass, self.robot.control_period)
+        return execute(s.skill, self.robot, start, s.task2world,
+                       {k: values[k] for k in s.skill.params.learned},
+                       task=s.task, goal2world=s.goal2world, config=self.config)
+
+    def __call__(
+        self, learned: Mapping[str, float] | None = None, starts: Sequence[Pose] | None = None
+    ) -> TrialOutcome:
+        traces = tuple(self.run(learned, st) for st in (starts or self.setup.starts))
+        scored = [self.metric.evaluate(tr) for tr in traces]
+        return TrialOutcome(tuple(s for s, _ in scored), tuple(c for _, c in scored), traces)

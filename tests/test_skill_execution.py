@@ -1,0 +1,116 @@
+"""Executing skills in simulation: peg-in-hole on peg2d, the cost metric, divergence."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from teachfit.errors import SimulationDiverged
+from teachfit.pose import Pose
+from teachfit.robot.floating import FloatingToolRobot
+from teachfit.skills import peg_in_hole
+from teachfit.skills.conditions import TimeAbove
+from teachfit.skills.executor import ExecConfig, execute
+from teachfit.skills.metric import LearningMetric
+from teachfit.skills.trial import SkillTrial, peg_in_hole_setup
+from teachfit.tasks.peg2d import Peg2D
+
+ORDER = ["approach", "contact", "lateral", "align", "insert"]
+
+
+@pytest.fixture(scope="module")
+def task():
+    return Peg2D()
+
+
+def _with_error(setup, dx, dy):
+    """The set-up with the hole estimate off the true hole by (dx, dy) m."""
+    est = setup.task.hole2world.compose(Pose.from_xyz_rz(dx, dy, 0.0))
+    return dataclasses.replace(setup, task2world=est)
+
+
+@pytest.mark.parametrize("controller", ["adaptive", "impedance"])
+def test_default_skill_inserts_despite_hole_pose_error(task, controller):
+    setup = _with_error(peg_in_hole_setup(task, seed=1, controller=controller), 8e-4, -6e-4)
+    trial = SkillTrial(setup, controller=controller, seed=1)
+    out = trial(starts=setup.starts[:2])
+    assert out.successes == (True, True), [tr.reason for tr in out.traces]
+    for tr, cost in zip(out.traces, out.costs, strict=True):
+        visited = [v.node for v in tr.visits]
+        assert visited[0] == "approach" and visited == ORDER[: len(visited)]
+        assert len(visited) >= 4 and tr.inserted
+        assert 0.0 < tr.t_first_contact < tr.t_end < 5.0
+        assert cost == pytest.approx(tr.t_end - tr.t_first_contact)
+        assert all(a.t_exit == pytest.approx(b.t_enter)
+                   for a, b in zip(tr.visits, tr.visits[1:], strict=False))
+        assert tr.steps == pytest.approx(tr.t_end * 1000, abs=15)
+        assert tr.log.t.size > 50 and np.all(np.diff(tr.log.t) > 0)
+    assert out.as_result().feasible and out.success_rate == 1.0
+
+
+def test_failure_costs_limit_plus_factor_times_remaining(task):
+    # estimate 6 mm off: the part lands beside the hole and cannot be inserted
+    setup = _with_error(peg_in_hole_setup(task, seed=2, controller="impedance"), 6e-3, 0.0)
+    setup = dataclasses.replace(setup, skill=setup.skill.with_context({"t_max": 1.6}))
+    trial = SkillTrial(setup, controller="impedance",
+                       metric=LearningMetric(time_limit=1.6, distance_factor=100.0))
+    out = trial(starts=setup.starts[:1])
+    tr = out.traces[0]
+    assert not out.successes[0] and tr.outcome == "error" and tr.inserted is False
+    truth = setup.goal2world.pos
+    assert tr.remaining > 0.004
+    assert tr.remaining == pytest.approx(np.linalg.norm(tr.log.pos[tr.log.t <= tr.t_end][-1]
+                                                        - truth), abs=2e-3)
+    assert out.costs[0] == pytest.approx(1.6 + 100.0 * tr.remaining)
+    assert tr.visits[-1].node == "retract"  # the recovery node ran after the error
+    assert LearningMetric(1.6, 100.0).evaluate(tr) == (False, out.costs[0])
+
+
+class _Exploding(FloatingToolRobot):
+    """A simulated robot whose state turns to NaN after ``after`` control ticks."""
+
+    def __init__(self, *args, after: int, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.after, self.ticks = after, 0
+
+    def step(self, n=1):
+        self.ticks += n
+        if self.ticks > self.after:
+            self.data.qvel[0] = math.nan
+        return super().step(n)
+
+
+def test_diverging_simulation_fails_the_execution_without_raising(task):
+    setup = peg_in_hole_setup(task, seed=0, controller="impedance")
+    robot = _Exploding(task, after=300)
+    with pytest.raises(SimulationDiverged):  # the robot itself does raise ...
+        robot.reset(setup.starts[0])
+        robot.ticks = 10_000
+        robot.step(1)
+    robot.ticks = 0
+    tr = execute(setup.skill, robot, setup.starts[0], setup.task2world, task=task,
+                 goal2world=setup.goal2world)  # ... the execution does not
+    assert tr.outcome == "diverged" and not tr.success and "diverged" in tr.reason
+    assert tr.t_end == pytest.approx(0.3, abs=0.02) and math.isfinite(tr.remaining)
+    ok, cost = LearningMetric().evaluate(tr)
+    assert not ok and math.isfinite(cost) and cost > LearningMetric().time_limit
+
+
+def test_precondition_blocks_the_start(task):
+    setup = peg_in_hole_setup(task, seed=0, controller="impedance")
+    skill = dataclasses.replace(setup.skill, pre=TimeAbove(1.0, scope="skill"))
+    robot = FloatingToolRobot(task)
+    tr = execute(skill, robot, setup.starts[0], setup.task2world, task=task,
+                 config=ExecConfig(recovery_time=0.0))
+    assert tr.outcome == "precondition" and tr.steps == 0 and tr.visits == ()
+
+
+def test_peg_in_hole_context_from_task(task):
+    rng = np.random.default_rng(0)
+    ctx = peg_in_hole.hole_context(task, rng)
+    assert ctx.values["depth"] == pytest.approx(task.success_depth + 5e-4)
+    off = ctx.hole2world_est.pos - task.hole2world.pos
+    assert 0 < np.hypot(*off[:2]) < 0.004  # a realistic, sub-4-mm taught error
+    starts = peg_in_hole.default_starts(task, 4, rng)
+    assert len(starts) == 4 and all(s.pos[2] > task.surface_z + 0.02 for s in starts)
