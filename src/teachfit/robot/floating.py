@@ -155,6 +155,7 @@ class FloatingToolRobot:
         self._angvel = np.zeros(3)
         self._tare = np.zeros(6)
         self._warnings = 0
+        self._warning_numbers = self.data.warning.number
         self._cmd: ImpedanceCommand | None = None
 
     # ------------------------------------------------------------------ Robot protocol
@@ -248,7 +249,7 @@ class FloatingToolRobot:
 
     # -------------------------------------------------------------------- divergence
     def _warning_count(self) -> int:
-        return int(sum(w.number for w in self.data.warning))
+        return int(self._warning_numbers.sum())  # a view: no Python loop per tick
 
     def _check_divergence(self) -> None:
         count = self._warning_count()
