@@ -1,0 +1,66 @@
+"""Figure of a tracked capture: ``L2G`` position and orientation over time, frames without a
+trustworthy pose shaded, and the per-frame quality (predicted error, reprojection, markers)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from scipy.spatial.transform import Rotation  # noqa: E402
+
+from teachfit.capture.track import Track  # noqa: E402
+from teachfit.demonstrations.dataset import Demonstration  # noqa: E402
+
+__all__ = ["track_figure"]
+
+
+def _rpy(R: np.ndarray) -> np.ndarray:
+    return Rotation.from_matrix(R).as_euler("xyz", degrees=True)
+
+
+def track_figure(track: Track, out: str | Path, truth: Demonstration | None = None) -> Path:
+    """Write a three-panel png of ``track`` (and ``truth`` dashed, when given)."""
+    out = Path(out)
+    t, ok = track.t, track.valid
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    pos = np.full((len(t), 3), np.nan)
+    rpy = np.full((len(t), 3), np.nan)
+    pos[ok] = 1e3 * track.L2G[ok, :3, 3]
+    if ok.any():
+        rpy[ok] = _rpy(track.L2G[ok, :3, :3])
+    for k, label in enumerate("xyz"):
+        axes[0].plot(t, pos[:, k], ".-", ms=3, color=f"C{k}", label=label)
+        axes[1].plot(t, rpy[:, k], ".-", ms=3, color=f"C{k}", label=("roll", "pitch", "yaw")[k])
+        if truth is not None:
+            R = Rotation.from_quat(np.asarray(truth.quat)[:, [1, 2, 3, 0]]).as_matrix()
+            axes[0].plot(truth.t, 1e3 * truth.pos[:, k], "--", color=f"C{k}", lw=0.8)
+            axes[1].plot(truth.t, _rpy(R)[:, k], "--", color=f"C{k}", lw=0.8)
+    dt = np.median(np.diff(t)) if len(t) > 1 else 1.0
+    for ax in axes:
+        for i in np.flatnonzero(~ok):
+            ax.axvspan(t[i] - dt / 2, t[i] + dt / 2, color="0.85", lw=0)
+    axes[0].set_ylabel("L in G position (mm)")
+    axes[1].set_ylabel("L in G angles (deg)")
+    axes[2].plot(t, track.std_mm, label="predicted 1-sigma (mm)")
+    axes[2].plot(t, track.std_deg, label="predicted 1-sigma (deg)")
+    axes[2].plot(t, track.rms_px, label="reprojection RMS (px)")
+    ax2 = axes[2].twinx()
+    ax2.step(t, track.n_markers.sum(axis=1), where="mid", color="0.4", lw=0.8)
+    ax2.set_ylabel("markers used")
+    axes[2].set_yscale("log")
+    axes[2].set_xlabel("time (s)")
+    for ax in axes:
+        ax.legend(loc="upper right", fontsize=7)
+    title = f"capture: {int(ok.sum())}/{track.n_frames} frames valid (grey: no trustworthy pose)"
+    if truth is not None:
+        title += "; dashed: ground truth"
+    axes[0].set_title(title)
+    fig.tight_layout()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
