@@ -84,3 +84,29 @@ def test_bad_sample_count_and_roundtrip():
     np.testing.assert_array_equal(e2.covs, e.covs)
     with pytest.raises(ModelError):
         ExplorationDistribution(("x", "y"), np.ones(1), np.zeros((1, 2)), -np.eye(2)[None])
+
+
+def test_qmc_samples_have_the_distributions_mean_and_covariance():
+    from teachfit.models.exploration import ExplorationDistribution
+
+    cov = np.array([[4.0, 1.0, 0.2], [1.0, 1.0, -0.3], [0.2, -0.3, 0.5]])
+    e = ExplorationDistribution(
+        ("x", "y", "rz"), np.array([1.0]), np.array([[1.0, 2.0, -1.0]]), cov[None]
+    )
+    x = e.sample(4096, np.random.default_rng(0), qmc=True)
+    assert np.allclose(x.mean(axis=0), [1.0, 2.0, -1.0], atol=0.01)
+    assert np.allclose(np.cov(x.T), cov, atol=0.03)
+
+
+def test_qmc_samples_cover_more_evenly_than_iid_draws():
+    from scipy.spatial import cKDTree
+
+    from teachfit.models.exploration import ExplorationDistribution
+
+    e = ExplorationDistribution(("x", "y"), np.array([1.0]), np.zeros((1, 2)), np.eye(2)[None])
+    grid = np.stack(np.meshgrid(np.linspace(-1, 1, 41), np.linspace(-1, 1, 41)), -1).reshape(-1, 2)
+    gaps = []
+    for qmc in (True, False):
+        pts = e.sample(300, np.random.default_rng(1), qmc=qmc)
+        gaps.append(cKDTree(pts).query(grid)[0].max())  # largest empty hole in the core
+    assert gaps[0] < gaps[1]

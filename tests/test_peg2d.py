@@ -78,3 +78,11 @@ def test_table1_starts_lie_in_a_3cm_circle_halfway():
     assert np.allclose([s.pos[2] for s in starts], task.surface_z)
     with pytest.raises(TaskError):
         task.protocol_starts("table9", 3, rng)
+
+
+def test_friction_parameter_reaches_the_scene():
+    from teachfit.robot.floating import build_scene
+    from teachfit.tasks.registry import get_task
+
+    xml = build_scene(get_task("peg2d", friction=0.7))
+    assert 'friction="0.7 ' in xml and 'friction="0.3 ' not in xml

@@ -37,3 +37,24 @@ def test_demos_that_end_at_once_or_never_are_discarded():
     assert demo is None and "never" in why
     with pytest.raises(TeachfitError, match="succeeded"):
         lazy.record(1, max_attempts=2)
+
+
+def test_worst_case_sweep_spans_start_to_hole_and_across():
+    """Seed A: one end of the exploration distribution lies at the demonstration's start."""
+    task = get_task("peg2d")
+    demos, _ = BlindTeacher(task, seed=2).record(1)
+    xy = demos[0].pos[:, :2]
+    hole = task.hole2world.pos[:2]
+    axis = (hole - xy[0]) / np.linalg.norm(hole - xy[0])
+    along = (xy - xy[0]) @ axis
+    across = (xy - xy[0]) @ np.array([-axis[1], axis[0]])
+    style = TeacherStyle()
+    assert along.min() < 0.003 and along.max() > 0.8 * task.params.demo_offset
+    assert across.max() - across.min() > 1.5 * style.sweep_halfwidth
+
+
+def test_other_patterns_go_straight_towards_the_belief():
+    task = get_task("peg2d")
+    demos, _ = BlindTeacher(task, TeacherStyle(pattern="spiral"), seed=2).record(1)
+    xy = demos[0].pos[:, :2]
+    assert np.linalg.norm(xy[-1] - task.hole2world.pos[:2]) < task.capture_radius

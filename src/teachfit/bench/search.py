@@ -1,36 +1,102 @@
 """Seed A's search experiments reproduced in simulation, beside the paper's numbers.
 
-Table I: one demonstration; 30 starts in a 3 cm circle halfway between the demonstration's
-start and the hole; TSHIX (300 points, a new trajectory per start) vs. one ergodic trajectory of
-about the mean TSHIX length, both with the GMR feed-forward.
+- Table I: one demonstration; 30 starts in a 3 cm circle halfway between the demonstration's
+  start and the hole; TSHIX (300 points, a new trajectory per start) vs. one ergodic trajectory
+  of about the mean TSHIX length, both with the GMR feed-forward. We add TSHIX with seed A's
+  i.i.d. sampling beside our default quasi-random sampling.
+- Table II: one start, 20 TSHIX trajectories per N = 100 ... 500: success and planning time.
+- Ablation: the same without the feed-forward, N = 100, 200, 400.
+- Table III: ``socket3d`` (x, y, rz), 15 starts in the socket's upper half, 600 points: random
+  walk, spiral, TSHIX from one and from two demonstrations (started at opposite ends) and the
+  3D ergodic trajectory (which the paper could not produce).
+
+Every execution is a :class:`~teachfit.bench.search_jobs.SearchJob` run in worker processes.
 """
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from teachfit.bench.search_jobs import JobResult, SearchJob, model_json, pose_tuple, run_jobs
+from teachfit.demonstrations.dataset import Demonstration
 from teachfit.demonstrations.teacher import BlindTeacher
-from teachfit.execution.search import plan_search, run_search
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
 from teachfit.pose import Pose
-from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.registry import get_task
 
 #: the paper's real-robot results (successes, trials)
 PAPER_TABLE1 = {"tshix": (25, 30), "ergodic": (20, 30)}
+PAPER_TABLE2 = {100: (6, 20), 200: (12, 20), 300: (17, 20), 400: (17, 20), 500: (17, 20)}
+#: the paper's trajectory-creation CPU time per N (s, Core2 Quad Q9400, MATLAB GA TSP)
+PAPER_TABLE2_CPU = {100: 13.8, 200: 34.1, 300: 61.9, 400: 94.3, 500: 135.6}
+PAPER_ABLATION = {100: (2, 20), 200: (7, 20), 400: (13, 20)}
+PAPER_TABLE3 = {"random-walk": (0, 15), "tshix-1demo": (3, 15), "tshix-2demo": (10, 15)}
+
+Progress = Callable[[], None] | None
 
 
 @dataclass(frozen=True)
 class Row:
+    """One line of a table: ours beside the paper's ``(successes, trials)`` (None: no figure).
+
+    ``plan_ms`` is the median planning wall time; ``length`` the mean path length (m, rz
+    unweighted); ``ergodic`` the mean ergodic metric of the executed plans.
+    """
+
     method: str
     ours: SuccessSummary
-    paper: tuple[int, int]
+    paper: tuple[int, int] | None
     plan_ms: float
+    length: float
+    ergodic: float
+    paper_cpu_s: float | None = None
+
+
+def _row(
+    method: str,
+    results: Sequence[JobResult],
+    paper: tuple[int, int] | None,
+    paper_cpu_s: float | None = None,
+) -> Row:
+    s = summarize([r.success for r in results], [r.time_to_insertion for r in results])
+    return Row(
+        method,
+        s,
+        paper,
+        1e3 * float(np.median([r.plan_s for r in results])),
+        float(np.mean([r.path_length for r in results])),
+        float(np.mean([r.ergodic_metric for r in results])),
+        paper_cpu_s,
+    )
+
+
+def _jobs(
+    task: str,
+    overrides: dict[str, float],
+    model: SearchModel,
+    starts: Sequence[Pose],
+    method: str,
+    n_points: int,
+    seeds: Sequence[int],
+    **kw: object,
+) -> list[SearchJob]:
+    doc = model_json(model)
+    ov = tuple(sorted(overrides.items()))
+    return [
+        SearchJob(task, ov, doc, pose_tuple(p), method, n_points, s, **kw)  # type: ignore[arg-type]
+        for p, s in zip(starts, seeds, strict=True)
+    ]
+
+
+def _peg_setup(seed: int, clearance: float) -> tuple[dict[str, float], Demonstration, SearchModel]:
+    overrides = {"clearance": clearance}
+    task = get_task("peg2d", **overrides)
+    demos, _ = BlindTeacher(task, seed=seed).record(1)
+    return overrides, demos[0], SearchModel.fit(demos, task.name)
 
 
 def table1(
@@ -38,42 +104,126 @@ def table1(
     n_starts: int = 30,
     n_points: int = 300,
     clearance: float = 0.0005,
-    progress: Callable[[str], None] | None = None,
+    workers: int | None = None,
+    progress: Progress = None,
 ) -> list[Row]:
-    """Run Table I's protocol; returns one row per method."""
-    task = get_task("peg2d", clearance=clearance)
-    demos, _ = BlindTeacher(task, seed=seed).record(1)
-    demo = demos[0]
-    model = SearchModel.fit(demos, task.name)
+    """Table I's protocol; rows ``tshix``, ``tshix-iid`` and ``ergodic`` on the same starts."""
+    overrides, demo, model = _peg_setup(seed, clearance)
+    task = get_task("peg2d", **overrides)
     rng = np.random.default_rng(seed + 1)
     starts = task.protocol_starts("table1", n_starts, rng, Pose(demo.pos[0], demo.quat[0]))
-    robot = FloatingToolRobot(task, seed=seed)
-    rows = []
-    tshix_lengths = []
-    results: dict[str, list] = {"tshix": [], "ergodic": []}
-    plan_ms: dict[str, list[float]] = {"tshix": [], "ergodic": []}
-    for i, start in enumerate(starts):
-        t0 = time.perf_counter()
-        traj = plan_search(model, "tshix", n_points, np.random.default_rng(seed * 1000 + i))
-        plan_ms["tshix"].append(1e3 * (time.perf_counter() - t0))
-        tshix_lengths.append(traj.path_length())
-        results["tshix"].append(run_search(robot, task, model, start, traj).outcome)
-        if progress:
-            progress("tshix")
-    t0 = time.perf_counter()
-    ergodic = plan_search(
-        model,
-        "ergodic",
-        n_points,
-        np.random.default_rng(seed),
-        length=float(np.mean(tshix_lengths)),
+    seeds = [seed * 1000 + i for i in range(n_starts)]
+    tshix = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds)
+    iid = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds, sampling="random")
+    res = run_jobs(tshix + iid, workers, progress)
+    res_q, res_r = res[:n_starts], res[n_starts:]
+    length = float(np.mean([r.weighted_length for r in res_q]))
+    erg = _jobs("peg2d", overrides, model, starts, "ergodic", n_points, seeds, length=length)
+    res_e = run_jobs(erg, workers, progress)
+    return [
+        _row("tshix", res_q, PAPER_TABLE1["tshix"]),
+        _row("tshix-iid", res_r, PAPER_TABLE1["tshix"]),
+        _row("ergodic", res_e, PAPER_TABLE1["ergodic"]),
+    ]
+
+
+def table2(
+    seed: int = 0,
+    sizes: Sequence[int] = (100, 200, 300, 400, 500),
+    n_traj: int = 20,
+    ablation: Sequence[int] = (100, 200, 400),
+    clearance: float = 0.0005,
+    workers: int | None = None,
+    progress: Progress = None,
+) -> tuple[list[Row], list[Row]]:
+    """Table II (success and planning time per N) and the feed-forward ablation.
+
+    Returns ``(table2_rows, ablation_rows)``; ablation rows are named ``N=... no-ff``, each
+    beside the paper's figure, and are compared with Table II's rows at the same N.
+    """
+    overrides, demo, model = _peg_setup(seed, clearance)
+    task = get_task("peg2d", **overrides)
+    start = task.protocol_starts(
+        "table2", 1, np.random.default_rng(seed), Pose(demo.pos[0], demo.quat[0])
+    )[0]
+    starts = [start] * n_traj
+    jobs: list[SearchJob] = []
+    for n in sizes:
+        seeds = [seed * 100_000 + n * 100 + k for k in range(n_traj)]
+        jobs += _jobs("peg2d", overrides, model, starts, "tshix", n, seeds)
+    for n in ablation:
+        seeds = [seed * 100_000 + n * 100 + k for k in range(n_traj)]
+        jobs += _jobs("peg2d", overrides, model, starts, "tshix", n, seeds, feedforward=False)
+    res = run_jobs(jobs, workers, progress)
+    rows, abl = [], []
+    for i, n in enumerate(sizes):
+        chunk = res[i * n_traj : (i + 1) * n_traj]
+        rows.append(_row(f"N={n}", chunk, PAPER_TABLE2.get(n), PAPER_TABLE2_CPU.get(n)))
+    off = len(sizes) * n_traj
+    for i, n in enumerate(ablation):
+        chunk = res[off + i * n_traj : off + (i + 1) * n_traj]
+        abl.append(_row(f"N={n} no-ff", chunk, PAPER_ABLATION.get(n)))
+    return rows, abl
+
+
+def _socket_demos(task: object, seed: int) -> list[Demonstration]:
+    """Two worst-case teacher demonstrations started at opposite ends of the socket's upper half.
+
+    Opposite ends in position (left and right of the upper half, against the wall) and in yaw
+    (turned by 60-100 % of ``start_rz`` one way, then the other), so that together they span
+    the start variability as seed A asks of demonstrations.
+    """
+    rng = np.random.default_rng(seed)
+    dist = task.play - task.params.start_wall_gap  # type: ignore[attr-defined]
+    teacher = BlindTeacher(task, seed=seed)  # type: ignore[arg-type]
+    demos: list[Demonstration] = []
+    rz_max = task.params.start_rz  # type: ignore[attr-defined]
+    for (lo, hi), sign in (((0.05, 0.25), 1.0), ((0.75, 0.95), -1.0)):
+        for _attempt in range(6):
+            ang = np.pi * rng.uniform(lo, hi)
+            rz = sign * rng.uniform(0.6 * rz_max, rz_max)  # worst case: far from aligned
+            start = task.contact_pose(dist * np.array([np.cos(ang), np.sin(ang)]), rz)  # type: ignore[attr-defined]
+            demo, _why = teacher.demonstrate(start)
+            if demo is not None:
+                demos.append(demo)
+                break
+        else:
+            raise RuntimeError("the teacher failed six times from one end of the socket")
+    return demos
+
+
+def table3(
+    seed: int = 0,
+    n_starts: int = 15,
+    n_points: int = 600,
+    workers: int | None = None,
+    progress: Progress = None,
+) -> list[Row]:
+    """Table III's protocol on ``socket3d``; one row per method, same starts for all."""
+    task = get_task("socket3d")
+    demos = _socket_demos(task, seed)
+    one = SearchModel.fit(demos[:1], task.name)
+    two = SearchModel.fit(demos, task.name)
+    starts = task.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
+    seeds = [seed * 1000 + i for i in range(n_starts)]
+    t1 = _jobs("socket3d", {}, one, starts, "tshix", n_points, seeds)
+    t2 = _jobs("socket3d", {}, two, starts, "tshix", n_points, seeds)
+    res = run_jobs(t1 + t2, workers, progress)
+    r1, r2 = res[:n_starts], res[n_starts:]
+    length = float(np.mean([r.weighted_length for r in r2]))
+    xy = float(np.mean([r.path_length for r in r2]))
+    steps = max(1, int(xy / 0.003))  # random-walk moves average 3 mm: equal x-y path length
+    more = (
+        _jobs("socket3d", {}, two, starts, "random-walk", steps, seeds)
+        + _jobs("socket3d", {}, two, starts, "spiral", n_points, seeds)
+        + _jobs("socket3d", {}, two, starts, "ergodic", n_points, seeds, length=length)
     )
-    plan_ms["ergodic"].append(1e3 * (time.perf_counter() - t0))
-    for start in starts:
-        results["ergodic"].append(run_search(robot, task, model, start, ergodic).outcome)
-        if progress:
-            progress("ergodic")
-    for method, outcomes in results.items():
-        s = summarize([o.success for o in outcomes], [o.time_to_insertion for o in outcomes])
-        rows.append(Row(method, s, PAPER_TABLE1[method], float(np.median(plan_ms[method]))))
-    return rows
+    res = run_jobs(more, workers, progress)
+    rw, sp, er = res[:n_starts], res[n_starts : 2 * n_starts], res[2 * n_starts :]
+    return [
+        _row("random-walk", rw, PAPER_TABLE3["random-walk"]),
+        _row("spiral", sp, None),
+        _row("tshix-1demo", r1, PAPER_TABLE3["tshix-1demo"]),
+        _row("tshix-2demo", r2, PAPER_TABLE3["tshix-2demo"]),
+        _row("ergodic-3d-2demo", er, None),
+    ]

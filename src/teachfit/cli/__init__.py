@@ -9,6 +9,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import typer  # noqa: E402
 
 from teachfit.cli import capture_cmd, plan_cmd, skill_cmd  # noqa: E402
+from teachfit.cli.bench_search_cmd import bench_search  # noqa: E402
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
 from teachfit.cli.search_cmd import learn_search, search_app  # noqa: E402
@@ -33,6 +34,7 @@ bench_app.command("planning")(plan_cmd.bench_planning_cmd)
 app.add_typer(skill_cmd.skill_app, name="skill")
 app.add_typer(capture_cmd.capture_app, name="capture")
 bench_app.command("capture")(capture_cmd.bench_capture_cmd)
+bench_app.command("search")(bench_search)
 register(app, bench_app)
 
 

@@ -94,46 +94,8 @@ def bench_sim(
     console.print(table)
 
 
-@guarded
-def bench_search(
-    table: Annotated[str, typer.Option(help="which paper table: 1")] = "1",
-    seed: int = 0,
-    starts: Annotated[int, typer.Option(help="start poses (paper: 30)")] = 30,
-    points: Annotated[int, typer.Option(help="TSHIX points (paper: 300)")] = 300,
-) -> None:
-    """Seed A's search experiments in simulation, beside the paper's numbers."""
-    from rich.progress import Progress
-
-    from teachfit.bench.search import table1
-    from teachfit.errors import TeachfitError
-    from teachfit.metrics.stats import wilson_interval
-
-    if table != "1":
-        raise TeachfitError(f"table {table!r} is not implemented yet; available: 1")
-    with Progress(console=console, transient=True) as bar:
-        job = bar.add_task("Table I: TSHIX and ergodic from each start", total=2 * starts)
-        rows = table1(seed, starts, points, progress=lambda _m: bar.advance(job))
-    out = Table(title=f"Table I (peg2d, clearance 0.5 mm, 1 demo, seed {seed})")
-    for col in ("method", "ours [95 % CI]", "paper [95 % CI]", "median time", "plan time"):
-        out.add_column(col, justify="right")
-    for r in rows:
-        lo, hi = wilson_interval(*r.paper)
-        t = "n/a" if r.ours.median_time != r.ours.median_time else f"{r.ours.median_time:.1f} s"
-        out.add_row(
-            r.method,
-            f"{r.ours.successes}/{r.ours.trials} = {100 * r.ours.rate:.0f} % "
-            f"[{100 * r.ours.low:.0f}, {100 * r.ours.high:.0f}]",
-            f"{r.paper[0]}/{r.paper[1]} = {100 * r.paper[0] / r.paper[1]:.0f} % "
-            f"[{100 * lo:.0f}, {100 * hi:.0f}]",
-            t,
-            f"{r.plan_ms:.0f} ms",
-        )
-    console.print(out)
-
-
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
     app.command("tasks")(tasks)
     app.command("render")(render)
     app.command("quickstart")(quickstart)
     bench_app.command("sim")(bench_sim)
-    bench_app.command("search")(bench_search)

@@ -1,9 +1,17 @@
 """A simulated blind teacher: a "human with closed eyes" demonstrating a search.
 
 The teacher starts from a worst-case offset, presses the part onto the surface and moves the
-compliant robot kinesthetically: first towards where they *believe* the hole is (their belief
-is off by ``belief_sigma``), then in a deliberate search pattern around that belief (an
-outward spiral or a zig-zag raster) until the part drops in. Human-like noise is a slow random
+compliant robot kinesthetically in a deliberate search pattern until the part drops in. The
+belief about where the hole is is off by ``belief_sigma``. Patterns:
+
+- ``"sweep"`` (default, the worst-case demonstration seed A asks for): a raster of passes
+  across the believed direction, ``2 sweep_halfwidth`` wide and ``spiral_pitch`` apart, that
+  starts at the start pose and advances towards (and beyond) the belief. The demonstrated
+  states then span the whole region between the start and the hole, so "one end of the
+  exploration distribution is approximately at the starting position" (seed A, Sec. IV-B).
+- ``"spiral"``: straight towards the belief, then an outward Archimedean spiral around it.
+- ``"zigzag"``: straight towards the belief, then a zig-zag raster around it.
+ Human-like noise is a slow random
 wander (an Ornstein-Uhlenbeck process) plus a small physiological tremor; for tasks with a
 rotational search DOF the teacher also wiggles the part about z around its belief. What is
 recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench at
@@ -25,17 +33,18 @@ from teachfit.pose import Pose, quat_from_rz
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.base import Task
 
-PATTERNS = ("spiral", "zigzag")
+PATTERNS = ("sweep", "spiral", "zigzag")
 
 
 @dataclass(frozen=True)
 class TeacherStyle:
     """How the simulated teacher searches (m, m/s, s, rad, N, N/m, Hz)."""
 
-    pattern: str = "spiral"
+    pattern: str = "sweep"
     speed: float = 0.012
     belief_sigma: float = 0.005
     spiral_pitch: float = 0.0025
+    sweep_halfwidth: float = 0.015
     wander_amplitude: float = 0.0005
     wander_timescale: float = 0.5
     tremor_amplitude: float = 0.00005
@@ -45,14 +54,15 @@ class TeacherStyle:
     rz_wiggle_frequency: float = 0.4
     push_force: float = 6.0
     arm_stiffness: float = 600.0
-    max_duration: float = 40.0
+    max_duration: float = 60.0
     min_duration: float = 0.5
     record_rate: float = 100.0
 
     def __post_init__(self) -> None:
         if self.pattern not in PATTERNS:
             raise TeachfitError(f"teacher pattern must be one of {PATTERNS}, got {self.pattern!r}")
-        for name in ("speed", "spiral_pitch", "max_duration", "record_rate", "wander_timescale"):
+        positive = ("speed", "spiral_pitch", "sweep_halfwidth", "max_duration", "record_rate")
+        for name in (*positive, "wander_timescale"):
             if not getattr(self, name) > 0:
                 raise TeachfitError(f"teacher {name} must be > 0")
         if self.min_duration >= self.max_duration:
@@ -90,6 +100,22 @@ class BlindTeacher:
         y = row * st.spiral_pitch - width / 2
         return np.column_stack([np.clip(x, -width / 2, width / 2), y])
 
+    def _sweep(self, p0: np.ndarray, belief: np.ndarray, n: int, dt: float) -> np.ndarray:
+        """(n, 2) raster from ``p0`` across the direction to ``belief`` and past it, world."""
+        st = self.style
+        span = float(np.linalg.norm(belief - p0))
+        u = (belief - p0) / span if span > 1e-9 else np.array([1.0, 0.0])
+        v = np.array([-u[1], u[0]]) * self.rng.choice([-1.0, 1.0])
+        w, pitch = st.sweep_halfwidth, st.spiral_pitch
+        rows = int(np.ceil((span + w) / pitch)) + 1
+        corners = [np.zeros(2)]
+        side = 1.0
+        for k in range(rows):
+            corners += [np.array([k * pitch, side * w]), np.array([(k + 1) * pitch, side * w])]
+            side = -side
+        local = _along_polyline(np.array(corners), st.speed * dt * np.arange(n))
+        return p0 + local[:, :1] * u + local[:, 1:] * v
+
     def _noise(self, n: int, dt: float) -> np.ndarray:
         """(n, 2) slow wander (Ornstein-Uhlenbeck) plus tremor, m."""
         st = self.style
@@ -112,12 +138,16 @@ class BlindTeacher:
         hole = task.hole2world.pos[:2]
         belief = hole + self.rng.normal(0.0, st.belief_sigma, 2)
         p0 = start.pos[:2]
-        approach_len = float(np.linalg.norm(belief - p0))
-        n_app = min(max(2, int(approach_len / st.speed / dt)), n - 1)
-        lam = np.linspace(0.0, 1.0, n_app)[:, None]
-        approach = p0 + lam * (belief - p0)
-        search = belief + self._search_pattern(n - n_app, dt)
-        xy = np.concatenate([approach, search])[:n] + self._noise(n, dt)
+        if st.pattern == "sweep":
+            n_app = min(n - 1, max(2, int(2.0 / dt)))  # turn towards the belief in 2 s
+            xy = self._sweep(p0, belief, n, dt)
+        else:
+            approach_len = float(np.linalg.norm(belief - p0))
+            n_app = min(max(2, int(approach_len / st.speed / dt)), n - 1)
+            lam = np.linspace(0.0, 1.0, n_app)[:, None]
+            approach = p0 + lam * (belief - p0)
+            xy = np.concatenate([approach, belief + self._search_pattern(n - n_app, dt)])[:n]
+        xy = xy + self._noise(n, dt)
         xy[0] = p0
         t = dt * np.arange(n)
         if self.has_rz:
@@ -202,6 +232,13 @@ class BlindTeacher:
                 f"discarded: {discarded}"
             )
         return demos, discarded
+
+
+def _along_polyline(corners: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Points at arc lengths ``s`` along the polyline through ``corners`` (clamped at its end)."""
+    seg = np.linalg.norm(np.diff(corners, axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    return np.column_stack([np.interp(s, cum, corners[:, j]) for j in range(corners.shape[1])])
 
 
 def _fields(demo: Demonstration) -> dict[str, object]:

@@ -74,16 +74,24 @@ def plan_search(
     rng: np.random.Generator,
     *,
     length: float | None = None,
+    sampling: str = "qmc",
 ) -> SearchTrajectory:
-    """A search trajectory in the search frame by ``method`` (see :data:`METHODS`)."""
+    """A search trajectory in the search frame by ``method`` (see :data:`METHODS`).
+
+    ``n_points``: TSHIX samples, or random-walk steps; an ergodic trajectory is as long as
+    ``length`` (m) or as a TSHIX pass through ``n_points`` samples. ``sampling`` is TSHIX's
+    sampler (``"qmc"`` or seed A's i.i.d. ``"random"``). The baselines span the exploration
+    distribution's 2-sigma radius (and, for rz, its 2-sigma rz range).
+    """
     if n_points <= 0:
         raise TeachfitError(f"number of points must be positive, got {n_points}")
     dims = model.dims
     if method == "tshix":
-        return TshixPlanner.from_model(model).plan(n_points, rng)
+        return TshixPlanner.from_model(model, sampling=sampling).plan(n_points, rng)
     if method == "ergodic":
         if length is None:
-            length = TshixPlanner.from_model(model).plan(n_points, rng).path_length()
+            planner = TshixPlanner.from_model(model, sampling=sampling)
+            length = planner.plan(n_points, rng).path_length()
         return ergodic_trajectory(
             model.exploration,
             speed=model.speed,
@@ -91,11 +99,31 @@ def plan_search(
             angular_speed=model.angular_speed,
             start=np.zeros(len(dims)),
         )
+    ex = model.exploration
+    var = np.diag(ex.cov)
+    lin = [i for i, d in enumerate(dims) if d != "rz"]
+    radius = float(np.linalg.norm(ex.mean[lin]) + 2.0 * np.sqrt(var[lin].max()))
+    rz_sd = float(np.sqrt(var[dims.index("rz")])) if "rz" in dims else 0.0
     if method == "spiral":
-        return archimedean_spiral(dims, pitch=0.002, radius=0.02, speed=model.speed)
+        return archimedean_spiral(
+            dims,
+            pitch=0.002,
+            radius=radius,
+            speed=model.speed,
+            rz_amplitude=2.0 * rz_sd,
+            angular_speed=model.angular_speed,
+        )
     if method == "random-walk":
         return random_walk(
-            dims, rng, n_steps=n_points, step_max=0.004, radius=0.02, speed=model.speed
+            dims,
+            rng,
+            n_steps=n_points,
+            step_max=0.004,
+            radius=radius,
+            speed=model.speed,
+            rz_step_max=rz_sd,
+            rz_radius=2.0 * rz_sd,
+            angular_speed=model.angular_speed,
         )
     raise TeachfitError(f"unknown search method {method!r}; choose from {METHODS}")
 

@@ -15,12 +15,14 @@ data's spread, so the model stays well-posed yet only puts mass where the teache
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from scipy.special import logsumexp
+from scipy.stats.qmc import MultivariateNormalQMC
 from sklearn.mixture import GaussianMixture
 
 from teachfit.errors import ModelError
@@ -200,17 +202,29 @@ class ExplorationDistribution:
         """p_e(s) (density in 1 / (m^n rad^r)) for s of shape (M, D) or (D,)."""
         return np.exp(self.logpdf(s))
 
-    def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
-        """Draw ``n`` samples (n, D); component counts are multinomial in the weights."""
+    def sample(self, n: int, rng: np.random.Generator, *, qmc: bool = False) -> np.ndarray:
+        """Draw ``n`` samples (n, D); component counts are multinomial in the weights.
+
+        ``qmc=True`` draws each component's samples as scrambled Sobol points mapped through
+        the Gaussian's inverse CDF (:class:`scipy.stats.qmc.MultivariateNormalQMC`): still
+        distributed as p_e, but without the clumps and gaps of i.i.d. draws, so a tour through
+        them covers the distribution more evenly.
+        """
         if not isinstance(n, int | np.integer) or n <= 0:
             raise ModelError(f"number of samples must be a positive integer, got {n!r}")
         counts = rng.multinomial(int(n), self.weights)
         chol = np.linalg.cholesky(self.covs)
-        parts = [
-            self.means[k] + rng.standard_normal((c, self.dim)) @ chol[k].T
-            for k, c in enumerate(counts)
-            if c > 0
-        ]
+        parts = []
+        for k, c in enumerate(counts):
+            if c == 0:
+                continue
+            if qmc:
+                engine = MultivariateNormalQMC(self.means[k], cov_root=chol[k].T, rng=rng)
+                with warnings.catch_warnings():  # Sobol prefers powers of 2; a prefix is fine
+                    warnings.simplefilter("ignore", UserWarning)
+                    parts.append(engine.random(int(c)))
+            else:
+                parts.append(self.means[k] + rng.standard_normal((c, self.dim)) @ chol[k].T)
         out = np.concatenate(parts)
         return out[rng.permutation(int(n))]
 

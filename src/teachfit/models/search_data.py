@@ -117,17 +117,15 @@ def yaw_relative(quat: np.ndarray) -> np.ndarray:
     return np.unwrap(yaw - yaw[0])
 
 
-def _as_search_frame(demo: Any) -> Any:
-    if getattr(demo, "frame", "search") != "search" and hasattr(demo, "in_search_frame"):
-        return demo.in_search_frame()
-    return demo
-
-
 def _demo_arrays(
     demo: Any, dims: tuple[str, ...]
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """(t, states, actions) of one demonstration at its own samples."""
-    demo = _as_search_frame(demo)
+    """(t, states, actions) of one demonstration at its own samples.
+
+    The search frame is the recording frame translated to the first pose, its axes kept (seed
+    A), and rz is relative to the first yaw: exactly how :mod:`teachfit.execution.search` maps
+    search states back from a new start, so fixture-fixed directions stay fixed.
+    """
     t = np.asarray(demo.t, dtype=float)
     pos = np.asarray(demo.pos, dtype=float)
     quat = np.asarray(demo.quat, dtype=float)
@@ -176,8 +174,8 @@ def search_data(
     Parameters
     ----------
     demos : iterable of Demonstration or DemoArrays
-        One or more demonstrations. A Demonstration not already in its search frame is converted
-        with ``in_search_frame()``; positions and rz are then taken relative to the first sample.
+        One or more demonstrations. Positions are taken relative to the first sample in the
+        recording frame's axes, rz relative to the first yaw.
     dims : sequence of str
         Search DOFs, e.g. ``("x", "y")`` or ``("x", "y", "rz")``.
     rate_hz : float, optional

@@ -100,6 +100,12 @@ class Task(ABC):
         )
 
     @property
+    def contact(self) -> ContactParams:
+        """Contact model of this cell; a ``friction`` task parameter sets the coefficient."""
+        friction = getattr(self.params, "friction", None)
+        return ContactParams() if friction is None else ContactParams(friction=float(friction))
+
+    @property
     def capture_radius(self) -> float:
         """Lateral TCP offset (m) beyond which the part cannot be inside the hole."""
         return 0.005

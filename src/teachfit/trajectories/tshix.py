@@ -184,6 +184,10 @@ class TshixPlanner:
         Dense resampling: median edge length / spacing.
     solver : {"fast", "lkh"}
         TSP solver.
+    sampling : {"qmc", "random"}
+        ``"random"``: i.i.d. draws from p_e (seed A). ``"qmc"`` (default): scrambled Sobol
+        points through p_e's inverse CDF, equally distributed but more even, so the tour leaves
+        fewer gaps (measured in BENCHMARKS.md, Table I).
     """
 
     exploration: ExplorationDistribution
@@ -195,10 +199,13 @@ class TshixPlanner:
     polyorder: int = 3
     points_per_edge: int = 8
     solver: Literal["fast", "lkh"] = "fast"
+    sampling: Literal["qmc", "random"] = "qmc"
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.speed) and self.speed > 0):
             raise ModelError(f"speed must be positive, got {self.speed}")
+        if self.sampling not in ("qmc", "random"):
+            raise ModelError(f"sampling must be 'qmc' or 'random', got {self.sampling!r}")
         if self.length_scale is None:
             object.__setattr__(self, "length_scale", default_length_scale(self.exploration))
         if not self.length_scale > 0 or self.rate_hz <= 0 or self.smooth < 0:
@@ -216,7 +223,7 @@ class TshixPlanner:
             raise PlanningError(f"number of samples must be a positive integer, got {n!r}")
         dims = self.exploration.dims
         w = metric_weights(dims, self.length_scale)
-        samples = self.exploration.sample(int(n), rng)
+        samples = self.exploration.sample(int(n), rng, qmc=self.sampling == "qmc")
         tour = open_tour(samples, start, weights=w, solver=self.solver, rng=rng)
         poly = np.vstack([start[None], samples[tour.order]]) * w
         seg = np.linalg.norm(np.diff(poly, axis=0), axis=1)

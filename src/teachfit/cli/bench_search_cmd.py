@@ -1,0 +1,120 @@
+"""``teachfit bench search``: seed A's tables in simulation, ours beside the paper's."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.progress import Progress
+from rich.table import Table
+
+from teachfit.cli.common import console, guarded
+from teachfit.errors import TeachfitError
+
+TABLES = ("1", "2", "ablation", "3", "all")
+_COLS = ("method", "ours [95 % CI]", "paper [95 % CI]", "median time", "plan", "length", "E")
+
+
+def _rate(s: int, n: int, lo: float, hi: float) -> str:
+    return f"{s}/{n} = {100 * s / n:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]"
+
+
+def _cells(row: object) -> list[str]:
+    from teachfit.metrics.stats import wilson_interval
+
+    ours = row.ours  # type: ignore[attr-defined]
+    paper = row.paper  # type: ignore[attr-defined]
+    p = "n/a" if paper is None else _rate(*paper, *wilson_interval(*paper))
+    t = "n/a" if ours.median_time != ours.median_time else f"{ours.median_time:.1f} s"
+    plan = f"{row.plan_ms:.0f} ms"  # type: ignore[attr-defined]
+    if getattr(row, "paper_cpu_s", None) is not None:
+        plan += f" (paper {row.paper_cpu_s:.1f} s)"  # type: ignore[attr-defined]
+    return [
+        row.method,  # type: ignore[attr-defined]
+        _rate(ours.successes, ours.trials, ours.low, ours.high),
+        p,
+        t,
+        plan,
+        f"{row.length:.2f} m",  # type: ignore[attr-defined]
+        f"{row.ergodic:.4f}",  # type: ignore[attr-defined]
+    ]
+
+
+def _emit(title: str, rows: Sequence[object], markdown: Path | None) -> None:
+    table = Table(title=title)
+    for col in _COLS:
+        table.add_column(col, justify="right")
+    for r in rows:
+        table.add_row(*_cells(r))
+    console.print(table)
+    if markdown is not None:
+        lines = [f"\n**{title}**\n", "| " + " | ".join(_COLS) + " |", "|" + " --- |" * len(_COLS)]
+        lines += ["| " + " | ".join(_cells(r)) + " |" for r in rows]
+        with markdown.open("a", encoding="utf-8") as fh:
+            fh.write("\n".join(lines) + "\n")
+
+
+@guarded
+def bench_search(
+    table: Annotated[str, typer.Option(help="paper table: 1, 2, ablation, 3 or all")] = "1",
+    seed: int = 0,
+    starts: Annotated[int | None, typer.Option(help="starts (paper: 30 / 15)")] = None,
+    points: Annotated[int | None, typer.Option(help="TSHIX points (paper: 300 / 600)")] = None,
+    trajectories: Annotated[int, typer.Option(help="Table II trajectories per N")] = 20,
+    workers: Annotated[int | None, typer.Option(help="processes (default: all cores)")] = None,
+    markdown: Annotated[Path | None, typer.Option(help="append the tables as markdown")] = None,
+) -> None:
+    """Seed A's search experiments in simulation, beside the paper's numbers.
+
+    Success rates carry a Wilson 95 % interval; ``plan`` is the median trajectory-planning wall
+    time, ``length`` the mean planned path length (x, y), ``E`` the mean ergodic metric.
+    """
+    from teachfit.bench import search as bs
+
+    if table not in TABLES:
+        raise TeachfitError(f"unknown table {table!r}; available: {list(TABLES)}")
+    todo = TABLES[:-1] if table == "all" else (table,)
+    with Progress(console=console, transient=True) as bar:
+        if "1" in todo:
+            n = starts or 30
+            job = bar.add_task("Table I: TSHIX (QMC, i.i.d.) and ergodic", total=3 * n)
+            rows = bs.table1(
+                seed, n, points or 300, workers=workers, progress=lambda: bar.advance(job)
+            )
+            _emit(
+                f"Table I (peg2d, 0.5 mm clearance, 1 demo, {n} starts, seed {seed})",
+                rows,
+                markdown,
+            )
+        if "2" in todo or "ablation" in todo:
+            sizes = (100, 200, 300, 400, 500) if "2" in todo else ()
+            abl = (100, 200, 400) if "ablation" in todo else ()
+            job = bar.add_task("Table II / ablation", total=(len(sizes) + len(abl)) * trajectories)
+            rows2, rows_a = bs.table2(
+                seed, sizes, trajectories, abl, workers=workers, progress=lambda: bar.advance(job)
+            )
+            if rows2:
+                _emit(
+                    f"Table II (peg2d, one start, {trajectories} TSHIX runs per N, seed {seed})",
+                    rows2,
+                    markdown,
+                )
+            if rows_a:
+                _emit(
+                    f"Feed-forward ablation (same start, no feed-forward, seed {seed})",
+                    rows_a,
+                    markdown,
+                )
+        if "3" in todo:
+            n = starts or 15
+            job = bar.add_task("Table III: socket3d", total=5 * n)
+            rows = bs.table3(
+                seed, n, points or 600, workers=workers, progress=lambda: bar.advance(job)
+            )
+            _emit(
+                f"Table III (socket3d x-y-rz, {n} starts, {points or 600} points, seed {seed})",
+                rows,
+                markdown,
+            )
