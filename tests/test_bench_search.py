@@ -33,13 +33,14 @@ def test_table2_and_ablation_rows_line_up_with_the_paper():
     assert PAPER_TABLE2[300] == (17, 20) and PAPER_ABLATION[400] == (13, 20)
 
 
-def test_table3_runs_five_methods_on_socket3d():
+def test_table3_runs_six_methods_on_socket3d():
     rows = table3(seed=0, n_starts=1, n_points=20, workers=0)
     assert [r.method for r in rows] == [
         "random-walk",
         "spiral",
         "tshix-1demo",
         "tshix-2demo",
+        "tshix-2demo-diag",
         "ergodic-3d-2demo",
     ]
     assert rows[0].paper == PAPER_TABLE3["random-walk"] and rows[1].paper is None

@@ -110,3 +110,20 @@ def test_qmc_samples_cover_more_evenly_than_iid_draws():
         pts = e.sample(300, np.random.default_rng(1), qmc=qmc)
         gaps.append(cKDTree(pts).query(grid)[0].max())  # largest empty hole in the core
     assert gaps[0] < gaps[1]
+
+
+def test_diagonal_covariance_drops_correlations_and_keeps_variances():
+    from teachfit.models.exploration import fit_exploration
+
+    rng = np.random.default_rng(0)
+    t = rng.uniform(-1, 1, 500)
+    x = np.column_stack([0.01 * t, 0.01 * t + 0.001 * rng.standard_normal(500)])
+    full = fit_exploration(x, ("x", "y"))
+    diag = fit_exploration(x, ("x", "y"), covariance="diag")
+    assert abs(full.cov[0, 1]) > 0.9 * np.sqrt(full.cov[0, 0] * full.cov[1, 1])
+    assert diag.cov[0, 1] == 0.0
+    assert np.allclose(np.diag(diag.cov), np.diag(full.cov), rtol=1e-6)
+    two = fit_exploration(x, ("x", "y"), n_components=2, covariance="diag")
+    assert two.covs.shape == (2, 2, 2) and np.all(two.covs[:, 0, 1] == 0.0)
+    with pytest.raises(ModelError):
+        fit_exploration(x, ("x", "y"), covariance="spherical")

@@ -7,8 +7,9 @@
 - Table II: one start, 20 TSHIX trajectories per N = 100 ... 500: success and planning time.
 - Ablation: the same without the feed-forward, N = 100, 200, 400.
 - Table III: ``socket3d`` (x, y, rz), 15 starts in the socket's upper half, 600 points: random
-  walk, spiral, TSHIX from one and from two demonstrations (started at opposite ends) and the
-  3D ergodic trajectory (which the paper could not produce).
+  walk, spiral, TSHIX from one and from two demonstrations (started at opposite ends; with
+  seed A's full covariance and with per-DOF variances only) and the 3D ergodic trajectory
+  (which the paper could not produce).
 
 Every execution is a :class:`~teachfit.bench.search_jobs.SearchJob` run in worker processes.
 """
@@ -204,12 +205,14 @@ def table3(
     demos = _socket_demos(task, seed)
     one = SearchModel.fit(demos[:1], task.name)
     two = SearchModel.fit(demos, task.name)
+    two_diag = SearchModel.fit(demos, task.name, covariance="diag")
     starts = task.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
     seeds = [seed * 1000 + i for i in range(n_starts)]
     t1 = _jobs("socket3d", {}, one, starts, "tshix", n_points, seeds)
     t2 = _jobs("socket3d", {}, two, starts, "tshix", n_points, seeds)
-    res = run_jobs(t1 + t2, workers, progress)
-    r1, r2 = res[:n_starts], res[n_starts:]
+    t2d = _jobs("socket3d", {}, two_diag, starts, "tshix", n_points, seeds)
+    res = run_jobs(t1 + t2 + t2d, workers, progress)
+    r1, r2, r2d = res[:n_starts], res[n_starts : 2 * n_starts], res[2 * n_starts :]
     length = float(np.mean([r.weighted_length for r in r2]))
     xy = float(np.mean([r.path_length for r in r2]))
     steps = max(1, int(xy / 0.003))  # random-walk moves average 3 mm: equal x-y path length
@@ -225,5 +228,6 @@ def table3(
         _row("spiral", sp, None),
         _row("tshix-1demo", r1, PAPER_TABLE3["tshix-1demo"]),
         _row("tshix-2demo", r2, PAPER_TABLE3["tshix-2demo"]),
+        _row("tshix-2demo-diag", r2d, None),
         _row("ergodic-3d-2demo", er, None),
     ]

@@ -109,7 +109,7 @@ def bench_search(
                 )
         if "3" in todo:
             n = starts or 15
-            job = bar.add_task("Table III: socket3d", total=5 * n)
+            job = bar.add_task("Table III: socket3d", total=6 * n)
             rows = bs.table3(
                 seed, n, points or 600, workers=workers, progress=lambda: bar.advance(job)
             )

@@ -30,7 +30,7 @@ def record(
     n: Annotated[int, typer.Option("-n", help="demonstrations to keep")] = 3,
     seed: Annotated[int, typer.Option(help="random seed")] = 0,
     out: Annotated[Path, typer.Option(help="HDF5 file to write")] = Path("demos.h5"),
-    pattern: Annotated[str, typer.Option(help=f"search pattern: {', '.join(PATTERNS)}")] = "spiral",
+    pattern: Annotated[str, typer.Option(help=f"search pattern: {', '.join(PATTERNS)}")] = "sweep",
     append: Annotated[bool, typer.Option(help="append to an existing file")] = False,
     overwrite: Annotated[bool, typer.Option(help="replace an existing file")] = False,
 ) -> None:

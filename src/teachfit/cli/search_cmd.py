@@ -21,6 +21,9 @@ def learn_search(
     demos: Annotated[Path, typer.Argument(help="HDF5 demonstrations of one task")],
     out: Annotated[Path, typer.Option(help="model file to write (JSON)")] = Path("search.model"),
     components: Annotated[str, typer.Option(help="GMM components: a number or 'bic'")] = "1",
+    covariance: Annotated[
+        str, typer.Option(help="p_e covariance: 'full' (seed A) or 'diag' (per-DOF variances)")
+    ] = "full",
     seed: int = 0,
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
@@ -32,7 +35,13 @@ def learn_search(
     if len(tasks) != 1:
         raise TeachfitError(f"{demos} mixes tasks {sorted(tasks)}; learn one task at a time")
     n_comp: int | str = components if components == "bic" else int(components)
-    model = SearchModel.fit(demo_list, tasks.pop(), n_components=n_comp, seed=seed)
+    model = SearchModel.fit(
+        demo_list,
+        tasks.pop(),
+        n_components=n_comp,
+        seed=seed,
+        covariance=covariance,  # type: ignore[arg-type]
+    )
     model.save(out)
     e = model.exploration
     console.print(

@@ -53,6 +53,7 @@ def fit_regularised_gmm(
     max_components: int = 4,
     rel_floor: float = 0.05,
     seed: int = 0,
+    covariance: Literal["full", "diag"] = "full",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fit a regularised Gaussian mixture; returns ``(weights (K,), means (K,D), covs (K,D,D))``.
 
@@ -60,8 +61,12 @@ def fit_regularised_gmm(
     ``scale_d = max(σ_d, ε_d)`` and scikit-learn's ``reg_covar = ρ²``; the covariances are mapped
     back and ``diag(ε_d²)`` is added. With ``n_components="bic"`` K = 1..``max_components``
     (at most N // (D + 1)) are fitted and the lowest BIC wins. K = 1 is the closed-form
-    maximum-likelihood estimate (mean, biased covariance).
+    maximum-likelihood estimate (mean, biased covariance). ``covariance="diag"`` keeps only
+    the per-DOF variances: with very few demonstrations the cross-correlations mostly record
+    where they happened to start, e.g. x against rz for two demos from opposite corners.
     """
+    if covariance not in ("full", "diag"):
+        raise ModelError(f"covariance must be 'full' or 'diag', got {covariance!r}")
     x = _check_data(x, "fit")
     n, d = x.shape
     abs_floor = np.broadcast_to(np.asarray(abs_floor, dtype=float), (d,))
@@ -81,21 +86,27 @@ def fit_regularised_gmm(
         if k == 1:
             w = np.ones(1)
             mu = z.mean(axis=0, keepdims=True)
-            cov = (np.cov(z.T, bias=True).reshape(d, d) + rel_floor**2 * np.eye(d))[None]
+            cov = np.cov(z.T, bias=True).reshape(d, d)
+            if covariance == "diag":
+                cov = np.diag(np.diag(cov))
+            cov = (cov + rel_floor**2 * np.eye(d))[None]
             if len(candidates) == 1:
                 best = (0.0, w, mu, cov)
                 break
             logl = _mixture_logpdf(z, w, mu, cov).sum()
-            bic = -2.0 * logl + (d + d * (d + 1) / 2) * np.log(n)
+            n_cov = d if covariance == "diag" else d * (d + 1) / 2
+            bic = -2.0 * logl + (d + n_cov) * np.log(n)
         else:
             gm = GaussianMixture(
                 n_components=k,
-                covariance_type="full",
+                covariance_type=covariance,
                 reg_covar=rel_floor**2,
                 random_state=seed,
                 n_init=1,
             ).fit(z)
             w, mu, cov, bic = gm.weights_, gm.means_, gm.covariances_, gm.bic(z)
+            if covariance == "diag":
+                cov = np.stack([np.diag(c) for c in cov])
         if best is None or bic < best[0]:
             best = (bic, w, mu, cov)
     assert best is not None
@@ -269,6 +280,7 @@ def fit_exploration(
     rel_floor: float = 0.05,
     abs_floor: Sequence[float] | None = None,
     seed: int = 0,
+    covariance: Literal["full", "diag"] = "full",
 ) -> ExplorationDistribution:
     """Fit p_e(s) to search states.
 
@@ -285,6 +297,8 @@ def fit_exploration(
         Regularisation (see module docstring); ``abs_floor`` defaults to :data:`ABS_FLOOR`.
     seed : int
         Seed of the EM initialisation (K > 1).
+    covariance : {"full", "diag"}
+        Full maximum-likelihood covariances (seed A), or per-DOF variances only.
     """
     dims = tuple(dims)
     x = _check_data(states, "exploration")
@@ -298,5 +312,6 @@ def fit_exploration(
         max_components=max_components,
         rel_floor=rel_floor,
         seed=seed,
+        covariance=covariance,
     )
     return ExplorationDistribution(dims, w, mu, cov)

@@ -95,11 +95,13 @@ class SearchModel:
         rate_hz: float | None = None,
         rel_floor: float = 0.05,
         seed: int = 0,
+        covariance: Literal["full", "diag"] = "full",
     ) -> SearchModel:
         """Learn p_e and the dynamics from demonstrations (see :func:`search_data`).
 
-        ``dims`` defaults to the task's search DOFs. Raises ModelError for too few or
-        degenerate samples, or a teacher who never moved.
+        ``dims`` defaults to the task's search DOFs; ``covariance`` is p_e's covariance type
+        (:func:`fit_exploration`). Raises ModelError for too few or degenerate samples, or a
+        teacher who never moved.
         """
         dims = dims_for_task(task) if dims is None else validate_dims(dims)
         data = search_data(demos, dims, rate_hz=rate_hz)
@@ -110,6 +112,7 @@ class SearchModel:
             max_components=max_components,
             rel_floor=rel_floor,
             seed=seed,
+            covariance=covariance,
         )
         dyn = None
         if data.actions is not None:
