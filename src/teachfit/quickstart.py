@@ -2,9 +2,11 @@
 
 Records demonstrations with the simulated blind teacher, then from new start poses (seed A's
 Table I protocol: a 3 cm circle halfway between the demonstration's start and the hole)
-compares two executions through the impedance controller: replaying the demonstration, and
-the learned TSHIX search (exploration distribution + GMR feed-forward from that one
-demonstration). Reports successes and time to insertion.
+compares three executions through the impedance controller: replaying the demonstration, the
+learned TSHIX search (exploration distribution + GMR feed-forward from that one demonstration)
+and a random-walk search of the same path length (Abu-Dakka et al.'s baseline). Reports
+successes and time to insertion, and draws the demonstrations, one TSHIX plan (samples ->
+itinerary -> smoothed trajectory) and the executed paths.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from teachfit.models.search_model import SearchModel
 from teachfit.pose import Pose
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.registry import get_task
+from teachfit.viz import search_figures
 from teachfit.viz.figures import plot_demonstrations, plot_executions
 
 
@@ -34,6 +37,7 @@ from teachfit.viz.figures import plot_demonstrations, plot_executions
 class QuickstartResult:
     replay: SuccessSummary
     search: SuccessSummary
+    random_walk: SuccessSummary
     outcomes: dict[str, list[Outcome]]
     files: dict[str, Path]
 
@@ -68,22 +72,31 @@ def run_quickstart(
     console.print(
         f"2. learned the exploration distribution and dynamics from {demo.name} -> {model_file}"
     )
-    outcomes: dict[str, list[Outcome]] = {"replay": [], "tshix": []}
-    paths: dict[str, list] = {"replay": [], "tshix": []}
+    outcomes: dict[str, list[Outcome]] = {"replay": [], "tshix": [], "random-walk": []}
+    paths: dict[str, list] = {k: [] for k in outcomes}
+    fig_plan = out / "tshix_plan.png"
     with Progress(console=console, transient=True) as bar:
-        job = bar.add_task("executing from new starts", total=2 * len(starts))
+        job = bar.add_task("executing from new starts", total=3 * len(starts))
         for i, start in enumerate(starts):
             outcome, log = run_trajectory(robot, task, replay_trajectory(demo, start), start)
             outcomes["replay"].append(outcome)
             paths["replay"].append((log.pos, outcome.success))
             bar.advance(job)
             traj = plan_search(model, "tshix", 300, np.random.default_rng(seed * 1000 + i))
-            run = run_search(robot, task, model, start, traj)
-            outcomes["tshix"].append(run.outcome)
-            paths["tshix"].append((run.log.pos, run.outcome.success))
-            bar.advance(job)
+            if i == 0:
+                search_figures.save(search_figures.tshix_stages(traj, model.exploration), fig_plan)
+            steps = max(1, int(traj.path_length() / 0.003))  # random-walk moves average 3 mm
+            walk = plan_search(model, "random-walk", steps, np.random.default_rng(seed + i))
+            for key, tr in (("tshix", traj), ("random-walk", walk)):
+                run = run_search(robot, task, model, start, tr)
+                outcomes[key].append(run.outcome)
+                paths[key].append((run.log.pos, run.outcome.success))
+                bar.advance(job)
     fig_replay = plot_executions(paths["replay"], out / "replay.png", task, title="demo replay")
     fig_search = plot_executions(paths["tshix"], out / "tshix.png", task, title="TSHIX search")
+    fig_walk = plot_executions(
+        paths["random-walk"], out / "random_walk.png", task, title="random-walk search"
+    )
     summaries = {
         k: summarize([o.success for o in v], [o.time_to_insertion for o in v])
         for k, v in outcomes.items()
@@ -91,7 +104,11 @@ def run_quickstart(
     table = Table(title=f"3. execution from {len(starts)} new starts (Table I protocol)")
     for col in ("execution", "starts", "successes", "rate [95 % CI]", "median time"):
         table.add_column(col, justify="right")
-    labels = {"replay": "replay of the demo", "tshix": "TSHIX search, 300 points"}
+    labels = {
+        "replay": "replay of the demo",
+        "tshix": "TSHIX search, 300 points",
+        "random-walk": "random walk, same length",
+    }
     for key, summary in summaries.items():
         t_med = "n/a" if np.isnan(summary.median_time) else f"{summary.median_time:.2f} s"
         table.add_row(
@@ -106,15 +123,18 @@ def run_quickstart(
         "demonstrations": demo_file,
         "demo figure": fig_demos,
         "model": model_file,
+        "TSHIX plan figure": fig_plan,
         "replay figure": fig_replay,
         "search figure": fig_search,
+        "random-walk figure": fig_walk,
     }
     for label, path in files.items():
         console.print(f"   {label}: {path}")
-    rep, srch = summaries["replay"], summaries["tshix"]
+    rep, srch, walk_s = summaries["replay"], summaries["tshix"], summaries["random-walk"]
     console.print(
-        f"[bold]What this showed:[/] from {len(starts)} new starts, replaying the blind "
-        f"teacher's demonstration inserted the peg {rep.successes} times; the TSHIX search "
-        f"learned from that same demonstration inserted it {srch.successes} times."
+        f"[bold]What this showed:[/] from {len(starts)} new starts, the TSHIX search learned "
+        f"from one blind demonstration inserted the peg {srch.successes} times, replaying that "
+        f"demonstration {rep.successes} times and a blind random walk of the same length "
+        f"{walk_s.successes} times. Seed A's Table I with 30 starts: teachfit bench search."
     )
-    return QuickstartResult(summaries["replay"], summaries["tshix"], outcomes, files)
+    return QuickstartResult(rep, srch, walk_s, outcomes, files)
