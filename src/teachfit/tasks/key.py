@@ -29,12 +29,11 @@ import numpy as np
 
 from teachfit.pose import Pose
 from teachfit.tasks.base import ContactParams
-from teachfit.tasks.mjcf import SceneXml, fmt
+from teachfit.tasks.mjcf import SceneXml, contact_attrs, fmt
 from teachfit.tasks.prism_geometry import beyond_edge_block, chamfered_prism, rectangle
 from teachfit.tasks.skill_protocol import (
     SkillProtocolParams,
     SkillTask,
-    contact_attrs,
     doc_field,
 )
 

@@ -9,8 +9,12 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from teachfit.tasks.base import ContactParams
 
 
 def fmt(values: np.ndarray | list[float] | tuple[float, ...] | float) -> str:
@@ -148,3 +152,15 @@ class SceneXml:
     def to_string(self) -> str:
         ET.indent(self.root)
         return ET.tostring(self.root, encoding="unicode")
+
+
+def contact_attrs(contact: ContactParams) -> dict[str, str]:
+    """MJCF geom attributes of a contact model: friction (sliding, torsional, rolling), solref,
+    solimp, margin, and ``condim=4`` (torsional friction, so a pressed part cannot spin freely)."""
+    return {
+        "friction": fmt([contact.friction, 0.005, 0.0001]),
+        "solref": fmt(contact.solref),
+        "solimp": fmt(contact.solimp),
+        "margin": fmt(contact.margin),
+        "condim": "4",
+    }

@@ -27,11 +27,10 @@ import numpy as np
 
 from teachfit.pose import Pose
 from teachfit.tasks.base import ContactParams
-from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, fmt, ring_sector
+from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
 from teachfit.tasks.skill_protocol import (
     SkillProtocolParams,
     SkillTask,
-    contact_attrs,
     doc_field,
 )
 

@@ -17,7 +17,7 @@ import numpy as np
 from teachfit.errors import TaskError
 from teachfit.pose import Pose
 from teachfit.tasks.base import ContactParams, Task
-from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, fmt, ring_sector
+from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
 
 
 def _doc(text: str, default: float | int) -> float | int:
@@ -122,7 +122,7 @@ class Peg2D(Task):
             ring_sector(hole_r, outer_r, z_bot, p.block_height, p.n_sectors, p.hole_chamfer),
         )
         block = ET.SubElement(scene.worldbody, "body", name="fixture")
-        geom_kw = _contact_attrs(contact)
+        geom_kw = contact_attrs(contact)
         ET.SubElement(
             block,
             "geom",
@@ -159,7 +159,7 @@ class Peg2D(Task):
             mesh="peg",
             material="tool",
             mass="0.1",
-            **_contact_attrs(contact),
+            **contact_attrs(contact),
         )
 
     def search_pose(self, state: np.ndarray, search2world: Pose, height: float = 0.0) -> Pose:
@@ -203,13 +203,3 @@ class Peg2D(Task):
             self.contact_pose(centre + ri * np.array([np.cos(ai), np.sin(ai)]))
             for ri, ai in zip(r, a, strict=True)
         ]
-
-
-def _contact_attrs(contact: ContactParams) -> dict[str, str]:
-    return {
-        "friction": fmt([contact.friction, 0.005, 0.0001]),
-        "solref": fmt(contact.solref),
-        "solimp": fmt(contact.solimp),
-        "margin": fmt(contact.margin),
-        "condim": "4",
-    }

@@ -28,7 +28,7 @@ import numpy as np
 
 from teachfit.pose import Pose
 from teachfit.tasks.base import ContactParams
-from teachfit.tasks.mjcf import SceneXml, fmt
+from teachfit.tasks.mjcf import SceneXml, contact_attrs, fmt
 from teachfit.tasks.prism_geometry import (
     beyond_edge_block,
     chamfered_prism,
@@ -39,7 +39,6 @@ from teachfit.tasks.prism_geometry import (
 from teachfit.tasks.skill_protocol import (
     SkillProtocolParams,
     SkillTask,
-    contact_attrs,
     doc_field,
 )
 

@@ -26,7 +26,6 @@ import numpy as np
 from teachfit.errors import TaskError
 from teachfit.pose import Pose
 from teachfit.tasks.base import ContactParams, Task
-from teachfit.tasks.mjcf import fmt
 
 
 def doc_field(text: str, default: float | int) -> Any:
@@ -66,17 +65,6 @@ class SkillProtocolParams:
         """Raise :class:`TaskError` with ``message`` (prefixed by the task name) unless true."""
         if not condition:
             raise TaskError(f"{self.task_name}: {message}")
-
-
-def contact_attrs(contact: ContactParams) -> dict[str, str]:
-    """MJCF geom attributes of a contact model (the same as ``peg2d`` and ``socket3d`` use)."""
-    return {
-        "friction": fmt([contact.friction, 0.005, 0.0001]),
-        "solref": fmt(contact.solref),
-        "solimp": fmt(contact.solimp),
-        "margin": fmt(contact.margin),
-        "condim": "4",
-    }
 
 
 _SHARED = {f.name for f in dataclasses.fields(SkillProtocolParams)}

@@ -36,7 +36,7 @@ import numpy as np
 from teachfit.errors import TaskError
 from teachfit.pose import Pose
 from teachfit.tasks.base import ContactParams, Task
-from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, fmt, ring_sector
+from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
 from teachfit.tasks.socket_geometry import disc_segment, rounded_pin, valley_wedge
 
 
@@ -214,7 +214,7 @@ class Socket3D(Task):
         z_bot = z_entry - p.hole_depth
         r_in = p.recess_diameter / 2
         r_out = r_in + p.wall_thickness
-        kw = _contact_attrs(contact)
+        kw = contact_attrs(contact)
         block = ET.SubElement(scene.worldbody, "body", name="fixture")
         ET.SubElement(
             block, "geom", name="socket_base", type="cylinder", size=fmt([r_out, z_bot / 2]),
@@ -254,7 +254,7 @@ class Socket3D(Task):
 
     def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
         p = self.params
-        kw = _contact_attrs(contact)
+        kw = contact_attrs(contact)
         scene.add_mesh("pin", rounded_pin(p.pin_diameter / 2, p.pin_length, p.pin_tip_radius))
         for name, x in (("pin_small", -p.pin_spacing / 2), ("pin_large", p.pin_spacing / 2)):
             ET.SubElement(
@@ -351,13 +351,3 @@ class Socket3D(Task):
             self.contact_pose(ri * np.array([np.cos(ai), np.sin(ai)]), zi)
             for ri, ai, zi in zip(r, a, rz, strict=True)
         ]
-
-
-def _contact_attrs(contact: ContactParams) -> dict[str, str]:
-    return {
-        "friction": fmt([contact.friction, 0.005, 0.0001]),
-        "solref": fmt(contact.solref),
-        "solimp": fmt(contact.solimp),
-        "margin": fmt(contact.margin),
-        "condim": "4",
-    }
