@@ -70,3 +70,18 @@ def test_methods_and_bad_input(peg_model):
         plan_search(model, "tshix", 0, rng)
     with pytest.raises(TeachfitError, match="unknown search method"):
         plan_search(model, "telepathy", 10, rng)
+
+
+def test_passes_append_resampled_tshix_passes(peg_model):
+    _, _, model = peg_model
+    one = plan_search(model, "tshix", 40, np.random.default_rng(5))
+    three = plan_search(model, "tshix", 40, np.random.default_rng(5), passes=3)
+    assert three.meta["passes"] == 3 and three.samples.shape[0] == 120
+    assert np.allclose(three.states[: one.states.shape[0]], one.states)  # the first pass is kept
+    assert three.duration > 2.5 * one.duration
+    # later passes draw new samples, they do not repeat the first
+    assert not np.allclose(three.samples[40:80], three.samples[:40])
+    with pytest.raises(TeachfitError, match="passes"):
+        plan_search(model, "ergodic", 40, np.random.default_rng(5), passes=2)
+    with pytest.raises(TeachfitError, match="passes"):
+        plan_search(model, "tshix", 40, np.random.default_rng(5), passes=0)

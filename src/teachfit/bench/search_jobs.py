@@ -32,7 +32,8 @@ class SearchJob:
     """One execution: ``method`` with ``n_points`` from ``start`` (world ``x y z qw qx qy qz``).
 
     ``length`` fixes an ergodic trajectory's path length (m); ``traj_seed`` seeds TSHIX and the
-    random walk; ``sampling`` is TSHIX's sampler (``"qmc"`` or ``"random"``).
+    random walk; ``sampling`` is TSHIX's sampler (``"qmc"`` or ``"random"``); ``passes`` its
+    number of re-sampled passes.
     """
 
     task: str
@@ -46,6 +47,7 @@ class SearchJob:
     length: float | None = None
     sampling: str = "qmc"
     robot_seed: int = 0
+    passes: int = 1
 
 
 @dataclass(frozen=True)
@@ -90,7 +92,13 @@ def run_job(job: SearchJob) -> JobResult:
     rng = np.random.default_rng(job.traj_seed)
     t0 = time.perf_counter()
     traj = plan_search(
-        model, job.method, job.n_points, rng, length=job.length, sampling=job.sampling
+        model,
+        job.method,
+        job.n_points,
+        rng,
+        length=job.length,
+        sampling=job.sampling,
+        passes=job.passes,
     )
     plan_s = time.perf_counter() - t0
     start = Pose(np.array(job.start[:3]), np.array(job.start[3:]))

@@ -103,6 +103,9 @@ def run(
     starts: Annotated[int, typer.Option(help="number of start poses")] = 30,
     protocol: Annotated[str, typer.Option(help="start protocol of the task")] = "table1",
     feedforward: Annotated[bool, typer.Option(help="superpose the GMR feed-forward")] = True,
+    passes: Annotated[
+        int, typer.Option(help="TSHIX passes: re-sample and continue after a failed pass")
+    ] = 1,
     demo: Annotated[
         str | None, typer.Option(help="demonstration whose start anchors the protocol (f.h5:0)")
     ] = None,
@@ -133,11 +136,15 @@ def run(
     start_poses = the_task.protocol_starts(protocol, starts, rng, demo_start)
     robot = FloatingToolRobot(the_task, seed=seed)
     fixed = plan_search(model, method, n, rng) if method == "ergodic" else None
+    if passes > 1 and method != "tshix":
+        raise TeachfitError(f"--passes needs --method tshix, not {method}")
     outcomes, paths = [], []
     with Progress(console=console, transient=True) as bar:
         job = bar.add_task(f"{method} from {starts} starts", total=starts)
         for i, start in enumerate(start_poses):
-            traj = fixed or plan_search(model, method, n, np.random.default_rng(seed * 1000 + i))
+            traj = fixed or plan_search(
+                model, method, n, np.random.default_rng(seed * 1000 + i), passes=passes
+            )
             r = run_search(robot, the_task, model, start, traj, feedforward=feedforward)
             outcomes.append(r.outcome)
             paths.append((r.log.pos, r.outcome.success))

@@ -75,6 +75,7 @@ def plan_search(
     *,
     length: float | None = None,
     sampling: str = "qmc",
+    passes: int = 1,
 ) -> SearchTrajectory:
     """A search trajectory in the search frame by ``method`` (see :data:`METHODS`).
 
@@ -82,12 +83,22 @@ def plan_search(
     ``length`` (m) or as a TSHIX pass through ``n_points`` samples. ``sampling`` is TSHIX's
     sampler (``"qmc"`` or seed A's i.i.d. ``"random"``). The baselines span the exploration
     distribution's 2-sigma radius (and, for rz, its 2-sigma rz range).
+
+    ``passes > 1`` (TSHIX only) appends re-sampled passes of ``n_points`` fresh samples, each
+    starting where the previous one ends (seed A's re-sampling): the runner stops at insertion,
+    so a pass is only executed when every pass before it failed.
     """
     if n_points <= 0:
         raise TeachfitError(f"number of points must be positive, got {n_points}")
+    if passes < 1 or (passes > 1 and method != "tshix"):
+        raise TeachfitError(f"passes must be 1, or >= 1 for tshix; got {passes} for {method}")
     dims = model.dims
     if method == "tshix":
-        return TshixPlanner.from_model(model, sampling=sampling).plan(n_points, rng)
+        planner = TshixPlanner.from_model(model, sampling=sampling)
+        traj = planner.plan(n_points, rng)
+        for _ in range(passes - 1):
+            traj = planner.extend(traj, n_points, rng)
+        return traj
     if method == "ergodic":
         if length is None:
             planner = TshixPlanner.from_model(model, sampling=sampling)
