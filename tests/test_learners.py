@@ -57,10 +57,11 @@ def test_each_learner_improves_within_a_small_budget(method: str) -> None:
         assert best < 0.03
 
 
-def test_gp_bayesian_optimisation_when_torch_is_there() -> None:
-    pytest.importorskip("torch")
-    learner = make_learner("bo", SPACE, seed=1, options={"n_startup": 5})
-    assert min(drive(learner, 20)) < 0.02
+def test_gp_bayesian_optimisation_is_the_default_and_learns() -> None:
+    learner = make_learner("bo", SPACE, seed=1, options={"n_startup": 4})
+    assert type(learner._study.sampler).__name__ == "GPSampler"
+    costs = drive(learner, 12)  # 8 GP-guided trials after 4 random ones
+    assert min(costs[4:]) < 0.02 < min(costs[:4])
 
 
 @pytest.mark.parametrize("method", ["cmaes", "pso", "lhs"])

@@ -112,10 +112,10 @@ def test_a_study_from_another_task_or_skill_is_an_error(tmp_path: Path) -> None:
         open_study(db, resume=False)
 
 
-def test_failures_are_stored_at_the_penalty_and_bo_resumes(tmp_path: Path) -> None:
+def test_failures_are_stored_at_the_penalty_and_gp_bo_resumes(tmp_path: Path) -> None:
     db = tmp_path / "bo.db"
     kw = dict(task="puzzle", skill="peg-in-hole", space=SPACE, method="bo", penalty=700.0)
-    opts = {"sampler": "tpe", "n_startup": 4}
+    opts = {"n_startup": 4}  # the GP sampler (the default) after 4 random trials
     run_study(Study(db, options=opts, **kw), rosenbrock, 6, workers=0)  # type: ignore[arg-type]
     study = Study(db, options=opts, **kw)  # type: ignore[arg-type]
     run_study(study, lambda p: float("nan"), 8, workers=0)

@@ -8,7 +8,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import typer  # noqa: E402
 
-from teachfit.cli import capture_cmd, plan_cmd, skill_cmd  # noqa: E402
+from teachfit.cli import capture_cmd, learn_cmd, plan_cmd, skill_cmd  # noqa: E402
 from teachfit.cli.bench_search_cmd import bench_search  # noqa: E402
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
@@ -25,6 +25,8 @@ app.add_typer(demo_app, name="demo")
 app.add_typer(bench_app, name="bench")
 learn_app = typer.Typer(help="Learn models from demonstrations or trials.", no_args_is_help=True)
 learn_app.command("search")(learn_search)
+learn_app.command("skill")(learn_cmd.learn_skill)
+bench_app.command("learning")(learn_cmd.bench_learning)
 app.add_typer(learn_app, name="learn")
 app.add_typer(search_app, name="search")
 app.add_typer(plan_cmd.parts_app, name="parts")

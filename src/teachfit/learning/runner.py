@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from teachfit.learning.base import Candidate, LearningError, TrialResult
-from teachfit.learning.study import Study
+from teachfit.learning.study import Study, TrialRecord
 
 #: what an objective may return: a cost, ``(cost, feasible)`` or a TrialResult
 Objective = Callable[[Mapping[str, float]], "TrialResult | float | tuple[float, bool]"]
@@ -115,6 +115,7 @@ def run_study(
     workers: int | None = None,
     handle_signals: bool = True,
     mp_context: str | None = None,
+    on_trial: Callable[[TrialRecord], None] | None = None,
 ) -> RunReport:
     """Run trials of ``study`` until it holds ``budget`` finished trials (restored included).
 
@@ -122,6 +123,7 @@ def run_study(
     feasible)`` or a :class:`TrialResult`; with workers it must be picklable (a module-level
     function or a :func:`functools.partial` of one). ``workers=None``: one per core; ``0``: in
     this process (no crash isolation). Stops early if the learner has nothing left to ask.
+    ``on_trial(record)`` is called in this process after each trial is stored (progress).
     """
     if budget < 0:
         raise LearningError(f"budget must be >= 0, got {budget}")
@@ -136,6 +138,8 @@ def run_study(
         nonlocal failed
         rec = study.tell(cand, result, error)
         failed += rec.outcome == "error"
+        if on_trial is not None:
+            on_trial(rec)
 
     with _Signals(handle_signals) as sig:
         if n_workers == 0:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +79,17 @@ def storage_url(storage: str | Path) -> str:
     return f"sqlite:///{path}"
 
 
+def stored_tags(storage: str | Path, name: str = "teachfit") -> dict[str, Any] | None:
+    """The tags of study ``name`` in ``storage`` (task, skill, method, options, ...), or
+    ``None`` if there is no such study."""
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    try:
+        study = optuna.load_study(study_name=name, storage=storage_url(storage))
+    except KeyError:
+        return None
+    return dict(study.user_attrs)
+
+
 @dataclass(frozen=True)
 class TrialRecord:
     """A stored finished trial; ``number`` counts finished trials from 0 in finishing order."""
@@ -90,6 +101,7 @@ class TrialRecord:
     feasible: bool
     outcome: str
     error: str
+    info: dict[str, float] = field(default_factory=dict)
 
 
 class Study:
@@ -111,6 +123,8 @@ class Study:
         Study name within the storage.
     resume : bool
         Allow opening a study that already has trials (else :class:`LearningError`).
+    context : mapping or None
+        More JSON-able tags that must match on resume (e.g. controller, set-up seed).
     """
 
     def __init__(
@@ -126,6 +140,7 @@ class Study:
         penalty: float = 1000.0,
         name: str = "teachfit",
         resume: bool = True,
+        context: Mapping[str, Any] | None = None,
     ) -> None:
         if not math.isfinite(penalty):
             raise LearningError(f"penalty must be finite, got {penalty}")
@@ -141,6 +156,8 @@ class Study:
             "space": space.to_json(),
             "penalty": self.penalty,
         }
+        if context:
+            tags["context"] = dict(context)
         self.tags = tags
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self.learner = make_learner(method, space, seed, options)
@@ -163,7 +180,7 @@ class Study:
         if finished and not resume:
             raise LearningError(
                 f"study {name!r} in {self.url} already has {len(finished)} trials: resume it "
-                "or choose another name"
+                "(--resume) or choose another study"
             )
         self.learner.restore(
             [
@@ -229,7 +246,9 @@ class Study:
         self._optuna.add_trial(frozen)  # committed before the learner hears of it
         self._n += 1
         self.learner.tell(candidate, cost, feasible)
-        return TrialRecord(self._n - 1, candidate.key, params, cost, feasible, outcome, error)
+        return TrialRecord(
+            self._n - 1, candidate.key, params, cost, feasible, outcome, error, info
+        )
 
     def trials(self) -> list[TrialRecord]:
         """All stored finished trials, in the order they finished."""
@@ -242,6 +261,7 @@ class Study:
                 bool(t.user_attrs["feasible"]),
                 str(t.user_attrs["outcome"]),
                 str(t.user_attrs["error"]),
+                {k: float(v) for k, v in (t.user_attrs.get("info") or {}).items()},
             )
             for i, t in enumerate(self._finished_trials())
         ]

@@ -1,0 +1,236 @@
+"""Seed B's learning experiments (Sec. V, Fig. 6) over tasks x methods x experiments.
+
+An *experiment* is one learning run of ``trials`` trials (each: one parameter set, ``n_starts``
+executions) with its own seed ``seed + e``: its own hole estimate, start poses, sensor noise
+and learner seed. Per task and method the bench reports, over experiments: the best cost
+(mean +- sd), the success rate of the best parameters (fraction of their executions that
+succeeded), trials until the first feasible one, the final insertion time (best feasible
+cost, s), the simulated robot time consumed until the first feasible trial, until the best
+one and in all (min; the paper: feasible after a few minutes, optimised in under 20 minutes
+on the real robot), and wall time and trials/s on this machine.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from teachfit.learning.base import LearningError
+from teachfit.learning.curves import Band, band, best_so_far, first_feasible
+from teachfit.learning.objective import SkillObjective
+from teachfit.learning.runner import run_study
+from teachfit.learning.study import METHODS, Study, TrialRecord
+
+__all__ = ["CellStats", "Experiment", "LearningBench", "method_options", "run_experiment",
+           "run_learning_bench", "speedup", "to_markdown"]
+
+
+def method_options(method: str, trials: int) -> dict[str, object]:
+    """Learner options the bench uses: LHS designs ``trials`` points, BO starts with
+    ``min(10, trials // 4)`` random trials (at least 2); CMA-ES and PSO keep their defaults."""
+    if method == "lhs":
+        return {"n": int(trials)}
+    if method == "bo":
+        return {"n_startup": max(2, min(10, trials // 4))}
+    return {}
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One finished learning run; per-trial arrays in finishing order, ``sim_s`` in s."""
+
+    task: str
+    method: str
+    seed: int
+    costs: tuple[float, ...]
+    feasible: tuple[bool, ...]
+    sim_s: tuple[float, ...]
+    success_rate: tuple[float, ...]
+    best_params: dict[str, float]
+    wall_s: float
+
+    @staticmethod
+    def from_records(task: str, method: str, seed: int, recs: Sequence[TrialRecord],
+                     wall_s: float) -> Experiment:
+        if not recs:
+            raise LearningError(f"{task}/{method} seed {seed}: no trial finished")
+        ok = [r for r in recs if r.feasible] or list(recs)
+        best = min(ok, key=lambda r: r.cost)
+        return Experiment(task, method, seed, tuple(r.cost for r in recs),
+                          tuple(r.feasible for r in recs),
+                          tuple(r.info.get("sim_s", 0.0) for r in recs),
+                          tuple(r.info.get("success_rate", 0.0) for r in recs),
+                          dict(best.params), wall_s)
+
+    @property
+    def best_index(self) -> int:
+        """0-based index of the best trial (feasible ones first)."""
+        c = np.where(np.asarray(self.feasible), np.asarray(self.costs), np.inf)
+        return int(np.argmin(c)) if np.isfinite(c).any() else int(np.argmin(self.costs))
+
+    @property
+    def first_feasible(self) -> int | None:
+        return first_feasible(self.feasible)
+
+    def sim_min_until(self, trial: int | None) -> float:
+        """Simulated robot minutes of trials 1..``trial`` (NaN for ``None``)."""
+        return math.nan if trial is None else float(sum(self.sim_s[:trial])) / 60.0
+
+
+@dataclass(frozen=True)
+class CellStats:
+    """One task x method over its experiments (costs and times in s, robot time in min)."""
+
+    task: str
+    method: str
+    n: int
+    best_cost_mean: float
+    best_cost_sd: float
+    best_success: float
+    first_feasible_mean: float
+    never_feasible: int
+    insertion_time: float
+    sim_feasible_min: float
+    sim_best_min: float
+    sim_total_min: float
+    wall_s: float
+    trials_per_s: float
+    curve: Band = field(repr=False)
+
+    @staticmethod
+    def of(exps: Sequence[Experiment]) -> CellStats:
+        best = np.array([e.costs[e.best_index] for e in exps])
+        ok = [e for e in exps if e.first_feasible is not None]
+        ins = [e.costs[e.best_index] for e in ok]
+        n_trials = sum(len(e.costs) for e in exps)
+        wall = float(np.mean([e.wall_s for e in exps]))
+        return CellStats(
+            exps[0].task, exps[0].method, len(exps), float(best.mean()),
+            float(best.std(ddof=1)) if len(exps) > 1 else 0.0,
+            float(np.mean([e.success_rate[e.best_index] for e in exps])),
+            float(np.mean([e.first_feasible for e in ok])) if ok else math.nan,
+            len(exps) - len(ok), float(np.mean(ins)) if ins else math.nan,
+            float(np.mean([e.sim_min_until(e.first_feasible) for e in ok])) if ok else math.nan,
+            float(np.mean([e.sim_min_until(e.best_index + 1) for e in exps])),
+            float(np.mean([e.sim_min_until(len(e.costs)) for e in exps])),
+            wall, n_trials / (wall * len(exps)) if wall > 0 else math.nan,
+            band([best_so_far(e.costs) for e in exps]))
+
+
+@dataclass(frozen=True)
+class LearningBench:
+    """The whole grid: cells in task-major order and every experiment."""
+
+    cells: tuple[CellStats, ...]
+    experiments: tuple[Experiment, ...]
+    trials: int
+    n_starts: int
+    workers: int
+    wall_s: float
+
+
+def run_experiment(
+    objective: SkillObjective, method: str, trials: int, *, workers: int | None = None,
+    storage: str | Path | None = None, on_trial: Callable[[TrialRecord], None] | None = None,
+    handle_signals: bool = True,
+) -> Experiment:
+    """One learning run of ``trials`` trials; the study goes to ``storage`` (default: a
+    temporary SQLite file, removed afterwards)."""
+    if method not in METHODS:
+        raise LearningError(f"unknown method {method!r}; known: {list(METHODS)}")
+    with tempfile.TemporaryDirectory(prefix="teachfit-bench-") as tmp:
+        db = storage or Path(tmp) / "study.db"
+        study = Study(db, task=objective.task, skill=objective.skill, space=objective.space,
+                      method=method, seed=objective.seed,
+                      options=method_options(method, trials), penalty=objective.penalty,
+                      resume=False, context=objective.context(),
+                      name=f"{objective.task}-{method}-{objective.seed}")
+        t0 = time.perf_counter()
+        run_study(study, objective, trials, workers=workers, on_trial=on_trial,
+                  handle_signals=handle_signals)
+        wall = time.perf_counter() - t0
+        return Experiment.from_records(objective.task, method, objective.seed, study.trials(),
+                                       wall)
+
+
+def run_learning_bench(
+    tasks: Sequence[str], methods: Sequence[str], experiments: int, trials: int, *,
+    workers: int | None = None, n_starts: int = 4, controller: str = "adaptive", seed: int = 0,
+    overrides: Mapping[str, float] | None = None,
+    on_trial: Callable[[str, TrialRecord], None] | None = None,
+) -> LearningBench:
+    """Every task x method x experiment; ``on_trial(label, record)`` reports progress."""
+    if experiments < 1 or trials < 1:
+        raise LearningError(f"experiments and trials must be >= 1, got {experiments}, {trials}")
+    bad = [m for m in methods if m not in METHODS]
+    if bad:
+        raise LearningError(f"unknown method(s) {bad}; known: {list(METHODS)}")
+    t0 = time.perf_counter()
+    cells, exps = [], []
+    ov = tuple(sorted((overrides or {}).items()))
+    for task in tasks:
+        for method in methods:
+            mine = []
+            for e in range(experiments):
+                obj = SkillObjective(task, controller=controller, seed=seed + e,
+                                     n_starts=n_starts, task_overrides=ov)
+                label = f"{task}/{method} #{e + 1}"
+                cb = None if on_trial is None else (lambda r, lb=label: on_trial(lb, r))
+                mine.append(run_experiment(obj, method, trials, workers=workers, on_trial=cb))
+            cells.append(CellStats.of(mine))
+            exps.extend(mine)
+    n_workers = workers if workers is not None else _cores()
+    return LearningBench(tuple(cells), tuple(exps), trials, n_starts, n_workers,
+                         time.perf_counter() - t0)
+
+
+def _cores() -> int:
+    import os
+
+    return os.cpu_count() or 1
+
+
+def speedup(task: str = "puzzle", method: str = "cmaes", trials: int = 24, workers: int = 2,
+            n_starts: int = 4, seed: int = 0, repeats: int = 2) -> tuple[float, float, float]:
+    """Wall time (s) of the same study with 1 and with ``workers`` workers, and the ratio.
+
+    The runs alternate (1, N, 1, N, ...) ``repeats`` times and each count keeps its fastest
+    run: on a machine shared with other work the minimum is the least disturbed estimate.
+    """
+    obj = SkillObjective(task, seed=seed, n_starts=n_starts)
+    t1 = tn = math.inf
+    for _ in range(max(1, repeats)):
+        t1 = min(t1, run_experiment(obj, method, trials, workers=1).wall_s)
+        tn = min(tn, run_experiment(obj, method, trials, workers=workers).wall_s)
+    return t1, tn, t1 / tn
+
+
+def _pm(mean: float, sd: float) -> str:
+    return f"{mean:.3f} ± {sd:.3f}"
+
+
+def _f(x: float, fmt: str = ".2f") -> str:
+    return "–" if math.isnan(x) else format(x, fmt)
+
+
+def to_markdown(bench: LearningBench) -> str:
+    """The grid as a markdown table (one row per task x method)."""
+    head = ("| task | method | best cost (s) | success of best | first feasible (trial) | "
+            "insertion time (s) | robot time to feasible / best / all (min) | wall (s) | "
+            "trials/s |\n|---|---|---|---|---|---|---|---|---|\n")
+    rows = []
+    for c in bench.cells:
+        never = f" ({c.never_feasible} never)" if c.never_feasible else ""
+        rows.append(
+            f"| {c.task} | {c.method} | {_pm(c.best_cost_mean, c.best_cost_sd)} | "
+            f"{100 * c.best_success:.0f} % | {_f(c.first_feasible_mean, '.1f')}{never} | "
+            f"{_f(c.insertion_time, '.3f')} | {_f(c.sim_feasible_min)} / "
+            f"{_f(c.sim_best_min)} / {_f(c.sim_total_min)} | {c.wall_s:.1f} | "
+            f"{c.trials_per_s:.2f} |")
+    return head + "\n".join(rows) + "\n"

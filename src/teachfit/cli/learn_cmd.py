@@ -1,0 +1,226 @@
+"""``teachfit learn skill`` and ``teachfit bench learning``: seed B's meta learning."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from teachfit.cli.common import console, guarded
+from teachfit.learning.base import LearningError
+
+_CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
+_TASK_PARAM = typer.Option("--task-param", help="task parameter override NAME=VALUE (SI units)")
+
+
+def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
+    out = []
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        try:
+            out.append((name.strip(), float(value)))
+        except ValueError:
+            sep = ""
+        if not sep or not name.strip():
+            raise LearningError(f"--task-param wants NAME=VALUE with a number, got {item!r}")
+    return tuple(out)
+
+
+def _bar() -> Progress:
+    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                    TimeElapsedColumn(), console=console, transient=True)
+
+
+def write_params_toml(path: Path, params: dict[str, float], header: str) -> Path:
+    """Learned values as a TOML ``[params]`` table (readable by ``skill run --params``)."""
+    lines = [f"# {line}" for line in header.splitlines()] + ["[params]"]
+    lines += [f"{name} = {float(v)!r}" for name, v in params.items()]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@guarded
+def learn_skill(
+    task: Annotated[str, typer.Option(help="task: puzzle, key, peg, ...")] = "puzzle",
+    skill: Annotated[str, typer.Option(help="built-in skill or skill .toml")] = "peg-in-hole",
+    method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
+    trials: Annotated[int, typer.Option(help="trial budget (restored trials count)")] = 130,
+    study: Annotated[str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")]
+    = "runs/study.db",
+    resume: Annotated[bool, typer.Option(help="continue a stored study")] = False,
+    workers: Annotated[int | None, typer.Option(help="worker processes (default: all cores; "
+                                                "0: in this process)")] = None,
+    ray: Annotated[str | None, typer.Option(help="run trials on Ray: 'local' or an address")]
+    = None,
+    controller: Annotated[str, _CONTROLLER] = "adaptive",
+    seed: Annotated[int, typer.Option(help="seed of the set-up (hole estimate, starts) and "
+                                      "of the learner")] = 0,
+    starts: Annotated[int, typer.Option(help="executions (start poses) per trial")] = 4,
+    task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
+    out: Annotated[Path | None, typer.Option(help="write the best parameters (TOML)")] = None,
+    plot: Annotated[Path | None, typer.Option(help="learning curve figure")] = None,
+    traces: Annotated[Path | None, typer.Option(help="parameter traces figure")] = None,
+    best_plot: Annotated[Path | None, typer.Option(help="re-run the best parameters once and "
+                                                   "plot force and pose over time")] = None,
+) -> None:
+    """Learn a skill's parameters on a task by trials; every trial is stored at once."""
+    from teachfit.bench.learning import method_options
+    from teachfit.learning.objective import SkillObjective
+    from teachfit.learning.runner import run_study
+    from teachfit.learning.study import Study, StudyMismatchError, stored_tags
+
+    if trials < 1:
+        raise LearningError(f"--trials must be >= 1, got {trials}")
+    obj = SkillObjective(task, skill, controller, seed, starts, _overrides(task_param))
+    tags = stored_tags(study)  # resuming keeps the stored options (e.g. the LHS design size)
+    same = tags is not None and tags.get("method") == method
+    options = tags.get("options", {}) if same else method_options(method, trials)
+    try:
+        st = Study(study, task=task, skill=obj.trial().setup.skill.name, space=obj.space,
+                   method=method, seed=seed, options=options, penalty=obj.penalty,
+                   resume=resume, context=obj.context())
+    except StudyMismatchError as exc:
+        raise StudyMismatchError(f"{exc} -- this database holds another study; choose "
+                                 "another --study or the same settings") from exc
+    where = f"Ray at {ray}" if ray else f"{'all cores' if workers is None else workers} worker(s)"
+    console.print(f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
+                  f"per trial) -> {st.url}; {st.n_restored} trial(s) restored; {where}")
+    best = [math.inf]
+    with _bar() as bar:
+        job = bar.add_task(f"{method} {task}", total=trials, completed=min(st.n_finished, trials))
+
+        def progress(rec: object) -> None:
+            if rec.feasible:  # type: ignore[attr-defined]
+                best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
+            bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
+
+        if ray:
+            from teachfit.learning.ray_runner import run_study_ray
+
+            rep = run_study_ray(st, obj, trials, address=ray, workers=workers, on_trial=progress)
+        else:
+            rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+    console.print(f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
+                  f"trials/s), {rep.failed} failed by crash/divergence; study holds "
+                  f"{st.n_finished}")
+    if not rep.interrupted and st.n_finished < trials:
+        console.print(f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
+                      f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials")
+    if st.n_finished:
+        _report_best(st, obj, out, plot, traces, best_plot, f"{method} on {task}")
+    if rep.interrupted:
+        console.print(f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
+                      "with the same command and --resume")
+        raise typer.Exit(130)
+
+
+def _report_best(st: object, obj: object, out: Path | None, plot: Path | None,
+                 traces: Path | None, best_plot: Path | None, title: str) -> None:
+    from teachfit.viz import learning_figures as lf
+
+    recs = st.trials()  # type: ignore[attr-defined]
+    best = st.best()  # type: ignore[attr-defined]
+    ok = sum(r.feasible for r in recs)
+    rate = best.info.get("success_rate", float("nan"))
+    console.print(f"best: trial {best.number + 1}, cost {best.cost:.3f} s, "
+                  f"{'feasible' if best.feasible else '[red]infeasible[/]'} "
+                  f"({100 * rate:.0f} % of its executions succeeded); {ok}/{len(recs)} "
+                  "trials feasible")
+    space = obj.space  # type: ignore[attr-defined]
+    table = Table(title="best parameters", title_justify="left")
+    for col in ("name", "value", "low", "high"):
+        table.add_column(col)
+    for name, v in best.params.items():
+        d = space.domains[name]
+        table.add_row(name, f"{v:.4g}", f"{d.low:.4g}", f"{d.high:.4g}")
+    console.print(table)
+    if out is not None:
+        head = f"best of {title}: cost {best.cost:.4f} s, trial {best.number + 1}"
+        console.print(f"parameters -> {write_params_toml(out, best.params, head)}")
+    if plot is not None:
+        console.print(f"learning curve -> {lf.plot_study_curve(recs, plot, title)}")
+    if traces is not None:
+        console.print(f"parameter traces -> {lf.plot_param_traces(recs, space, traces, title)}")
+    if best_plot is not None:
+        outcome = obj.outcome(best.params)  # type: ignore[attr-defined]
+        k = next((i for i, s in enumerate(outcome.successes) if s), 0)
+        path = lf.plot_best_execution(outcome.traces[k], best_plot)
+        console.print(f"best execution -> {path}")
+
+
+@guarded
+def bench_learning(
+    tasks: Annotated[str, typer.Option(help="comma-separated tasks")] = "puzzle,key,peg",
+    methods: Annotated[str, typer.Option(help="comma-separated methods")] = "cmaes,pso,bo,lhs",
+    experiments: Annotated[int, typer.Option(help="learning runs per task and method")] = 2,
+    trials: Annotated[int, typer.Option(help="trials per experiment")] = 60,
+    workers: Annotated[int | None, typer.Option(help="worker processes (default: all)")] = None,
+    starts: Annotated[int, typer.Option(help="executions per trial")] = 4,
+    controller: Annotated[str, _CONTROLLER] = "adaptive",
+    seed: int = 0,
+    task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
+    plot: Annotated[Path | None, typer.Option(help="Fig. 6-like learning curves")] = Path(
+        "out/bench_learning/curves.png"),
+    target: Annotated[bool, typer.Option(help="time a 130-trial x 4-start CMA-ES puzzle "
+                                         "experiment against the 5-minute target")] = True,
+    speedup_trials: Annotated[int, typer.Option(help="trials of the 1-vs-N-worker speed-up "
+                                                "study (0: skip)")] = 24,
+    markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")]
+    = None,
+) -> None:
+    """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
+    import os
+
+    from teachfit.bench import learning as bl
+    from teachfit.learning.objective import SkillObjective
+
+    task_list = [t for t in tasks.split(",") if t]
+    method_list = [m for m in methods.split(",") if m]
+    total = len(task_list) * len(method_list) * experiments * trials
+    with _bar() as bar:
+        job = bar.add_task("learning", total=total)
+        res = bl.run_learning_bench(
+            task_list, method_list, experiments, trials, workers=workers, n_starts=starts,
+            controller=controller, seed=seed, overrides=dict(_overrides(task_param)),
+            on_trial=lambda label, _r: bar.update(job, advance=1, description=label))
+    extra = "".join(f" --task-param {p}" for p in task_param or [])
+    text = (f"`teachfit bench learning --tasks {tasks} --methods {methods} --experiments "
+            f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
+            f"{os.cpu_count()} cores, {res.wall_s:.0f} s in all)\n\n" + bl.to_markdown(res))
+    n_w = workers or os.cpu_count() or 1
+    if target:
+        done = [e for e in res.experiments if e.task == "puzzle" and e.method == "cmaes"]
+        if done and trials == 130 and starts == 4:
+            wall = done[0].wall_s
+        else:
+            with console.status("130-trial x 4-start CMA-ES on puzzle"):
+                wall = bl.run_experiment(SkillObjective("puzzle", seed=seed), "cmaes", 130,
+                                         workers=workers).wall_s
+        verdict = "meets" if wall <= 300 else "misses"
+        text += (f"\nCMA-ES, 130 trials x 4 starts on puzzle: {wall:.1f} s wall "
+                 f"({130 / wall:.2f} trials/s, {n_w} workers) -- {verdict} the 5-minute target\n")
+    if speedup_trials > 0 and n_w > 1:
+        with console.status(f"speed-up: {speedup_trials} trials with 1 and {n_w} workers"):
+            t1, tn, ratio = bl.speedup(trials=speedup_trials, workers=n_w, seed=seed,
+                                       n_starts=starts)
+        text += (f"\nspeed-up, {speedup_trials}-trial x {starts}-start CMA-ES puzzle study "
+                 f"(fastest of 2 alternating runs each): 1 worker {t1:.1f} s, {n_w} workers "
+                 f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
+                 f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n")
+    console.print(text)
+    if plot is not None:
+        from teachfit.viz.learning_figures import plot_learning_curves
+
+        bands = {(c.task, c.method): c.curve for c in res.cells}
+        path = plot_learning_curves(bands, plot, f"best cost so far, mean and 95 % CI over "
+                                    f"{experiments} experiment(s)")
+        console.print(f"learning curves -> {path}")
+    if markdown is not None:
+        markdown.parent.mkdir(parents=True, exist_ok=True)
+        markdown.write_text(text)
+        console.print(f"markdown -> {markdown}")

@@ -1,0 +1,110 @@
+"""The skill-learning objective: one trial = one learned parameter set, several executions.
+
+:class:`SkillObjective` is a small frozen (hence picklable and hashable) description of an
+experiment -- task name and parameter overrides, skill, controller, set-up seed, number of
+start poses -- that turns into ``params -> TrialResult`` in whichever process calls it (a
+worker of :func:`~teachfit.learning.runner.run_study`, a Ray worker, or this one). The MuJoCo
+scene and robot are built once per process and objective and then reused across trials.
+
+Cost (seed B, Sec. V): the mean over the starts of the learning metric
+(:class:`~teachfit.skills.metric.LearningMetric`): the time from first contact to full
+insertion (s) on success, ``t_max + k_d * remaining distance`` on failure. A trial is
+feasible if any start succeeded. ``info`` carries ``success_rate``, ``sim_s`` (simulated robot
+seconds of all executions, recovery included) and ``wall_s``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from teachfit.learning.base import LearningError, ParamSpace, TrialResult
+
+#: distance (m) at which a crashed or diverged trial is penalised: well beyond any region of
+#: interest, so every such trial costs more than every ordinary failure
+PENALTY_DISTANCE = 0.05
+
+_CACHE: dict[SkillObjective, Any] = {}  # objective -> SkillTrial, per process
+
+
+@dataclass(frozen=True)
+class SkillObjective:
+    """A picklable learning objective for a skill on a task.
+
+    Parameters
+    ----------
+    task : str
+        Built-in task name (:func:`teachfit.tasks.registry.get_task`).
+    skill : str
+        Built-in skill name or skill ``.toml``.
+    controller : str
+        ``"adaptive"`` (learns the controller's meta-parameters too) or ``"impedance"``.
+    seed : int
+        Seed of the experiment's fixed part: hole estimate, start poses, sensor noise.
+    n_starts : int
+        Executions per trial (four in the paper).
+    task_overrides : tuple of (name, value)
+        Task parameter overrides, e.g. ``(("hole_pos_sigma", 0.001),)`` (SI units).
+    """
+
+    task: str
+    skill: str = "peg-in-hole"
+    controller: str = "adaptive"
+    seed: int = 0
+    n_starts: int = 4
+    task_overrides: tuple[tuple[str, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.n_starts < 1:
+            raise LearningError(f"n_starts must be >= 1, got {self.n_starts}")
+        object.__setattr__(self, "task_overrides", tuple(sorted(self.task_overrides)))
+
+    # ---------------------------------------------------------------------------- set-up
+    def trial(self) -> Any:
+        """The :class:`~teachfit.skills.trial.SkillTrial` (built once per process)."""
+        found = _CACHE.get(self)
+        if found is None:
+            from teachfit.skills.library import get_skill
+            from teachfit.skills.trial import SkillTrial, peg_in_hole_setup
+            from teachfit.tasks.registry import get_task
+
+            task = get_task(self.task, **dict(self.task_overrides))
+            skill = get_skill(self.skill, self.controller)
+            setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
+            found = SkillTrial(setup, self.controller, seed=self.seed)
+            _CACHE.clear()  # one experiment per worker at a time: keep memory flat
+            _CACHE[self] = found
+        return found
+
+    @property
+    def space(self) -> ParamSpace:
+        """The skill's learned parameters and their domains."""
+        return self.trial().setup.skill.space
+
+    @property
+    def penalty(self) -> float:
+        """Cost of a crashed or diverged trial (s): a failure ``PENALTY_DISTANCE`` away."""
+        return float(self.trial().metric.failure_cost(PENALTY_DISTANCE))
+
+    def context(self) -> dict[str, Any]:
+        """JSON-able description stored with a study and compared on resume."""
+        return {
+            "controller": self.controller,
+            "setup_seed": int(self.seed),
+            "n_starts": int(self.n_starts),
+            "task_overrides": {k: float(v) for k, v in self.task_overrides},
+        }
+
+    # ---------------------------------------------------------------------------- trials
+    def outcome(self, params: Mapping[str, float] | None) -> Any:
+        """The full :class:`~teachfit.skills.trial.TrialOutcome` (traces with logs)."""
+        return self.trial()(params)
+
+    def __call__(self, params: Mapping[str, float]) -> TrialResult:
+        out = self.outcome(params)
+        tr = self.trial()
+        period = float(tr.robot.control_period)
+        sim_s = sum(t.steps for t in out.traces) * period
+        res = out.as_result()
+        return TrialResult(res.cost, res.feasible, dict(res.info) | {"sim_s": sim_s})

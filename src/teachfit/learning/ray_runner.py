@@ -1,0 +1,132 @@
+"""Run a study's trials on a Ray cluster (optional extra: ``pip install teachfit[ray]``).
+
+The same contract as :func:`~teachfit.learning.runner.run_study`: trials are asked in this
+process, evaluated as Ray tasks (one CPU each) and stored here the moment each finishes, so a
+killed driver resumes from the study database. Each Ray task fails on its own: an exception
+or a non-finite cost in the objective, or a worker process that dies, fails only that trial
+(stored at the study's penalty). SIGINT / SIGTERM: the first stops asking and lets running
+trials finish; a second cancels them and raises ``KeyboardInterrupt``.
+
+``address``: ``"local"`` starts a private local Ray instance (``workers`` CPUs, default all
+cores) and shuts it down afterwards; anything else (``"auto"``, ``"HOST:PORT"``,
+``"ray://HOST:10001"``) connects to a running cluster. If Ray is already initialised in this
+process it is used as it is. The objective must be picklable and importable on the workers
+(e.g. :class:`~teachfit.learning.objective.SkillObjective` with teachfit installed there).
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import socket
+import time
+from collections.abc import Callable
+from types import ModuleType
+from typing import Any
+
+from teachfit.learning.base import Candidate, LearningError, TrialResult
+from teachfit.learning.runner import Objective, RunReport, _Signals, evaluate
+from teachfit.learning.study import Study, TrialRecord
+
+
+def import_ray() -> ModuleType:
+    """The ``ray`` module, or a :class:`LearningError` saying how to get it."""
+    try:
+        return importlib.import_module("ray")
+    except ImportError as exc:
+        raise LearningError(
+            "--ray needs the optional Ray extra: pip install 'teachfit[ray]' (or ray>=2.9)"
+        ) from exc
+
+
+def _check_reachable(address: str, timeout: float = 5.0) -> None:
+    """Fail fast on a ``HOST:PORT`` (or ``ray://HOST:PORT``) nobody listens on: Ray itself
+    retries a missing head node for minutes."""
+    if address in ("", "local", "auto"):
+        return
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit():
+        raise LearningError(f"a Ray address is 'local', 'auto' or HOST:PORT, got {address!r}")
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout).close()
+    except OSError as exc:
+        raise LearningError(f"no Ray cluster reachable at {address!r}: {exc}") from exc
+
+
+def _init(ray: ModuleType, address: str, workers: int | None) -> bool:
+    """Initialise Ray unless it is; True if this call started it (and must shut it down)."""
+    if ray.is_initialized():
+        return False
+    kwargs: dict[str, Any] = dict(include_dashboard=False, log_to_driver=False,
+                                  configure_logging=False)
+    os.environ.setdefault("RAY_DEDUP_LOGS", "0")
+    _check_reachable(address)
+    try:
+        if address in ("", "local"):
+            ray.init(num_cpus=workers or os.cpu_count() or 1, **kwargs)
+        else:
+            ray.init(address=address, **kwargs)
+    except Exception as exc:  # connection refused, bad address, ...
+        raise LearningError(f"cannot start or reach Ray at {address!r}: {exc}") from exc
+    return True
+
+
+def run_study_ray(
+    study: Study,
+    objective: Objective,
+    budget: int,
+    address: str = "local",
+    workers: int | None = None,
+    handle_signals: bool = True,
+    on_trial: Callable[[TrialRecord], None] | None = None,
+) -> RunReport:
+    """Run trials of ``study`` on Ray until it holds ``budget`` finished trials.
+
+    ``workers``: trials in flight at once (default: the cluster's CPUs).
+    """
+    if budget < 0:
+        raise LearningError(f"budget must be >= 0, got {budget}")
+    if workers is not None and workers < 1:
+        raise LearningError(f"workers must be >= 1 with Ray, got {workers}")
+    ray = import_ray()
+    t0 = time.perf_counter()
+    started = _init(ray, address, workers)
+    restored, failed = study.n_finished, 0
+    pending: dict[Any, Candidate] = {}
+    try:
+        slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
+        task = ray.remote(num_cpus=1, max_retries=0)(evaluate)
+        obj_ref = ray.put(objective)
+        with _Signals(handle_signals) as sig:
+            while True:
+                while (not sig.stop and len(pending) < slots
+                       and study.n_finished + len(pending) < budget):
+                    cand = study.ask()
+                    if cand is None:
+                        break
+                    pending[task.remote(obj_ref, study.params_of(cand))] = cand
+                if not pending:
+                    break
+                done, _ = ray.wait(list(pending), num_returns=1, timeout=0.2)
+                for ref in done:
+                    cand = pending.pop(ref)
+                    result: TrialResult | None
+                    try:
+                        result, error = ray.get(ref)
+                    except ray.exceptions.RayError as exc:  # the worker died, or was lost
+                        why = str(exc).strip().splitlines()[-1:] or [""]
+                        result, error = None, f"Ray worker failed: {type(exc).__name__}: {why[0]}"
+                    rec = study.tell(cand, result, error)
+                    failed += rec.outcome == "error"
+                    if on_trial is not None:
+                        on_trial(rec)
+            interrupted = sig.stop
+    except BaseException:
+        for ref in pending:
+            ray.cancel(ref, force=True)
+        raise
+    finally:
+        if started:
+            ray.shutdown()
+    return RunReport(restored, study.n_finished - restored, failed, interrupted,
+                     time.perf_counter() - t0)

@@ -1,0 +1,112 @@
+"""``teachfit learn skill``: the skill objective in workers, resume, kills, mismatches."""
+
+from __future__ import annotations
+
+import pickle
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from teachfit.cli import app
+from teachfit.learning import Study, run_study
+from teachfit.learning.objective import SkillObjective
+from teachfit.learning.study import stored_tags
+from teachfit.skills import read_params_toml
+
+runner = CliRunner()
+QUICK = ["--task", "puzzle", "--starts", "1", "--method", "cmaes"]
+
+
+def cli(*args: object) -> object:
+    return runner.invoke(app, ["learn", "skill", *[str(a) for a in args]])
+
+
+def test_skill_objective_runs_in_worker_processes_and_stores_sim_time(tmp_path: Path) -> None:
+    obj = SkillObjective("puzzle", seed=1, n_starts=1)
+    assert pickle.loads(pickle.dumps(obj)) == obj
+    space = obj.space
+    assert "force" in space.names and "alpha_t" in space.names  # skill + adaptive controller
+    direct = obj(space.from_unit([0.5] * space.dim))
+    study = Study(tmp_path / "s.db", task="puzzle", skill="peg-in-hole", space=space,
+                  method="lhs", seed=1, options={"n": 4}, penalty=obj.penalty,
+                  context=obj.context())
+    report = run_study(study, obj, 4, workers=2)
+    recs = study.trials()
+    assert report.finished == 4 and report.failed == 0 and len(recs) == 4
+    for r in recs:
+        assert 0.0 < r.cost < obj.penalty
+        assert 0.5 < r.info["sim_s"] < 12.0  # one execution: skill + recovery, simulated s
+        assert r.info["success_rate"] in (0.0, 1.0)
+        assert r.feasible == (r.info["success_rate"] > 0)
+    assert direct.feasible and direct.info["sim_s"] > 0.5
+    assert obj.penalty > 5.0  # beyond every ordinary failure (t_max + k_d * d, d < roi)
+
+
+def test_learn_resume_mismatch_and_best_params_file(tmp_path: Path) -> None:
+    db, best = tmp_path / "runs" / "p.db", tmp_path / "best.toml"
+    res = cli(*QUICK, "--trials", 5, "--study", db, "--workers", 0, "--out", best,
+              "--plot", tmp_path / "c.png", "--traces", tmp_path / "t.png")
+    assert res.exit_code == 0, res.output
+    assert "best: trial" in res.output and (tmp_path / "c.png").stat().st_size > 0
+    obj = SkillObjective("puzzle", n_starts=1)
+    params = read_params_toml(best, obj.trial().setup.skill.params)
+    assert set(params) == set(obj.space.names)
+    res = cli(*QUICK, "--trials", 7, "--study", db, "--workers", 0)
+    assert res.exit_code == 2 and "already has 5 trials" in res.output and "--resume" in res.output
+    res = cli(*QUICK, "--trials", 7, "--study", db, "--workers", 0, "--resume")
+    assert res.exit_code == 0 and "5 trial(s) restored" in res.output
+    assert len(Study(db, task="puzzle", skill="peg-in-hole", space=obj.space, method="cmaes",
+                     penalty=obj.penalty, context=obj.context()).trials()) == 7
+    res = cli("--task", "key", "--starts", "1", "--method", "cmaes", "--trials", 8, "--study", db,
+              "--resume", "--workers", 0)
+    assert res.exit_code == 2 and "task: stored 'puzzle', asked 'key'" in res.output
+    res = cli(*QUICK, "--trials", 8, "--study", db, "--resume", "--controller", "impedance")
+    assert res.exit_code == 2 and "differs" in res.output and "space" in res.output
+    res = cli(*QUICK, "--trials", 8, "--study", db, "--resume", "--seed", 3)
+    assert res.exit_code == 2 and "seed" in res.output
+
+
+def _stored(db: Path) -> int:
+    try:
+        with sqlite3.connect(db) as con:
+            q = "SELECT count(*) FROM trials WHERE state = 'COMPLETE'"
+            return int(con.execute(q).fetchone()[0])
+    except sqlite3.OperationalError:  # Optuna has not created its tables yet
+        return 0
+
+
+def test_sigterm_mid_study_stops_cleanly_and_resume_loses_nothing(tmp_path: Path) -> None:
+    db = tmp_path / "k.db"
+    exe = Path(sys.executable).with_name("teachfit")
+    proc = subprocess.Popen([str(exe), "learn", "skill", *QUICK, "--trials", "300",
+                             "--study", str(db), "--workers", "1"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and (not db.exists() or _stored(db) < 4):
+            time.sleep(0.2)
+        proc.send_signal(signal.SIGTERM)
+        out, _ = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, out
+    assert "stopped" in out and "--resume" in out
+    n1 = _stored(db)
+    assert 4 <= n1 < 300
+    tags = stored_tags(db)
+    assert tags is not None and tags["method"] == "cmaes" and tags["task"] == "puzzle"
+    obj = SkillObjective("puzzle", n_starts=1)
+    kw = dict(task="puzzle", skill="peg-in-hole", space=obj.space, method="cmaes",
+              options={}, penalty=obj.penalty, context=obj.context())
+    before = [(r.key, r.cost) for r in Study(db, **kw).trials()]  # type: ignore[arg-type]
+    res = cli(*QUICK, "--trials", n1 + 3, "--study", db, "--workers", 0, "--resume")
+    assert res.exit_code == 0, res.output
+    after = Study(db, **kw).trials()  # type: ignore[arg-type]
+    assert len(after) == n1 + 3 and len({r.key for r in after}) == n1 + 3
+    assert [(r.key, r.cost) for r in after[:n1]] == before
