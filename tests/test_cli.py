@@ -106,6 +106,12 @@ def test_learn_plan_run_search(tmp_path):
     assert "starts" in res.output
     res = invoke("search", "run", "--task", "socket3d", "--model", model, "--starts", "1")
     assert res.exit_code == 2  # a peg2d model for the socket task
+    res = invoke("search", "run", "--model", model, "--method", "ergodic", "--passes", "2")
+    assert res.exit_code == 2 and "passes" in res.output
+    res = invoke("search", "figures", model, "--out", tmp_path / "figs", "-n", "40")
+    assert res.exit_code == 0, res.output
+    names = {"samples.png", "tshix_stages.png", "feedforward.png", "planned_vs_executed.png"}
+    assert names <= {f.name for f in (tmp_path / "figs").iterdir()}
 
 
 def test_bench_search_names_missing_tables():

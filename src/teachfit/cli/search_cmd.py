@@ -170,3 +170,47 @@ def run(
 
         plot_executions(paths, plot, the_task, title=method)
         console.print(f"figure -> {plot}")
+
+
+@search_app.command("figures")
+@guarded
+def figures(
+    model_file: Annotated[Path, typer.Argument(help="model from 'teachfit learn search'")],
+    out: Annotated[Path, typer.Option(help="folder for the figures")] = Path("search_figures"),
+    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
+    seed: int = 0,
+) -> None:
+    """Seed A's figures for a model: samples over p_e for N = 100...500, samples -> itinerary ->
+    smoothed trajectory, feed-forward arrows, the 3D trajectory (x, y, rz tasks), and a
+    planned vs. executed path from the task's first protocol start."""
+    from teachfit.execution.search import plan_search, run_search
+    from teachfit.models.search_model import SearchModel
+    from teachfit.robot.floating import FloatingToolRobot
+    from teachfit.tasks.registry import get_task
+    from teachfit.viz import search_figures as sf
+
+    model = SearchModel.load(model_file)
+    task = get_task(model.task)
+    out.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    written = [sf.save(sf.samples_over_distribution(model.exploration, rng), out / "samples.png")]
+    traj = plan_search(model, "tshix", n, np.random.default_rng(seed))
+    if model.exploration.dim == 2:
+        written.append(sf.save(sf.tshix_stages(traj, model.exploration), out / "tshix_stages.png"))
+    else:
+        written.append(sf.save(sf.trajectory_3d(traj), out / "trajectory_3d.png"))
+    ff = np.zeros((traj.t.size, 6))
+    if model.dynamics is not None:
+        ff[:, :2] = model.feedforward_along(traj.t, traj.states)[:, :2]
+    written.append(sf.save(sf.feedforward_arrows(traj, ff), out / "feedforward.png"))
+    protocol = (
+        "table1" if task.name == "peg2d" else "table3" if task.name == "socket3d" else "teacher"
+    )
+    start = task.protocol_starts(protocol, 1, np.random.default_rng(seed))[0]
+    run = run_search(FloatingToolRobot(task, seed=seed), task, model, start, traj)
+    executed = run.log.pos[:, :2] - start.pos[:2]
+    fig = sf.planned_vs_executed(traj.states[:, :2], executed)
+    fig.axes[0].set_title(f"from a {protocol} start: {run.outcome.reason}")
+    written.append(sf.save(fig, out / "planned_vs_executed.png"))
+    for path in written:
+        console.print(f"figure -> {path}")
