@@ -174,6 +174,10 @@ def test_bad_inputs_raise_clear_errors(clip, tmp_path):
         VideoSet([tmp_path / "missing.mp4", *_videos(clip)[1:]], rig)
     with pytest.raises(CaptureError, match="2 video"):
         VideoSet(_videos(clip, 2), rig)
+    copy = tmp_path / "copy.mp4"
+    copy.write_bytes(Path(_videos(clip)[0]).read_bytes())
+    with pytest.raises(CaptureError, match="same file"):
+        VideoSet([_videos(clip)[0], copy, _videos(clip)[2]], rig)
     short = tmp_path / "short.mp4"
     reader = imageio.get_reader(_videos(clip)[0])
     fps = reader.get_meta_data()["fps"]

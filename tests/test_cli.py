@@ -106,6 +106,10 @@ def test_learn_plan_run_search(tmp_path):
     assert "starts" in res.output
     res = invoke("search", "run", "--task", "socket3d", "--model", model, "--starts", "1")
     assert res.exit_code == 2  # a peg2d model for the socket task
+    other = tmp_path / "socket.h5"
+    assert invoke("demo", "record", "--task", "socket3d", "-n", "1", "--out", other).exit_code == 0
+    res = invoke("search", "run", "--model", model, "--starts", "1", "--demo", f"{other}:0")
+    assert res.exit_code == 2 and "socket3d" in res.output
     res = invoke("search", "run", "--model", model, "--method", "ergodic", "--passes", "2")
     assert res.exit_code == 2 and "passes" in res.output
     res = invoke("search", "figures", model, "--out", tmp_path / "figs", "-n", "40")

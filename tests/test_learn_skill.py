@@ -110,3 +110,18 @@ def test_sigterm_mid_study_stops_cleanly_and_resume_loses_nothing(tmp_path: Path
     after = Study(db, **kw).trials()  # type: ignore[arg-type]
     assert len(after) == n1 + 3 and len({r.key for r in after}) == n1 + 3
     assert [(r.key, r.cost) for r in after[:n1]] == before
+
+
+def test_bad_method_or_task_creates_no_study_and_lhs_cannot_grow(tmp_path: Path) -> None:
+    db = tmp_path / "runs" / "x.db"
+    res = cli("--task", "puzzle", "--method", "nope", "--study", db)
+    assert res.exit_code == 2 and "unknown learning method" in res.output
+    res = cli("--task", "nope", "--study", db)
+    assert res.exit_code == 2 and "unknown task" in res.output
+    assert not db.exists() and stored_tags(db) is None and not db.exists()
+    lhs = ["--task", "puzzle", "--starts", "1", "--method", "lhs", "--workers", 0]
+    assert cli(*lhs, "--trials", 2, "--study", db).exit_code == 0
+    res = cli(*lhs, "--trials", 4, "--study", db, "--resume")
+    assert res.exit_code == 2 and "Latin hypercube has 2 points" in res.output
+    res = cli(*lhs, "--trials", 2, "--study", db, "--resume")
+    assert res.exit_code == 0 and "nothing to run" in res.output

@@ -6,6 +6,7 @@ per camera, in rig order.
 
 from __future__ import annotations
 
+import hashlib
 import time
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -28,6 +29,13 @@ def _check_size(img: np.ndarray, rig: Rig, i: int, label: str) -> None:
         )
 
 
+def _fingerprint(path: Path, head: int = 1 << 20) -> str:
+    """Size and hash of the first MiB: equal for the same video under two names."""
+    with path.open("rb") as fh:
+        digest = hashlib.sha1(fh.read(head), usedforsecurity=False).hexdigest()
+    return f"{path.stat().st_size}:{digest}"
+
+
 class VideoSet:
     """Videos of the rig's cameras (one per camera, same order), read in lock step.
 
@@ -46,10 +54,19 @@ class VideoSet:
             raise CaptureError(
                 f"{len(self.paths)} video(s) given but the rig has {len(rig)} cameras"
             )
-        self.caps = []
         for p in self.paths:
             if not p.is_file():
                 raise CaptureError(f"video {p}: no such file")
+        seen: dict[str, Path] = {}
+        for p in self.paths:
+            key = _fingerprint(p)
+            if key in seen:
+                raise CaptureError(
+                    f"videos {seen[key]} and {p} are the same file: each camera needs its own"
+                )
+            seen[key] = p
+        self.caps = []
+        for p in self.paths:
             cap = cv2.VideoCapture(str(p), cv2.CAP_FFMPEG, [cv2.CAP_PROP_N_THREADS, threads])
             if not cap.isOpened():
                 raise CaptureError(
@@ -67,7 +84,7 @@ class VideoSet:
         self.n_frames = counts[0]
 
     def _list(self, values: Sequence[object]) -> str:
-        return ", ".join(f"{p.name}: {v}" for p, v in zip(self.paths, values, strict=True))
+        return ", ".join(f"{p}: {v}" for p, v in zip(self.paths, values, strict=True))
 
     def close(self) -> None:
         """Release the decoders."""

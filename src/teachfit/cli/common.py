@@ -26,7 +26,9 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
         try:
             return func(*args, **kwargs)
         except TeachfitError as exc:
-            err_console.print(f"[bold red]error:[/] {exc}")
+            err_console.print("[bold red]error:[/] ", end="")
+            # the message is plain text: no markup, no ":emoji:" codes, no highlighting
+            err_console.print(str(exc), markup=False, emoji=False, highlight=False)
             raise typer.Exit(2) from exc
 
     return wrapper

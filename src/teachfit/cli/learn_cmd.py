@@ -72,14 +72,23 @@ def learn_skill(
     from teachfit.bench.learning import method_options
     from teachfit.learning.objective import SkillObjective
     from teachfit.learning.runner import run_study
-    from teachfit.learning.study import Study, StudyMismatchError, stored_tags
+    from teachfit.learning.study import METHODS, Study, StudyMismatchError, stored_tags
+    from teachfit.tasks.registry import get_task
 
     if trials < 1:
         raise LearningError(f"--trials must be >= 1, got {trials}")
+    if method not in METHODS:
+        raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
+    get_task(task)  # an unknown task fails here, before any study file is created
     obj = SkillObjective(task, skill, controller, seed, starts, _overrides(task_param))
     tags = stored_tags(study)  # resuming keeps the stored options (e.g. the LHS design size)
     same = tags is not None and tags.get("method") == method
     options = tags.get("options", {}) if same else method_options(method, trials)
+    if same and method == "lhs" and int(options.get("n", trials)) < trials:
+        raise LearningError(
+            f"the stored Latin hypercube has {options.get('n')} points; --trials {trials} "
+            "cannot extend it (a new design needs a new --study)"
+        )
     try:
         st = Study(study, task=task, skill=obj.trial().setup.skill.name, space=obj.space,
                    method=method, seed=seed, options=options, penalty=obj.penalty,
@@ -90,6 +99,9 @@ def learn_skill(
     where = f"Ray at {ray}" if ray else f"{'all cores' if workers is None else workers} worker(s)"
     console.print(f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
                   f"per trial) -> {st.url}; {st.n_restored} trial(s) restored; {where}")
+    if st.n_finished >= trials:
+        console.print(f"[yellow]the study already holds {st.n_finished} trial(s) >= --trials "
+                      f"{trials}[/]: nothing to run; raise --trials to continue")
     best = [math.inf]
     with _bar() as bar:
         job = bar.add_task(f"{method} {task}", total=trials, completed=min(st.n_finished, trials))

@@ -73,10 +73,14 @@ def plan(
     traj = plan_search(model, method, n, np.random.default_rng(seed))
     wall = time.perf_counter() - t0
     metric = ergodic_metric(traj.states, model.exploration, t=traj.t)
+    xy = float(np.linalg.norm(np.diff(traj.states[:, :2], axis=0), axis=1).sum())
+    rz = ""
+    if "rz" in model.dims:
+        turn = np.abs(np.diff(traj.states[:, model.dims.index("rz")])).sum()
+        rz = f" and {np.degrees(turn):.0f} deg of rz"
     console.print(
-        f"{method}: {traj.t.size} set-points, {traj.duration:.1f} s, path "
-        f"{traj.path_length() * 1e3:.0f} mm, ergodic metric {metric:.4f}, planned in "
-        f"{wall * 1e3:.0f} ms"
+        f"{method}: {traj.t.size} set-points, {traj.duration:.1f} s, path {xy * 1e3:.0f} mm "
+        f"in x-y{rz}, ergodic metric {metric:.4f}, planned in {wall * 1e3:.0f} ms"
     )
     if plot is not None:
         from teachfit.viz import search_figures as sf
@@ -86,7 +90,10 @@ def plan(
         elif traj.states.shape[1] == 3:
             fig = sf.trajectory_3d(traj)
         else:
-            fig = sf.planned_vs_executed(traj.states, traj.states, ("planned", "planned"))
+            fig = sf.planned_vs_executed(traj.states, traj.states, (method, method))
+            fig.axes[0].lines[1].remove()  # one path: draw it once
+            fig.axes[0].legend()
+            fig.axes[0].set_title(f"{method} search trajectory (search frame)")
         sf.save(fig, plot)
         console.print(f"figure -> {plot}")
 
@@ -132,7 +139,16 @@ def run(
         from teachfit.pose import Pose
 
         d = read_demo(demo)
+        if d.task != the_task.name:
+            raise TeachfitError(
+                f"--demo {demo} is a {d.task!r} demonstration, not {the_task.name!r}"
+            )
         demo_start = Pose(d.pos[0], d.quat[0])
+    elif protocol == "table1":
+        console.print(
+            "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
+            "the hole; without --demo a nominal demonstration start is assumed"
+        )
     start_poses = the_task.protocol_starts(protocol, starts, rng, demo_start)
     robot = FloatingToolRobot(the_task, seed=seed)
     fixed = plan_search(model, method, n, rng) if method == "ergodic" else None

@@ -332,7 +332,10 @@ def write_dataset(
     path = Path(path)
     items = _checked_demos(demos, path)
     if path.exists() and not overwrite:
-        raise DatasetError("file exists (pass overwrite=True to replace it)", path=str(path))
+        raise DatasetError(
+            "file exists (pass --overwrite, or overwrite=True in Python, to replace it)",
+            path=str(path),
+        )
 
     def fill(tmp: Path) -> None:
         with h5py.File(tmp, "x") as f:

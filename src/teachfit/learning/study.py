@@ -83,6 +83,8 @@ def stored_tags(storage: str | Path, name: str = "teachfit") -> dict[str, Any] |
     """The tags of study ``name`` in ``storage`` (task, skill, method, options, ...), or
     ``None`` if there is no such study."""
     optuna.logging.set_verbosity(optuna.logging.WARNING)
+    if "://" not in str(storage) and not Path(storage).expanduser().exists():
+        return None  # a file that does not exist yet holds no study: do not create it here
     try:
         study = optuna.load_study(study_name=name, storage=storage_url(storage))
     except KeyError:

@@ -210,8 +210,12 @@ class SearchModel:
         path = Path(path)
         try:
             doc = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        except OSError as exc:
             raise ModelError(f"cannot read search model {path}: {exc}") from exc
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise ModelError(
+                f"{path} is not a search model (a JSON file written by 'teachfit learn search')"
+            ) from exc
         try:
             return cls.from_dict(doc, task=task, dims=dims)
         except ModelError as exc:
