@@ -11,6 +11,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -52,9 +53,10 @@ def plot_learning_curves(
             if b is None:
                 ax.set_axis_off()
                 continue
-            ax.fill_between(b.trials, b.low, b.high, color="0.75", lw=0,
+            ax.fill_between(b.trials, b.low, b.high, color="0.75", lw=0, step="post",
                             label="95 % CI" if b.n > 1 else None)
-            ax.plot(b.trials, b.mean, color="tab:blue", lw=1.6, label=f"mean of {b.n}")
+            ax.step(b.trials, b.mean, where="post", color="tab:blue", lw=1.6,
+                    label=f"mean of {b.n}")
             ax.set_ylim(max(0.0, low * 0.9), top * 1.05 + 1e-9)
             ax.grid(alpha=0.3)
             if i == 0:
@@ -82,6 +84,9 @@ def plot_study_curve(records: Sequence[TrialRecord], path: str | Path, title: st
     ax.set_xlabel("trial")
     ax.set_ylabel("cost (s)")
     ax.set_yscale("log")
+    # label the minor decades too: costs span 0.2-10 s, one "10^0" tick says nothing
+    ax.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     ax.set_title(title, fontsize=9)
@@ -117,6 +122,8 @@ def plot_param_traces(
         ax.grid(alpha=0.3)
     for ax in axes[-1]:
         ax.set_xlabel("trial")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("in domain (0-1)", fontsize=7)
     if title:
         fig.suptitle(title, fontsize=10)
     return _save(fig, path)
