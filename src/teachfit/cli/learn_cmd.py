@@ -224,7 +224,9 @@ def bench_learning(
                  f"(fastest of 2 alternating runs each): 1 worker {t1:.1f} s, {n_w} workers "
                  f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
                  f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n")
-    console.print(text)
+    from rich.markdown import Markdown
+
+    console.print(Markdown(text))  # tables drawn for the terminal; --markdown keeps the source
     if plot is not None:
         from teachfit.viz.learning_figures import plot_learning_curves
 
