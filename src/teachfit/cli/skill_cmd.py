@@ -109,6 +109,14 @@ def run(
     learned = None
     if params is not None:
         learned = read_params_toml(params, setup.skill.params, setup.skill.users())
+        import tomllib
+
+        given = tomllib.loads(params.read_text()).get("params", {})
+        given = given if isinstance(given, dict) and given else tomllib.loads(params.read_text())
+        missing = sorted(set(setup.skill.params.learned) - set(given))
+        if missing:
+            console.print(f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
+                          "their defaults are used")
     trial = SkillTrial(setup, controller, seed=seed)
     est = setup.task2world.inverse().compose(the_task.hole2world)
     console.print(
