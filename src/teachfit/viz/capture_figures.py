@@ -8,8 +8,9 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 import numpy as np  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 
 from teachfit.capture.track import Track  # noqa: E402
@@ -49,15 +50,21 @@ def track_figure(track: Track, out: str | Path, truth: Demonstration | None = No
     axes[2].plot(t, track.std_deg, label="predicted 1-sigma (deg)")
     axes[2].plot(t, track.rms_px, label="reprojection RMS (px)")
     ax2 = axes[2].twinx()
-    ax2.step(t, track.n_markers.sum(axis=1), where="mid", color="0.4", lw=0.8)
+    ax2.step(t, track.n_markers.sum(axis=1), where="mid", color="0.4", lw=0.8,
+             label="markers used (right axis)")
     ax2.set_ylabel("markers used")
+    ax2.yaxis.set_major_locator(MaxNLocator(integer=True))
     axes[2].set_yscale("log")
+    axes[2].set_ylabel("quality (mm, deg or px)")
     axes[2].set_xlabel("time (s)")
-    for ax in axes:
+    for ax in axes[:2]:
         ax.legend(loc="upper right", fontsize=7)
+    lines = axes[2].get_legend_handles_labels()
+    more = ax2.get_legend_handles_labels()
+    axes[2].legend(lines[0] + more[0], lines[1] + more[1], loc="upper right", fontsize=7)
     title = f"capture: {int(ok.sum())}/{track.n_frames} frames valid (grey: no trustworthy pose)"
     if truth is not None:
-        title += "; dashed: ground truth"
+        title += "; dashed: ground truth (under the track where they agree)"
     axes[0].set_title(title)
     fig.tight_layout()
     out.parent.mkdir(parents=True, exist_ok=True)
