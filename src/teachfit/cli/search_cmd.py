@@ -56,7 +56,9 @@ def learn_search(
 @guarded
 def plan(
     model_file: Annotated[Path, typer.Argument(help="model from 'teachfit learn search'")],
-    method: Annotated[str, typer.Option(help="tshix, ergodic, spiral or random-walk")] = "tshix",
+    method: Annotated[
+        str, typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
+    ] = "tshix",
     n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
     seed: int = 0,
     plot: Annotated[Path | None, typer.Option(help="figure to write")] = None,
@@ -94,6 +96,7 @@ def plan(
             fig.axes[0].lines[1].remove()  # one path: draw it once
             fig.axes[0].legend()
             fig.axes[0].set_title(f"{method} search trajectory (search frame)")
+            fig.tight_layout()
         sf.save(fig, plot)
         console.print(f"figure -> {plot}")
 
@@ -105,7 +108,9 @@ def run(
     model_file: Annotated[Path, typer.Option("--model", help="learned model")] = Path(
         "search.model"
     ),
-    method: Annotated[str, typer.Option(help="tshix, ergodic, spiral or random-walk")] = "tshix",
+    method: Annotated[
+        str, typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
+    ] = "tshix",
     n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
     starts: Annotated[int, typer.Option(help="number of start poses")] = 30,
     protocol: Annotated[str, typer.Option(help="start protocol of the task")] = "table1",
@@ -151,7 +156,7 @@ def run(
         )
     start_poses = the_task.protocol_starts(protocol, starts, rng, demo_start)
     robot = FloatingToolRobot(the_task, seed=seed)
-    fixed = plan_search(model, method, n, rng) if method == "ergodic" else None
+    fixed = plan_search(model, method, n, rng) if method.startswith("ergodic") else None
     if passes > 1 and method != "tshix":
         raise TeachfitError(f"--passes needs --method tshix, not {method}")
     outcomes, paths = [], []

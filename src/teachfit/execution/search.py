@@ -22,8 +22,9 @@ from teachfit.robot.interface import Robot
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
+from teachfit.trajectories.ergodic_opt import optimise_ergodic
 
-METHODS = ("tshix", "ergodic", "spiral", "random-walk")
+METHODS = ("tshix", "ergodic", "ergodic-opt", "spiral", "random-walk")
 _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rz": 5}
 
 
@@ -80,9 +81,11 @@ def plan_search(
     """A search trajectory in the search frame by ``method`` (see :data:`METHODS`).
 
     ``n_points``: TSHIX samples, or random-walk steps; an ergodic trajectory is as long as
-    ``length`` (m) or as a TSHIX pass through ``n_points`` samples. ``sampling`` is TSHIX's
-    sampler (``"qmc"`` or seed A's i.i.d. ``"random"``). The baselines span the exploration
-    distribution's 2-sigma radius (and, for rz, its 2-sigma rz range).
+    ``length`` (m, rz weighted by the planner's length scale) or as a TSHIX pass through
+    ``n_points`` samples; ``"ergodic-opt"`` then lowers its ergodic metric by trajectory
+    optimisation (:func:`~teachfit.trajectories.ergodic_opt.optimise_ergodic`). ``sampling``
+    is TSHIX's sampler (``"qmc"`` or seed A's i.i.d. ``"random"``). The baselines span the
+    exploration distribution's 2-sigma radius (and, for rz, its 2-sigma rz range).
 
     ``passes > 1`` (TSHIX only) appends re-sampled passes of ``n_points`` fresh samples, each
     starting where the previous one ends (seed A's re-sampling): the runner stops at insertion,
@@ -99,16 +102,21 @@ def plan_search(
         for _ in range(passes - 1):
             traj = planner.extend(traj, n_points, rng)
         return traj
-    if method == "ergodic":
+    if method in ("ergodic", "ergodic-opt"):
         if length is None:
             planner = TshixPlanner.from_model(model, sampling=sampling)
-            length = planner.plan(n_points, rng).path_length()
-        return ergodic_trajectory(
+            length = planner.plan(n_points, rng).path_length(planner.length_scale)
+        traj = ergodic_trajectory(
             model.exploration,
             speed=model.speed,
             length=length,
             angular_speed=model.angular_speed,
             start=np.zeros(len(dims)),
+        )
+        if method == "ergodic":
+            return traj
+        return optimise_ergodic(
+            traj, model.exploration, speed=model.speed, angular_speed=model.angular_speed
         )
     ex = model.exploration
     var = np.diag(ex.cov)
