@@ -17,6 +17,7 @@ import numpy as np
 
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.ergodic import ergodic_metric, ergodic_trajectory
+from teachfit.trajectories.ergodic_opt import optimise_ergodic
 from teachfit.trajectories.tshix import TshixPlanner, metric_weights
 from teachfit.trajectories.tsp import open_tour
 
@@ -75,9 +76,14 @@ def main() -> None:
             erg = ergodic_trajectory(expl, speed=0.01, length=length, length_scale=ls)
             times.append(time.perf_counter() - t0)
         e_tshix = ergodic_metric(tr.states, expl, t=tr.t)
+        t0 = time.perf_counter()
+        opt = optimise_ergodic(erg, expl, speed=0.01)
+        t_opt = time.perf_counter() - t0
         print(
             f"  D={len(dims)} length {length:.3f} m: {np.median(times):.3f} s wall; "
-            f"ergodic metric: ergodic {erg.meta['ergodic_metric']:.4f}, TSHIX {e_tshix:.4f}"
+            f"ergodic metric: ergodic {erg.meta['ergodic_metric']:.4f}, TSHIX {e_tshix:.4f}; "
+            f"optimised {opt.meta['ergodic_metric']:.4f} in {t_opt:.2f} s "
+            f"(length {opt.path_length(ls):.3f} m)"
         )
 
 
