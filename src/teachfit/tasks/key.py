@@ -142,14 +142,6 @@ class Key(SkillTask):
         return self.params.slot_depth
 
     @property
-    def success_depth(self) -> float:
-        return self.params.success_depth
-
-    @property
-    def capture_radius(self) -> float:
-        return self.params.clearance + 1e-4
-
-    @property
     def rz_tolerance(self) -> float:
         """Twice the yaw play of a centred blade plus 0.01 rad for soft-contact penetration."""
         p = self.params

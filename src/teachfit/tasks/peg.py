@@ -124,14 +124,6 @@ class AluminiumPeg(SkillTask):
         return self.params.hole_depth
 
     @property
-    def success_depth(self) -> float:
-        return self.params.success_depth
-
-    @property
-    def capture_radius(self) -> float:
-        return self.params.clearance + 1e-4
-
-    @property
     def held_part_length(self) -> float:
         return self.params.peg_length
 

@@ -134,14 +134,6 @@ class Puzzle(SkillTask):
         return self.params.hole_depth
 
     @property
-    def success_depth(self) -> float:
-        return self.params.success_depth
-
-    @property
-    def capture_radius(self) -> float:
-        return self.params.clearance + 1e-4
-
-    @property
     def rz_tolerance(self) -> float:
         """Twice the yaw play of a centred piece plus 0.01 rad for soft-contact penetration."""
         return 2 * self.params.clearance / self.params.side_length + 0.01

@@ -25,7 +25,7 @@ import numpy as np
 
 from teachfit.errors import TaskError
 from teachfit.pose import Pose
-from teachfit.tasks.base import ContactParams, Task
+from teachfit.tasks.base import Task
 
 
 def doc_field(text: str, default: float | int) -> Any:
@@ -80,9 +80,13 @@ class SkillTask(Task):
     params: SkillProtocolParams
 
     @property
-    def contact(self) -> ContactParams:
-        """Contact model of this cell (``build_scene`` uses it): the defaults, own friction."""
-        return ContactParams(friction=self.params.friction)
+    def success_depth(self) -> float:
+        return float(self.params.success_depth)  # type: ignore[attr-defined]
+
+    @property
+    def capture_radius(self) -> float:
+        """The part's clearance plus 0.1 mm of soft-contact give (m)."""
+        return float(self.params.clearance) + 1e-4  # type: ignore[attr-defined]
 
     @property
     @abstractmethod
