@@ -33,7 +33,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import mujoco
 import numpy as np
 
 from teachfit.control.adaptive_params import (
@@ -42,7 +41,13 @@ from teachfit.control.adaptive_params import (
     MetaBounds,
     meta_bounds,
 )
-from teachfit.control.impedance import ImpedanceLimits, clipped_twist, critical_damping
+from teachfit.control.impedance import (
+    ImpedanceLimits,
+    SetpointError,
+    clip_wrench,
+    clipped_twist,
+    critical_damping,
+)
 from teachfit.errors import ControlError
 from teachfit.robot.interface import ImpedanceCommand
 
@@ -119,19 +124,11 @@ class AdaptiveImpedance:
         self._k_room = np.zeros(6)
         self._d0 = np.zeros((6, 6))
         self._xi = 1.0
-        self._xd = np.zeros(3)
-        self._qd = np.array([1.0, 0.0, 0.0, 0.0])
-        self._vd = np.zeros(6)
+        self._error = SetpointError()
         self._fd = np.zeros(6)
-        self._t0 = 0.0
-        self._err = np.zeros(6)
-        self._derr = np.zeros(6)
         self._eps = np.zeros(6)
         self._step = np.zeros(6)
         self._tmp = np.zeros(6)
-        self._qtmp = np.zeros(4)
-        self._rtmp = np.zeros(3)
-        self._spinning = False
         self._has_cmd = False
         self.last_wrench = np.zeros(6)
 
@@ -185,12 +182,8 @@ class AdaptiveImpedance:
             self._d0[:] = critical_damping(self._k0, self.mass, cmd.damping_ratio)
         else:
             self._d0[:] = cmd.damping
-        self._vd[:] = clipped_twist(cmd, ilim)
-        self._spinning = bool(np.any(self._vd[3:] != 0.0))
-        self._xd[:] = cmd.pos
-        self._qd[:] = cmd.quat
+        self._error.set(cmd, clipped_twist(cmd, ilim), t)
         self._fd[:] = cmd.wrench_ff
-        self._t0 = t
         self._has_cmd = True
 
     def _adaptive_damping(self, out: np.ndarray) -> np.ndarray:
@@ -216,20 +209,9 @@ class AdaptiveImpedance:
         """
         if not self._has_cmd:
             raise ControlError("compute() called before set_command()")
-        # errors exactly as in CartesianImpedance (x_d extrapolated with the desired twist)
-        dt = t - self._t0
-        err, derr, eps, step, tmp = self._err, self._derr, self._eps, self._step, self._tmp
-        np.subtract(self._xd, pos, out=err[:3])
-        err[:3] += self._vd[:3] * dt
-        qd = self._qd
-        if self._spinning:
-            qd = self._qtmp
-            qd[:] = self._qd
-            mujoco.mju_quatIntegrate(qd, self._vd[3:], dt)
-        mujoco.mju_subQuat(self._rtmp, qd, quat)
-        mujoco.mju_rotVecQuat(err[3:], self._rtmp, quat)
-        np.subtract(self._vd[:3], lin_vel, out=derr[:3])
-        np.subtract(self._vd[3:], ang_vel, out=derr[3:])
+        # the same errors as CartesianImpedance (x_d extrapolated with the desired twist)
+        err, derr = self._error.update(t, pos, quat, lin_vel, ang_vel)
+        eps, step, tmp = self._eps, self._step, self._tmp
         # eps = de + kappa e
         np.multiply(self._kappa, err, out=eps)
         eps += derr
@@ -265,12 +247,6 @@ class AdaptiveImpedance:
         w += tmp
         w += self._fd
         w += self._ff_adapt
-        ilim = self.impedance_limits
-        fn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-        if fn > ilim.max_force:
-            w[:3] *= ilim.max_force / fn
-        tn = np.sqrt(w[3] * w[3] + w[4] * w[4] + w[5] * w[5])
-        if tn > ilim.max_torque:
-            w[3:] *= ilim.max_torque / tn
+        clip_wrench(w, self.impedance_limits)
         self.last_wrench = w
         return w

@@ -80,6 +80,66 @@ def aligned_stiffness(
     return out
 
 
+class SetpointError:
+    """Pose and twist errors to a command's set-point, extrapolated with its twist.
+
+    ``x_d(t) = x_d + v_d (t - t_0)`` and ``q_d(t) = q_d ⊗ exp(ω_d (t - t_0))``; the errors are
+    ``e = [x_d(t) - x; r]`` with ``q ⊗ exp(r_tool) = q_d(t)`` and ``r`` the rotation vector in the
+    world frame, and ``de = v_d - [v; ω]`` (m, rad, m/s, rad/s, world frame at the TCP). Shared by
+    the fixed-gain and the adaptive controller; buffers are allocated once (1 kHz path).
+    """
+
+    def __init__(self) -> None:
+        self.err = np.zeros(6)
+        self.derr = np.zeros(6)
+        self._xd = np.zeros(3)
+        self._qd = np.array([1.0, 0.0, 0.0, 0.0])
+        self._vd = np.zeros(6)
+        self._t0 = 0.0
+        self._qtmp = np.zeros(4)
+        self._rtmp = np.zeros(3)
+        self._spinning = False
+
+    def set(self, cmd: ImpedanceCommand, twist: np.ndarray, t: float) -> None:
+        """Adopt ``cmd``'s set-point with the (already limited) desired ``twist`` (6,) at ``t``."""
+        self._vd[:] = twist
+        self._spinning = bool(np.any(self._vd[3:] != 0.0))
+        self._xd[:] = cmd.pos
+        self._qd[:] = cmd.quat
+        self._t0 = t
+
+    def update(
+        self, t: float, pos: np.ndarray, quat: np.ndarray, lin_vel: np.ndarray, ang_vel: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``(e, de)`` (6,) each at time ``t``; views of buffers overwritten by the next call."""
+        dt = t - self._t0
+        err, derr = self.err, self.derr
+        np.subtract(self._xd, pos, out=err[:3])
+        err[:3] += self._vd[:3] * dt
+        qd = self._qd
+        if self._spinning:
+            qd = self._qtmp
+            qd[:] = self._qd
+            mujoco.mju_quatIntegrate(qd, self._vd[3:], dt)
+        # rotation vector r with q * exp(r) = q_d (tool frame), then expressed in the world
+        mujoco.mju_subQuat(self._rtmp, qd, quat)
+        mujoco.mju_rotVecQuat(err[3:], self._rtmp, quat)
+        np.subtract(self._vd[:3], lin_vel, out=derr[:3])
+        np.subtract(self._vd[3:], ang_vel, out=derr[3:])
+        return err, derr
+
+
+def clip_wrench(w: np.ndarray, limits: ImpedanceLimits) -> np.ndarray:
+    """Scale force and torque of ``w`` (6,) in place to at most the limits' norms; returns w."""
+    fn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    if fn > limits.max_force:
+        w[:3] *= limits.max_force / fn
+    tn = np.sqrt(w[3] * w[3] + w[4] * w[4] + w[5] * w[5])
+    if tn > limits.max_torque:
+        w[3:] *= limits.max_torque / tn
+    return w
+
+
 class CartesianImpedance:
     """Cartesian impedance controller; see the module docstring for the law.
 
@@ -99,16 +159,8 @@ class CartesianImpedance:
         # buffers allocated once; the per-tick path below allocates as little as possible
         self._k = np.zeros((6, 6))
         self._d = np.zeros((6, 6))
-        self._xd = np.zeros(3)
-        self._qd = np.array([1.0, 0.0, 0.0, 0.0])
-        self._vd = np.zeros(6)
         self._ff = np.zeros(6)
-        self._t0 = 0.0
-        self._err = np.zeros(6)
-        self._derr = np.zeros(6)
-        self._qtmp = np.zeros(4)
-        self._rtmp = np.zeros(3)
-        self._spinning = False
+        self._error = SetpointError()
         self._has_cmd = False
         self.last_wrench = np.zeros(6)
 
@@ -124,12 +176,8 @@ class CartesianImpedance:
             self._d[:] = critical_damping(self._k, self.mass, cmd.damping_ratio)
         else:
             self._d[:] = cmd.damping
-        self._vd[:] = clipped_twist(cmd, lim)
-        self._spinning = bool(np.any(self._vd[3:] != 0.0))
-        self._xd[:] = cmd.pos
-        self._qd[:] = cmd.quat
+        self._error.set(cmd, clipped_twist(cmd, lim), t)
         self._ff[:] = cmd.wrench_ff
-        self._t0 = t
         self._has_cmd = True
 
     def compute(
@@ -146,29 +194,10 @@ class CartesianImpedance:
         """
         if not self._has_cmd:
             raise ControlError("compute() called before set_command()")
-        dt = t - self._t0
-        err, derr = self._err, self._derr
-        np.subtract(self._xd, pos, out=err[:3])
-        err[:3] += self._vd[:3] * dt
-        qd = self._qd
-        if self._spinning:
-            qd = self._qtmp
-            qd[:] = self._qd
-            mujoco.mju_quatIntegrate(qd, self._vd[3:], dt)
-        # rotation vector r with q * exp(r) = q_d (tool frame), then expressed in the world
-        mujoco.mju_subQuat(self._rtmp, qd, quat)
-        mujoco.mju_rotVecQuat(err[3:], self._rtmp, quat)
-        np.subtract(self._vd[:3], lin_vel, out=derr[:3])
-        np.subtract(self._vd[3:], ang_vel, out=derr[3:])
+        err, derr = self._error.update(t, pos, quat, lin_vel, ang_vel)
         w = self._k @ err
         w += self._d @ derr
         w += self._ff
-        lim = self.limits
-        fn = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-        if fn > lim.max_force:
-            w[:3] *= lim.max_force / fn
-        tn = np.sqrt(w[3] * w[3] + w[4] * w[4] + w[5] * w[5])
-        if tn > lim.max_torque:
-            w[3:] *= lim.max_torque / tn
+        clip_wrench(w, self.limits)
         self.last_wrench = w
         return w
