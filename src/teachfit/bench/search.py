@@ -24,6 +24,7 @@ import numpy as np
 from teachfit.bench.search_jobs import JobResult, SearchJob, model_json, pose_tuple, run_jobs
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.demonstrations.teacher import BlindTeacher
+from teachfit.errors import TeachfitError
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
 from teachfit.pose import Pose
@@ -189,7 +190,7 @@ def _socket_demos(task: object, seed: int) -> list[Demonstration]:
                 demos.append(demo)
                 break
         else:
-            raise RuntimeError("the teacher failed six times from one end of the socket")
+            raise TeachfitError("the teacher failed six times from one end of the socket")
     return demos
 
 
