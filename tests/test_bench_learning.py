@@ -16,11 +16,21 @@ from teachfit.viz.learning_figures import plot_best_execution, plot_learning_cur
 
 def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
     seen: list[str] = []
-    bench = run_learning_bench(["key"], ["cmaes", "lhs"], 2, 6, workers=0, n_starts=1,
-                               seed=5, on_trial=lambda label, _r: seen.append(label))
+    bench = run_learning_bench(
+        ["key"],
+        ["cmaes", "lhs"],
+        2,
+        6,
+        workers=0,
+        n_starts=1,
+        seed=5,
+        on_trial=lambda label, _r: seen.append(label),
+    )
     assert len(seen) == 2 * 2 * 6 and seen[0] == "key/cmaes #1"
-    assert [(c.task, c.method, c.n) for c in bench.cells] == [("key", "cmaes", 2),
-                                                              ("key", "lhs", 2)]
+    assert [(c.task, c.method, c.n) for c in bench.cells] == [
+        ("key", "cmaes", 2),
+        ("key", "lhs", 2),
+    ]
     for cell in bench.cells:
         exps = [e for e in bench.experiments if e.method == cell.method]
         assert [e.seed for e in exps] == [5, 6] and all(len(e.costs) == 6 for e in exps)
@@ -43,21 +53,58 @@ def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
         assert cell.trials_per_s > 0
     text = to_markdown(bench)
     assert text.count("| key |") == 2 and "robot time" in text
-    path = plot_learning_curves({(c.task, c.method): c.curve for c in bench.cells},
-                                tmp_path / "fig6.png")
+    path = plot_learning_curves(
+        {(c.task, c.method): c.curve for c in bench.cells}, tmp_path / "fig6.png"
+    )
     assert path.stat().st_size > 10_000
 
 
 def test_bench_learning_cli_and_best_execution_figure(tmp_path: Path) -> None:
     md, fig = tmp_path / "bench.md", tmp_path / "curves.png"
-    res = CliRunner().invoke(app, [
-        "bench", "learning", "--tasks", "key", "--methods", "lhs", "--experiments", "2",
-        "--trials", "3", "--starts", "1", "--workers", "0", "--no-target",
-        "--speedup-trials", "0", "--plot", str(fig), "--markdown", str(md)])
+    res = CliRunner().invoke(
+        app,
+        [
+            "bench",
+            "learning",
+            "--tasks",
+            "key",
+            "--methods",
+            "lhs",
+            "--experiments",
+            "2",
+            "--trials",
+            "3",
+            "--starts",
+            "1",
+            "--workers",
+            "0",
+            "--no-target",
+            "--speedup-trials",
+            "0",
+            "--plot",
+            str(fig),
+            "--markdown",
+            str(md),
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "| key | lhs |" in md.read_text() and fig.stat().st_size > 10_000
-    res = CliRunner().invoke(app, ["bench", "learning", "--tasks", "key", "--methods", "sgd",
-                                   "--experiments", "1", "--trials", "2", "--no-target"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "bench",
+            "learning",
+            "--tasks",
+            "key",
+            "--methods",
+            "sgd",
+            "--experiments",
+            "1",
+            "--trials",
+            "2",
+            "--no-target",
+        ],
+    )
     assert res.exit_code == 2 and "unknown method(s) ['sgd']" in res.output
     obj = SkillObjective("key", n_starts=1)
     trace = obj.outcome(None).traces[0]

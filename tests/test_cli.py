@@ -33,8 +33,19 @@ def test_record_show_render_round_trip(tmp_path):
     assert res.exit_code == 2 and "exists" in res.output  # never overwrites silently
     out = tmp_path / "demo0.mp4"
     res = invoke(
-        "render", "--task", "peg2d", "--demo", f"{demos}:0", "--out", out,
-        "--fps", "5", "--width", "160", "--height", "120",
+        "render",
+        "--task",
+        "peg2d",
+        "--demo",
+        f"{demos}:0",
+        "--out",
+        out,
+        "--fps",
+        "5",
+        "--width",
+        "160",
+        "--height",
+        "120",
     )
     if res.exit_code == 2 and "rendering is unavailable" in res.output:
         pytest.skip("no OpenGL on this machine")
@@ -45,8 +56,15 @@ def test_record_show_render_round_trip(tmp_path):
 def test_import_csv_and_clear_errors(tmp_path):
     out = tmp_path / "demos.h5"
     res = invoke(
-        "demo", "import", EXAMPLES / "robot_log.csv", "--task", "peg2d",
-        "--columns", EXAMPLES / "columns.toml", "--out", out,
+        "demo",
+        "import",
+        EXAMPLES / "robot_log.csv",
+        "--task",
+        "peg2d",
+        "--columns",
+        EXAMPLES / "columns.toml",
+        "--out",
+        out,
     )
     assert res.exit_code == 0, res.output
     assert "imported" in res.output
@@ -57,8 +75,15 @@ def test_import_csv_and_clear_errors(tmp_path):
     text[5] = ",".join(cells)
     bad.write_text("\n".join(text) + "\n")
     res = invoke(
-        "demo", "import", bad, "--task", "peg2d", "--columns", EXAMPLES / "columns.toml",
-        "--out", tmp_path / "other.h5",
+        "demo",
+        "import",
+        bad,
+        "--task",
+        "peg2d",
+        "--columns",
+        EXAMPLES / "columns.toml",
+        "--out",
+        tmp_path / "other.h5",
     )
     assert res.exit_code == 2
     assert "row 6" in res.output.replace("\n", " ")
@@ -96,12 +121,25 @@ def test_learn_plan_run_search(tmp_path):
     model = tmp_path / "peg.model"
     res = invoke("learn", "search", demos, "--out", model)
     assert res.exit_code == 0, res.output
-    res = invoke("search", "plan", model, "--method", "tshix", "-n", "50", "--plot",
-                 tmp_path / "plan.png")
+    res = invoke(
+        "search", "plan", model, "--method", "tshix", "-n", "50", "--plot", tmp_path / "plan.png"
+    )
     assert res.exit_code == 0, res.output
     assert "ergodic metric" in res.output and (tmp_path / "plan.png").exists()
-    res = invoke("search", "run", "--task", "peg2d", "--model", model, "-n", "50",
-                 "--starts", "1", "--demo", f"{demos}:0")
+    res = invoke(
+        "search",
+        "run",
+        "--task",
+        "peg2d",
+        "--model",
+        model,
+        "-n",
+        "50",
+        "--starts",
+        "1",
+        "--demo",
+        f"{demos}:0",
+    )
     assert res.exit_code == 0, res.output
     assert "starts" in res.output
     res = invoke("search", "run", "--task", "socket3d", "--model", model, "--starts", "1")

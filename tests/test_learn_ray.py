@@ -28,11 +28,18 @@ def objective(p: dict[str, float]) -> float:
 
 
 def test_a_tiny_study_on_a_local_ray_instance(tmp_path: Path) -> None:
-    study = Study(tmp_path / "ray.db", task="puzzle", skill="peg-in-hole", space=SPACE,
-                  method="lhs", seed=0, options={"n": 12}, penalty=50.0)
+    study = Study(
+        tmp_path / "ray.db",
+        task="puzzle",
+        skill="peg-in-hole",
+        space=SPACE,
+        method="lhs",
+        seed=0,
+        options={"n": 12},
+        penalty=50.0,
+    )
     seen = []
-    report = run_study_ray(study, objective, 12, address="local", workers=1,
-                           on_trial=seen.append)
+    report = run_study_ray(study, objective, 12, address="local", workers=1, on_trial=seen.append)
     assert not ray.is_initialized()  # the instance it started is shut down again
     trials = study.trials()
     assert report.finished == len(trials) == len(seen) == 12
@@ -48,8 +55,14 @@ def test_a_tiny_study_on_a_local_ray_instance(tmp_path: Path) -> None:
 
 
 def test_an_unreachable_ray_address_fails_fast_with_a_clear_error(tmp_path: Path) -> None:
-    study = Study(tmp_path / "r.db", task="puzzle", skill="peg-in-hole", space=SPACE,
-                  method="lhs", options={"n": 2})
+    study = Study(
+        tmp_path / "r.db",
+        task="puzzle",
+        skill="peg-in-hole",
+        space=SPACE,
+        method="lhs",
+        options={"n": 2},
+    )
     with pytest.raises(LearningError, match="no Ray cluster reachable at '127.0.0.1:1'"):
         run_study_ray(study, objective, 2, address="127.0.0.1:1")
     with pytest.raises(LearningError, match="HOST:PORT"):

@@ -32,9 +32,17 @@ def test_skill_objective_runs_in_worker_processes_and_stores_sim_time(tmp_path: 
     space = obj.space
     assert "force" in space.names and "alpha_t" in space.names  # skill + adaptive controller
     direct = obj(space.from_unit([0.5] * space.dim))
-    study = Study(tmp_path / "s.db", task="puzzle", skill="peg-in-hole", space=space,
-                  method="lhs", seed=1, options={"n": 4}, penalty=obj.penalty,
-                  context=obj.context())
+    study = Study(
+        tmp_path / "s.db",
+        task="puzzle",
+        skill="peg-in-hole",
+        space=space,
+        method="lhs",
+        seed=1,
+        options={"n": 4},
+        penalty=obj.penalty,
+        context=obj.context(),
+    )
     report = run_study(study, obj, 4, workers=2)
     recs = study.trials()
     assert report.finished == 4 and report.failed == 0 and len(recs) == 4
@@ -49,8 +57,21 @@ def test_skill_objective_runs_in_worker_processes_and_stores_sim_time(tmp_path: 
 
 def test_learn_resume_mismatch_and_best_params_file(tmp_path: Path) -> None:
     db, best = tmp_path / "runs" / "p.db", tmp_path / "best.toml"
-    res = cli(*QUICK, "--trials", 5, "--study", db, "--workers", 0, "--out", best,
-              "--plot", tmp_path / "c.png", "--traces", tmp_path / "t.png")
+    res = cli(
+        *QUICK,
+        "--trials",
+        5,
+        "--study",
+        db,
+        "--workers",
+        0,
+        "--out",
+        best,
+        "--plot",
+        tmp_path / "c.png",
+        "--traces",
+        tmp_path / "t.png",
+    )
     assert res.exit_code == 0, res.output
     assert "best: trial" in res.output and (tmp_path / "c.png").stat().st_size > 0
     obj = SkillObjective("puzzle", n_starts=1)
@@ -60,10 +81,35 @@ def test_learn_resume_mismatch_and_best_params_file(tmp_path: Path) -> None:
     assert res.exit_code == 2 and "already has 5 trials" in res.output and "--resume" in res.output
     res = cli(*QUICK, "--trials", 7, "--study", db, "--workers", 0, "--resume")
     assert res.exit_code == 0 and "5 trial(s) restored" in res.output
-    assert len(Study(db, task="puzzle", skill="peg-in-hole", space=obj.space, method="cmaes",
-                     penalty=obj.penalty, context=obj.context()).trials()) == 7
-    res = cli("--task", "key", "--starts", "1", "--method", "cmaes", "--trials", 8, "--study", db,
-              "--resume", "--workers", 0)
+    assert (
+        len(
+            Study(
+                db,
+                task="puzzle",
+                skill="peg-in-hole",
+                space=obj.space,
+                method="cmaes",
+                penalty=obj.penalty,
+                context=obj.context(),
+            ).trials()
+        )
+        == 7
+    )
+    res = cli(
+        "--task",
+        "key",
+        "--starts",
+        "1",
+        "--method",
+        "cmaes",
+        "--trials",
+        8,
+        "--study",
+        db,
+        "--resume",
+        "--workers",
+        0,
+    )
     assert res.exit_code == 2 and "task: stored 'puzzle', asked 'key'" in res.output
     res = cli(*QUICK, "--trials", 8, "--study", db, "--resume", "--controller", "impedance")
     assert res.exit_code == 2 and "differs" in res.output and "space" in res.output
@@ -83,9 +129,23 @@ def _stored(db: Path) -> int:
 def test_sigterm_mid_study_stops_cleanly_and_resume_loses_nothing(tmp_path: Path) -> None:
     db = tmp_path / "k.db"
     exe = Path(sys.executable).with_name("teachfit")
-    proc = subprocess.Popen([str(exe), "learn", "skill", *QUICK, "--trials", "300",
-                             "--study", str(db), "--workers", "1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.Popen(
+        [
+            str(exe),
+            "learn",
+            "skill",
+            *QUICK,
+            "--trials",
+            "300",
+            "--study",
+            str(db),
+            "--workers",
+            "1",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     try:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline and (not db.exists() or _stored(db) < 4):
@@ -102,8 +162,15 @@ def test_sigterm_mid_study_stops_cleanly_and_resume_loses_nothing(tmp_path: Path
     tags = stored_tags(db)
     assert tags is not None and tags["method"] == "cmaes" and tags["task"] == "puzzle"
     obj = SkillObjective("puzzle", n_starts=1)
-    kw = dict(task="puzzle", skill="peg-in-hole", space=obj.space, method="cmaes",
-              options={}, penalty=obj.penalty, context=obj.context())
+    kw = dict(
+        task="puzzle",
+        skill="peg-in-hole",
+        space=obj.space,
+        method="cmaes",
+        options={},
+        penalty=obj.penalty,
+        context=obj.context(),
+    )
     before = [(r.key, r.cost) for r in Study(db, **kw).trials()]  # type: ignore[arg-type]
     res = cli(*QUICK, "--trials", n1 + 3, "--study", db, "--workers", 0, "--resume")
     assert res.exit_code == 0, res.output

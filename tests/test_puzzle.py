@@ -190,8 +190,10 @@ def test_search_pose_and_registry(name: str) -> None:
     with pytest.raises(TaskError, match="search states"):
         t.search_pose(np.zeros(5), frame)
     assert t.contact.friction == t.params.friction
-    assert t.success_depth < t.hole_depth == pytest.approx(
-        getattr(t.params, "hole_depth", getattr(t.params, "slot_depth", None))
+    assert (
+        t.success_depth
+        < t.hole_depth
+        == pytest.approx(getattr(t.params, "hole_depth", getattr(t.params, "slot_depth", None)))
     )
     rows = [r[0] for r in t.param_table()]
     assert rows[-1] == "friction"  # the shared protocol parameters come last

@@ -29,9 +29,31 @@ def test_skill_run_with_params_plot_and_render(tmp_path):
     best = tmp_path / "best.toml"
     best.write_text("force = 10.0\nspeed_factor = 0.8\n")
     plot, video = tmp_path / "run.png", tmp_path / "run.mp4"
-    res = invoke("skill", "run", "peg-in-hole", "--task", "peg2d", "--params", best,
-                 "--controller", "impedance", "--starts", "1", "--seed", "3", "--plot", plot,
-                 "--render", video, "--fps", "5", "--width", "160", "--height", "120")
+    res = invoke(
+        "skill",
+        "run",
+        "peg-in-hole",
+        "--task",
+        "peg2d",
+        "--params",
+        best,
+        "--controller",
+        "impedance",
+        "--starts",
+        "1",
+        "--seed",
+        "3",
+        "--plot",
+        plot,
+        "--render",
+        video,
+        "--fps",
+        "5",
+        "--width",
+        "160",
+        "--height",
+        "120",
+    )
     if res.exit_code == 2 and "rendering is unavailable" in res.output:
         pytest.skip("no OpenGL on this machine")
     assert res.exit_code == 0, res.output

@@ -42,8 +42,10 @@ def test_default_skill_inserts_despite_hole_pose_error(task, controller):
         assert len(visited) >= 4 and tr.inserted
         assert 0.0 < tr.t_first_contact < tr.t_end < 5.0
         assert cost == pytest.approx(tr.t_end - tr.t_first_contact)
-        assert all(a.t_exit == pytest.approx(b.t_enter)
-                   for a, b in zip(tr.visits, tr.visits[1:], strict=False))
+        assert all(
+            a.t_exit == pytest.approx(b.t_enter)
+            for a, b in zip(tr.visits, tr.visits[1:], strict=False)
+        )
         assert tr.steps == pytest.approx(tr.t_end * 1000, abs=15)
         assert tr.log.t.size > 50 and np.all(np.diff(tr.log.t) > 0)
     assert out.as_result().feasible and out.success_rate == 1.0
@@ -53,15 +55,17 @@ def test_failure_costs_limit_plus_factor_times_remaining(task):
     # estimate 6 mm off: the part lands beside the hole and cannot be inserted
     setup = _with_error(peg_in_hole_setup(task, seed=2, controller="impedance"), 6e-3, 0.0)
     setup = dataclasses.replace(setup, skill=setup.skill.with_context({"t_max": 1.6}))
-    trial = SkillTrial(setup, controller="impedance",
-                       metric=LearningMetric(time_limit=1.6, distance_factor=100.0))
+    trial = SkillTrial(
+        setup, controller="impedance", metric=LearningMetric(time_limit=1.6, distance_factor=100.0)
+    )
     out = trial(starts=setup.starts[:1])
     tr = out.traces[0]
     assert not out.successes[0] and tr.outcome == "error" and tr.inserted is False
     truth = setup.goal2world.pos
     assert tr.remaining > 0.004
-    assert tr.remaining == pytest.approx(np.linalg.norm(tr.log.pos[tr.log.t <= tr.t_end][-1]
-                                                        - truth), abs=2e-3)
+    assert tr.remaining == pytest.approx(
+        np.linalg.norm(tr.log.pos[tr.log.t <= tr.t_end][-1] - truth), abs=2e-3
+    )
     assert out.costs[0] == pytest.approx(1.6 + 100.0 * tr.remaining)
     assert tr.visits[-1].node == "retract"  # the recovery node ran after the error
     assert LearningMetric(1.6, 100.0).evaluate(tr) == (False, out.costs[0])
@@ -89,8 +93,14 @@ def test_diverging_simulation_fails_the_execution_without_raising(task):
         robot.ticks = 10_000
         robot.step(1)
     robot.ticks = 0
-    tr = execute(setup.skill, robot, setup.starts[0], setup.task2world, task=task,
-                 goal2world=setup.goal2world)  # ... the execution does not
+    tr = execute(
+        setup.skill,
+        robot,
+        setup.starts[0],
+        setup.task2world,
+        task=task,
+        goal2world=setup.goal2world,
+    )  # ... the execution does not
     assert tr.outcome == "diverged" and not tr.success and "diverged" in tr.reason
     assert tr.t_end == pytest.approx(0.3, abs=0.02) and math.isfinite(tr.remaining)
     ok, cost = LearningMetric().evaluate(tr)
@@ -101,8 +111,14 @@ def test_precondition_blocks_the_start(task):
     setup = peg_in_hole_setup(task, seed=0, controller="impedance")
     skill = dataclasses.replace(setup.skill, pre=TimeAbove(1.0, scope="skill"))
     robot = FloatingToolRobot(task)
-    tr = execute(skill, robot, setup.starts[0], setup.task2world, task=task,
-                 config=ExecConfig(recovery_time=0.0))
+    tr = execute(
+        skill,
+        robot,
+        setup.starts[0],
+        setup.task2world,
+        task=task,
+        config=ExecConfig(recovery_time=0.0),
+    )
     assert tr.outcome == "precondition" and tr.steps == 0 and tr.visits == ()
 
 

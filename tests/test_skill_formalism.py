@@ -66,8 +66,14 @@ def test_synchronized_profile_keeps_every_limit():
 def _percept(force=(0, 0, 0), pos=(0, 0, 0), vel=(0, 0, 0), t=0.0):
     pc = Percept(Pose.from_xyz_rz(0.1, 0.0, 0.5, math.pi / 2), 0.01)
     # world quantities for a task frame rotated +90 deg about z: task x = world y
-    state = RobotState(t, np.array(pos, float) + [0.1, 0, 0.5], np.array([1.0, 0, 0, 0]),
-                       np.array(vel, float), np.zeros(3), np.array([*force, 0, 0, 0], float))
+    state = RobotState(
+        t,
+        np.array(pos, float) + [0.1, 0, 0.5],
+        np.array([1.0, 0, 0, 0]),
+        np.array(vel, float),
+        np.zeros(3),
+        np.array([*force, 0, 0, 0], float),
+    )
     pc.update(state, t)
     return pc
 
@@ -108,8 +114,13 @@ def test_speed_below_must_be_sustained_and_restarts_per_node():
 
 
 def test_condition_toml_round_trip_and_errors():
-    cond = Any_((ForceAbove("f_lateral", axis="-x"),
-                 All((TimeAbove(0.2), SpeedBelow("v", duration=0.1))), ~DepthAbove(0.01)))
+    cond = Any_(
+        (
+            ForceAbove("f_lateral", axis="-x"),
+            All((TimeAbove(0.2), SpeedBelow("v", duration=0.1))),
+            ~DepthAbove(0.01),
+        )
+    )
     assert condition_from_toml(cond.to_toml()) == cond
     assert cond.refs() == {"f_lateral", "v"}
     with pytest.raises(SkillError, match="unknown condition kind 'hot'"):
@@ -126,8 +137,16 @@ def _params(**learned):
 
 
 def _skill(nodes, transitions, params=None, **kw):
-    return Skill("test", tuple(nodes), tuple(transitions), nodes[0].name,
-                 params or _params(), DepthAbove(0.01), TimeAbove("t_lim", scope="skill"), **kw)
+    return Skill(
+        "test",
+        tuple(nodes),
+        tuple(transitions),
+        nodes[0].name,
+        params or _params(),
+        DepthAbove(0.01),
+        TimeAbove("t_lim", scope="skill"),
+        **kw,
+    )
 
 
 _TIMEOUT = TimeAbove(1.0)
@@ -220,8 +239,11 @@ def test_toml_errors_name_the_node(tmp_path):
     data = tomllib.loads(skill_to_toml(peg_in_hole.build("impedance")))
     del data["nodes"]["lateral"]["error"]
     bad = tmp_path / "bad.toml"
-    bad.write_text(skill_to_toml(peg_in_hole.build("impedance")).replace(
-        'primitive = "insert"', 'primitive = "insert"\nwobble = 1.0'))
+    bad.write_text(
+        skill_to_toml(peg_in_hole.build("impedance")).replace(
+            'primitive = "insert"', 'primitive = "insert"\nwobble = 1.0'
+        )
+    )
     with pytest.raises(SkillError, match=r"bad.toml: node 'insert'.*unknown field.*wobble") as e:
         load_skill(bad)
     assert e.value.node == "insert"

@@ -140,8 +140,19 @@ def test_bad_protocol(task: Socket3D) -> None:
 def test_flat_wedges_tile_the_square_minus_the_hole() -> None:
     k, r, hw = 16, 0.0022, 0.0095
     vols = [
-        ConvexHull(valley_wedge((0.0, 0.0), 2 * np.pi * i / k, 2 * np.pi * (i + 1) / k, r, hw,
-                                0.0, 0.01, 0.01, 0.005)).volume
+        ConvexHull(
+            valley_wedge(
+                (0.0, 0.0),
+                2 * np.pi * i / k,
+                2 * np.pi * (i + 1) / k,
+                r,
+                hw,
+                0.0,
+                0.01,
+                0.01,
+                0.005,
+            )
+        ).volume
         for i in range(k)
     ]
     hole_area = k * r**2 * np.tan(np.pi / k)  # polygon circumscribing the hole circle

@@ -27,8 +27,16 @@ from teachfit.learning.objective import SkillObjective
 from teachfit.learning.runner import run_study
 from teachfit.learning.study import METHODS, Study, TrialRecord
 
-__all__ = ["CellStats", "Experiment", "LearningBench", "method_options", "run_experiment",
-           "run_learning_bench", "speedup", "to_markdown"]
+__all__ = [
+    "CellStats",
+    "Experiment",
+    "LearningBench",
+    "method_options",
+    "run_experiment",
+    "run_learning_bench",
+    "speedup",
+    "to_markdown",
+]
 
 
 def method_options(method: str, trials: int) -> dict[str, object]:
@@ -56,17 +64,24 @@ class Experiment:
     wall_s: float
 
     @staticmethod
-    def from_records(task: str, method: str, seed: int, recs: Sequence[TrialRecord],
-                     wall_s: float) -> Experiment:
+    def from_records(
+        task: str, method: str, seed: int, recs: Sequence[TrialRecord], wall_s: float
+    ) -> Experiment:
         if not recs:
             raise LearningError(f"{task}/{method} seed {seed}: no trial finished")
         ok = [r for r in recs if r.feasible] or list(recs)
         best = min(ok, key=lambda r: r.cost)
-        return Experiment(task, method, seed, tuple(r.cost for r in recs),
-                          tuple(r.feasible for r in recs),
-                          tuple(r.info.get("sim_s", 0.0) for r in recs),
-                          tuple(r.info.get("success_rate", 0.0) for r in recs),
-                          dict(best.params), wall_s)
+        return Experiment(
+            task,
+            method,
+            seed,
+            tuple(r.cost for r in recs),
+            tuple(r.feasible for r in recs),
+            tuple(r.info.get("sim_s", 0.0) for r in recs),
+            tuple(r.info.get("success_rate", 0.0) for r in recs),
+            dict(best.params),
+            wall_s,
+        )
 
     @property
     def best_index(self) -> int:
@@ -111,16 +126,22 @@ class CellStats:
         n_trials = sum(len(e.costs) for e in exps)
         wall = float(np.mean([e.wall_s for e in exps]))
         return CellStats(
-            exps[0].task, exps[0].method, len(exps), float(best.mean()),
+            exps[0].task,
+            exps[0].method,
+            len(exps),
+            float(best.mean()),
             float(best.std(ddof=1)) if len(exps) > 1 else 0.0,
             float(np.mean([e.success_rate[e.best_index] for e in exps])),
             float(np.mean([e.first_feasible for e in ok])) if ok else math.nan,
-            len(exps) - len(ok), float(np.mean(ins)) if ins else math.nan,
+            len(exps) - len(ok),
+            float(np.mean(ins)) if ins else math.nan,
             float(np.mean([e.sim_min_until(e.first_feasible) for e in ok])) if ok else math.nan,
             float(np.mean([e.sim_min_until(e.best_index + 1) for e in exps])),
             float(np.mean([e.sim_min_until(len(e.costs)) for e in exps])),
-            wall, n_trials / (wall * len(exps)) if wall > 0 else math.nan,
-            band([best_so_far(e.costs) for e in exps]))
+            wall,
+            n_trials / (wall * len(exps)) if wall > 0 else math.nan,
+            band([best_so_far(e.costs) for e in exps]),
+        )
 
 
 @dataclass(frozen=True)
@@ -136,8 +157,13 @@ class LearningBench:
 
 
 def run_experiment(
-    objective: SkillObjective, method: str, trials: int, *, workers: int | None = None,
-    storage: str | Path | None = None, on_trial: Callable[[TrialRecord], None] | None = None,
+    objective: SkillObjective,
+    method: str,
+    trials: int,
+    *,
+    workers: int | None = None,
+    storage: str | Path | None = None,
+    on_trial: Callable[[TrialRecord], None] | None = None,
     handle_signals: bool = True,
 ) -> Experiment:
     """One learning run of ``trials`` trials; the study goes to ``storage`` (default: a
@@ -146,22 +172,42 @@ def run_experiment(
         raise LearningError(f"unknown method {method!r}; known: {list(METHODS)}")
     with tempfile.TemporaryDirectory(prefix="teachfit-bench-") as tmp:
         db = storage or Path(tmp) / "study.db"
-        study = Study(db, task=objective.task, skill=objective.skill, space=objective.space,
-                      method=method, seed=objective.seed,
-                      options=method_options(method, trials), penalty=objective.penalty,
-                      resume=False, context=objective.context(),
-                      name=f"{objective.task}-{method}-{objective.seed}")
+        study = Study(
+            db,
+            task=objective.task,
+            skill=objective.skill,
+            space=objective.space,
+            method=method,
+            seed=objective.seed,
+            options=method_options(method, trials),
+            penalty=objective.penalty,
+            resume=False,
+            context=objective.context(),
+            name=f"{objective.task}-{method}-{objective.seed}",
+        )
         t0 = time.perf_counter()
-        run_study(study, objective, trials, workers=workers, on_trial=on_trial,
-                  handle_signals=handle_signals)
+        run_study(
+            study,
+            objective,
+            trials,
+            workers=workers,
+            on_trial=on_trial,
+            handle_signals=handle_signals,
+        )
         wall = time.perf_counter() - t0
-        return Experiment.from_records(objective.task, method, objective.seed, study.trials(),
-                                       wall)
+        return Experiment.from_records(objective.task, method, objective.seed, study.trials(), wall)
 
 
 def run_learning_bench(
-    tasks: Sequence[str], methods: Sequence[str], experiments: int, trials: int, *,
-    workers: int | None = None, n_starts: int = 4, controller: str = "adaptive", seed: int = 0,
+    tasks: Sequence[str],
+    methods: Sequence[str],
+    experiments: int,
+    trials: int,
+    *,
+    workers: int | None = None,
+    n_starts: int = 4,
+    controller: str = "adaptive",
+    seed: int = 0,
     overrides: Mapping[str, float] | None = None,
     on_trial: Callable[[str, TrialRecord], None] | None = None,
 ) -> LearningBench:
@@ -178,16 +224,18 @@ def run_learning_bench(
         for method in methods:
             mine = []
             for e in range(experiments):
-                obj = SkillObjective(task, controller=controller, seed=seed + e,
-                                     n_starts=n_starts, task_overrides=ov)
+                obj = SkillObjective(
+                    task, controller=controller, seed=seed + e, n_starts=n_starts, task_overrides=ov
+                )
                 label = f"{task}/{method} #{e + 1}"
                 cb = None if on_trial is None else (lambda r, lb=label: on_trial(lb, r))
                 mine.append(run_experiment(obj, method, trials, workers=workers, on_trial=cb))
             cells.append(CellStats.of(mine))
             exps.extend(mine)
     n_workers = workers if workers is not None else _cores()
-    return LearningBench(tuple(cells), tuple(exps), trials, n_starts, n_workers,
-                         time.perf_counter() - t0)
+    return LearningBench(
+        tuple(cells), tuple(exps), trials, n_starts, n_workers, time.perf_counter() - t0
+    )
 
 
 def _cores() -> int:
@@ -196,8 +244,15 @@ def _cores() -> int:
     return os.cpu_count() or 1
 
 
-def speedup(task: str = "puzzle", method: str = "cmaes", trials: int = 24, workers: int = 2,
-            n_starts: int = 4, seed: int = 0, repeats: int = 2) -> tuple[float, float, float]:
+def speedup(
+    task: str = "puzzle",
+    method: str = "cmaes",
+    trials: int = 24,
+    workers: int = 2,
+    n_starts: int = 4,
+    seed: int = 0,
+    repeats: int = 2,
+) -> tuple[float, float, float]:
     """Wall time (s) of the same study with 1 and with ``workers`` workers, and the ratio.
 
     The runs alternate (1, N, 1, N, ...) ``repeats`` times and each count keeps its fastest
@@ -221,9 +276,11 @@ def _f(x: float, fmt: str = ".2f") -> str:
 
 def to_markdown(bench: LearningBench) -> str:
     """The grid as a markdown table (one row per task x method)."""
-    head = ("| task | method | best cost (s) | success of best | first feasible (trial) | "
-            "insertion time (s) | robot time to feasible / best / all (min) | wall (s) | "
-            "trials/s |\n|---|---|---|---|---|---|---|---|---|\n")
+    head = (
+        "| task | method | best cost (s) | success of best | first feasible (trial) | "
+        "insertion time (s) | robot time to feasible / best / all (min) | wall (s) | "
+        "trials/s |\n|---|---|---|---|---|---|---|---|---|\n"
+    )
     rows = []
     for c in bench.cells:
         never = f" ({c.never_feasible} never)" if c.never_feasible else ""
@@ -232,5 +289,6 @@ def to_markdown(bench: LearningBench) -> str:
             f"{100 * c.best_success:.0f} % | {_f(c.first_feasible_mean, '.1f')}{never} | "
             f"{_f(c.insertion_time, '.3f')} | {_f(c.sim_feasible_min)} / "
             f"{_f(c.sim_best_min)} / {_f(c.sim_total_min)} | {c.wall_s:.1f} | "
-            f"{c.trials_per_s:.2f} |")
+            f"{c.trials_per_s:.2f} |"
+        )
     return head + "\n".join(rows) + "\n"

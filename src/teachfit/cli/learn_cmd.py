@@ -31,8 +31,14 @@ def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
 
 
 def _bar() -> Progress:
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TimeElapsedColumn(), console=console, transient=True)
+    return Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    )
 
 
 def write_params_toml(path: Path, params: dict[str, float], header: str) -> Path:
@@ -50,23 +56,29 @@ def learn_skill(
     skill: Annotated[str, typer.Option(help="built-in skill or skill .toml")] = "peg-in-hole",
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
     trials: Annotated[int, typer.Option(help="trial budget (restored trials count)")] = 130,
-    study: Annotated[str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")]
-    = "runs/study.db",
+    study: Annotated[
+        str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")
+    ] = "runs/study.db",
     resume: Annotated[bool, typer.Option(help="continue a stored study")] = False,
-    workers: Annotated[int | None, typer.Option(help="worker processes (default: all cores; "
-                                                "0: in this process)")] = None,
-    ray: Annotated[str | None, typer.Option(help="run trials on Ray: 'local' or an address")]
-    = None,
+    workers: Annotated[
+        int | None, typer.Option(help="worker processes (default: all cores; 0: in this process)")
+    ] = None,
+    ray: Annotated[
+        str | None, typer.Option(help="run trials on Ray: 'local' or an address")
+    ] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
-    seed: Annotated[int, typer.Option(help="seed of the set-up (hole estimate, starts) and "
-                                      "of the learner")] = 0,
+    seed: Annotated[
+        int, typer.Option(help="seed of the set-up (hole estimate, starts) and of the learner")
+    ] = 0,
     starts: Annotated[int, typer.Option(help="executions (start poses) per trial")] = 4,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
     out: Annotated[Path | None, typer.Option(help="write the best parameters (TOML)")] = None,
     plot: Annotated[Path | None, typer.Option(help="learning curve figure")] = None,
     traces: Annotated[Path | None, typer.Option(help="parameter traces figure")] = None,
-    best_plot: Annotated[Path | None, typer.Option(help="re-run the best parameters once and "
-                                                   "plot force and pose over time")] = None,
+    best_plot: Annotated[
+        Path | None,
+        typer.Option(help="re-run the best parameters once and plot force and pose over time"),
+    ] = None,
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.bench.learning import method_options
@@ -90,18 +102,33 @@ def learn_skill(
             "cannot extend it (a new design needs a new --study)"
         )
     try:
-        st = Study(study, task=task, skill=obj.trial().setup.skill.name, space=obj.space,
-                   method=method, seed=seed, options=options, penalty=obj.penalty,
-                   resume=resume, context=obj.context())
+        st = Study(
+            study,
+            task=task,
+            skill=obj.trial().setup.skill.name,
+            space=obj.space,
+            method=method,
+            seed=seed,
+            options=options,
+            penalty=obj.penalty,
+            resume=resume,
+            context=obj.context(),
+        )
     except StudyMismatchError as exc:
-        raise StudyMismatchError(f"{exc} -- this database holds another study; choose "
-                                 "another --study or the same settings") from exc
+        raise StudyMismatchError(
+            f"{exc} -- this database holds another study; choose "
+            "another --study or the same settings"
+        ) from exc
     where = f"Ray at {ray}" if ray else f"{'all cores' if workers is None else workers} worker(s)"
-    console.print(f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
-                  f"per trial) -> {st.url}; {st.n_restored} trial(s) restored; {where}")
+    console.print(
+        f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
+        f"per trial) -> {st.url}; {st.n_restored} trial(s) restored; {where}"
+    )
     if st.n_finished >= trials:
-        console.print(f"[yellow]the study already holds {st.n_finished} trial(s) >= --trials "
-                      f"{trials}[/]: nothing to run; raise --trials to continue")
+        console.print(
+            f"[yellow]the study already holds {st.n_finished} trial(s) >= --trials "
+            f"{trials}[/]: nothing to run; raise --trials to continue"
+        )
     best = [math.inf]
     with _bar() as bar:
         job = bar.add_task(f"{method} {task}", total=trials, completed=min(st.n_finished, trials))
@@ -117,32 +144,47 @@ def learn_skill(
             rep = run_study_ray(st, obj, trials, address=ray, workers=workers, on_trial=progress)
         else:
             rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
-    console.print(f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
-                  f"trials/s), {rep.failed} failed by crash/divergence; study holds "
-                  f"{st.n_finished}")
+    console.print(
+        f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
+        f"trials/s), {rep.failed} failed by crash/divergence; study holds "
+        f"{st.n_finished}"
+    )
     if not rep.interrupted and st.n_finished < trials:
-        console.print(f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
-                      f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials")
+        console.print(
+            f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
+            f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials"
+        )
     if st.n_finished:
         _report_best(st, obj, out, plot, traces, best_plot, f"{method} on {task}")
     if rep.interrupted:
-        console.print(f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
-                      "with the same command and --resume")
+        console.print(
+            f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
+            "with the same command and --resume"
+        )
         raise typer.Exit(130)
 
 
-def _report_best(st: object, obj: object, out: Path | None, plot: Path | None,
-                 traces: Path | None, best_plot: Path | None, title: str) -> None:
+def _report_best(
+    st: object,
+    obj: object,
+    out: Path | None,
+    plot: Path | None,
+    traces: Path | None,
+    best_plot: Path | None,
+    title: str,
+) -> None:
     from teachfit.viz import learning_figures as lf
 
     recs = st.trials()  # type: ignore[attr-defined]
     best = st.best()  # type: ignore[attr-defined]
     ok = sum(r.feasible for r in recs)
     rate = best.info.get("success_rate", float("nan"))
-    console.print(f"best: trial {best.number + 1}, cost {best.cost:.3f} s, "
-                  f"{'feasible' if best.feasible else '[red]infeasible[/]'} "
-                  f"({100 * rate:.0f} % of its executions succeeded); {ok}/{len(recs)} "
-                  "trials feasible")
+    console.print(
+        f"best: trial {best.number + 1}, cost {best.cost:.3f} s, "
+        f"{'feasible' if best.feasible else '[red]infeasible[/]'} "
+        f"({100 * rate:.0f} % of its executions succeeded); {ok}/{len(recs)} "
+        "trials feasible"
+    )
     space = obj.space  # type: ignore[attr-defined]
     table = Table(title="best parameters", title_justify="left")
     for col in ("name", "value", "low", "high"):
@@ -177,13 +219,18 @@ def bench_learning(
     seed: int = 0,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
     plot: Annotated[Path | None, typer.Option(help="Fig. 6-like learning curves")] = Path(
-        "out/bench_learning/curves.png"),
-    target: Annotated[bool, typer.Option(help="time a 130-trial x 4-start CMA-ES puzzle "
-                                         "experiment against the 5-minute target")] = True,
-    speedup_trials: Annotated[int, typer.Option(help="trials of the 1-vs-N-worker speed-up "
-                                                "study (0: skip)")] = 24,
-    markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")]
-    = None,
+        "out/bench_learning/curves.png"
+    ),
+    target: Annotated[
+        bool,
+        typer.Option(
+            help="time a 130-trial x 4-start CMA-ES puzzle experiment against the 5-minute target"
+        ),
+    ] = True,
+    speedup_trials: Annotated[
+        int, typer.Option(help="trials of the 1-vs-N-worker speed-up study (0: skip)")
+    ] = 24,
+    markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")] = None,
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
     import os
@@ -197,13 +244,23 @@ def bench_learning(
     with _bar() as bar:
         job = bar.add_task("learning", total=total)
         res = bl.run_learning_bench(
-            task_list, method_list, experiments, trials, workers=workers, n_starts=starts,
-            controller=controller, seed=seed, overrides=dict(_overrides(task_param)),
-            on_trial=lambda label, _r: bar.update(job, advance=1, description=label))
+            task_list,
+            method_list,
+            experiments,
+            trials,
+            workers=workers,
+            n_starts=starts,
+            controller=controller,
+            seed=seed,
+            overrides=dict(_overrides(task_param)),
+            on_trial=lambda label, _r: bar.update(job, advance=1, description=label),
+        )
     extra = "".join(f" --task-param {p}" for p in task_param or [])
-    text = (f"`teachfit bench learning --tasks {tasks} --methods {methods} --experiments "
-            f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
-            f"{os.cpu_count()} cores, {res.wall_s:.0f} s in all)\n\n" + bl.to_markdown(res))
+    text = (
+        f"`teachfit bench learning --tasks {tasks} --methods {methods} --experiments "
+        f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
+        f"{os.cpu_count()} cores, {res.wall_s:.0f} s in all)\n\n" + bl.to_markdown(res)
+    )
     n_w = workers or os.cpu_count() or 1
     if target:
         done = [e for e in res.experiments if e.task == "puzzle" and e.method == "cmaes"]
@@ -211,19 +268,25 @@ def bench_learning(
             wall = done[0].wall_s
         else:
             with console.status("130-trial x 4-start CMA-ES on puzzle"):
-                wall = bl.run_experiment(SkillObjective("puzzle", seed=seed), "cmaes", 130,
-                                         workers=workers).wall_s
+                wall = bl.run_experiment(
+                    SkillObjective("puzzle", seed=seed), "cmaes", 130, workers=workers
+                ).wall_s
         verdict = "meets" if wall <= 300 else "misses"
-        text += (f"\nCMA-ES, 130 trials x 4 starts on puzzle: {wall:.1f} s wall "
-                 f"({130 / wall:.2f} trials/s, {n_w} workers) -- {verdict} the 5-minute target\n")
+        text += (
+            f"\nCMA-ES, 130 trials x 4 starts on puzzle: {wall:.1f} s wall "
+            f"({130 / wall:.2f} trials/s, {n_w} workers) -- {verdict} the 5-minute target\n"
+        )
     if speedup_trials > 0 and n_w > 1:
         with console.status(f"speed-up: {speedup_trials} trials with 1 and {n_w} workers"):
-            t1, tn, ratio = bl.speedup(trials=speedup_trials, workers=n_w, seed=seed,
-                                       n_starts=starts)
-        text += (f"\nspeed-up, {speedup_trials}-trial x {starts}-start CMA-ES puzzle study "
-                 f"(fastest of 2 alternating runs each): 1 worker {t1:.1f} s, {n_w} workers "
-                 f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
-                 f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n")
+            t1, tn, ratio = bl.speedup(
+                trials=speedup_trials, workers=n_w, seed=seed, n_starts=starts
+            )
+        text += (
+            f"\nspeed-up, {speedup_trials}-trial x {starts}-start CMA-ES puzzle study "
+            f"(fastest of 2 alternating runs each): 1 worker {t1:.1f} s, {n_w} workers "
+            f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
+            f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n"
+        )
     from rich.markdown import Markdown
 
     console.print(Markdown(text))  # tables drawn for the terminal; --markdown keeps the source
@@ -231,8 +294,9 @@ def bench_learning(
         from teachfit.viz.learning_figures import plot_learning_curves
 
         bands = {(c.task, c.method): c.curve for c in res.cells}
-        path = plot_learning_curves(bands, plot, f"best cost so far, mean and 95 % CI over "
-                                    f"{experiments} experiment(s)")
+        path = plot_learning_curves(
+            bands, plot, f"best cost so far, mean and 95 % CI over {experiments} experiment(s)"
+        )
         console.print(f"learning curves -> {path}")
     if markdown is not None:
         markdown.parent.mkdir(parents=True, exist_ok=True)

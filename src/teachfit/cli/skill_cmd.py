@@ -42,8 +42,9 @@ def show(
         nodes.add_column(col)
     for node in sk.nodes + ((sk.recovery,) if sk.recovery else ()):
         tag = " (recovery)" if node is sk.recovery else " (start)" if node.name == sk.start else ""
-        nodes.add_row(node.name + tag, node.primitive.describe(),
-                      node.error.describe() if node.error else "-")
+        nodes.add_row(
+            node.name + tag, node.primitive.describe(), node.error.describe() if node.error else "-"
+        )
     console.print(nodes)
     trs = Table(title="transitions", title_justify="left")
     for col in ("from", "to", "when"):
@@ -64,8 +65,9 @@ def show(
         lrn.add_column(col)
     for name, p in sk.params.learned.items():
         scale = " (log)" if p.domain.log else ""
-        lrn.add_row(name, _num(p.default), _num(p.domain.low), _num(p.domain.high) + scale,
-                    p.unit, p.doc)
+        lrn.add_row(
+            name, _num(p.default), _num(p.domain.low), _num(p.domain.high) + scale, p.unit, p.doc
+        )
     console.print(lrn)
     if toml is not None:
         toml.parent.mkdir(parents=True, exist_ok=True)
@@ -115,8 +117,10 @@ def run(
         given = given if isinstance(given, dict) and given else tomllib.loads(params.read_text())
         missing = sorted(set(setup.skill.params.learned) - set(given))
         if missing:
-            console.print(f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
-                          "their defaults are used")
+            console.print(
+                f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
+                "their defaults are used"
+            )
     trial = SkillTrial(setup, controller, seed=seed)
     est = setup.task2world.inverse().compose(the_task.hole2world)
     console.print(
@@ -130,9 +134,15 @@ def run(
         table.add_column(col)
     for i, (tr, ok, cost) in enumerate(zip(out.traces, out.successes, out.costs, strict=True)):
         path = " > ".join(v.node for v in tr.visits)
-        table.add_row(str(i), "[green]success[/]" if ok else f"[red]{tr.outcome}[/]",
-                      str(tr.inserted), f"{cost:.3f}", f"{tr.t_first_contact:.2f}",
-                      f"{tr.t_end:.2f}", path)
+        table.add_row(
+            str(i),
+            "[green]success[/]" if ok else f"[red]{tr.outcome}[/]",
+            str(tr.inserted),
+            f"{cost:.3f}",
+            f"{tr.t_first_contact:.2f}",
+            f"{tr.t_end:.2f}",
+            path,
+        )
     console.print(table)
     steps = sum(tr.steps for tr in out.traces)
     wall = sum(tr.wall_s for tr in out.traces)
@@ -149,6 +159,7 @@ def run(
 
         log = out.traces[render_start].log
         with console.status("rendering"):
-            path = render_motion(the_task, log.t, log.pos, log.quat, render, fps=fps,
-                                 width=width, height=height)
+            path = render_motion(
+                the_task, log.t, log.pos, log.quat, render, fps=fps, width=width, height=height
+            )
         console.print(f"video -> {path}")

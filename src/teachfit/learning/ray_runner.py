@@ -57,8 +57,9 @@ def _init(ray: ModuleType, address: str, workers: int | None) -> bool:
     """Initialise Ray unless it is; True if this call started it (and must shut it down)."""
     if ray.is_initialized():
         return False
-    kwargs: dict[str, Any] = dict(include_dashboard=False, log_to_driver=False,
-                                  configure_logging=False)
+    kwargs: dict[str, Any] = dict(
+        include_dashboard=False, log_to_driver=False, configure_logging=False
+    )
     os.environ.setdefault("RAY_DEDUP_LOGS", "0")
     _check_reachable(address)
     try:
@@ -99,8 +100,11 @@ def run_study_ray(
         obj_ref = ray.put(objective)
         with _Signals(handle_signals) as sig:
             while True:
-                while (not sig.stop and len(pending) < slots
-                       and study.n_finished + len(pending) < budget):
+                while (
+                    not sig.stop
+                    and len(pending) < slots
+                    and study.n_finished + len(pending) < budget
+                ):
                     cand = study.ask()
                     if cand is None:
                         break
@@ -128,5 +132,6 @@ def run_study_ray(
     finally:
         if started:
             ray.shutdown()
-    return RunReport(restored, study.n_finished - restored, failed, interrupted,
-                     time.perf_counter() - t0)
+    return RunReport(
+        restored, study.n_finished - restored, failed, interrupted, time.perf_counter() - t0
+    )

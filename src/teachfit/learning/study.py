@@ -248,9 +248,7 @@ class Study:
         self._optuna.add_trial(frozen)  # committed before the learner hears of it
         self._n += 1
         self.learner.tell(candidate, cost, feasible)
-        return TrialRecord(
-            self._n - 1, candidate.key, params, cost, feasible, outcome, error, info
-        )
+        return TrialRecord(self._n - 1, candidate.key, params, cost, feasible, outcome, error, info)
 
     def trials(self) -> list[TrialRecord]:
         """All stored finished trials, in the order they finished."""

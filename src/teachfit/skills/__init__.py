@@ -19,8 +19,24 @@ from teachfit.skills.params import ContextParam, LearnedParam, SkillParams, read
 from teachfit.skills.trial import SkillSetup, SkillTrial, TrialOutcome, peg_in_hole_setup
 
 __all__ = [
-    "SKILLS", "ContextParam", "ExecConfig", "ExecutionTrace", "LearnedParam", "LearningMetric",
-    "Node", "NodeVisit", "Skill", "SkillParams", "SkillSetup", "SkillTrial", "Transition",
-    "TrialOutcome", "execute", "get_skill", "load_skill", "peg_in_hole_setup",
-    "read_params_toml", "skill_to_toml",
+    "SKILLS",
+    "ContextParam",
+    "ExecConfig",
+    "ExecutionTrace",
+    "LearnedParam",
+    "LearningMetric",
+    "Node",
+    "NodeVisit",
+    "Skill",
+    "SkillParams",
+    "SkillSetup",
+    "SkillTrial",
+    "Transition",
+    "TrialOutcome",
+    "execute",
+    "get_skill",
+    "load_skill",
+    "peg_in_hole_setup",
+    "read_params_toml",
+    "skill_to_toml",
 ]

@@ -25,8 +25,14 @@ from teachfit.skills.percept import Percept
 
 Check = Callable[[Percept], bool]
 
-_AXES = {"+x": (0, 1.0), "-x": (0, -1.0), "+y": (1, 1.0), "-y": (1, -1.0), "+z": (2, 1.0),
-         "-z": (2, -1.0)}
+_AXES = {
+    "+x": (0, 1.0),
+    "-x": (0, -1.0),
+    "+y": (1, 1.0),
+    "-y": (1, -1.0),
+    "+z": (2, 1.0),
+    "-z": (2, -1.0),
+}
 
 
 def _fmt(value: Value, unit: str) -> str:
@@ -234,8 +240,12 @@ class SpeedBelow(_Threshold):
         return f"|v_{self.axes}| < {_fmt(self.value, 'm/s')} for {_fmt(self.duration, 's')}"
 
     def to_toml(self) -> dict[str, Any]:
-        return {"kind": self.kind, "axes": self.axes, "value": self.value,
-                "duration": self.duration}
+        return {
+            "kind": self.kind,
+            "axes": self.axes,
+            "value": self.value,
+            "duration": self.duration,
+        }
 
 
 @dataclass(frozen=True)
@@ -321,8 +331,16 @@ def _paren(c: Condition) -> str:
 
 _LEAVES: dict[str, type[Condition]] = {
     c.kind: c
-    for c in (ForceAbove, TimeAbove, DepthAbove, LateralAbove, RemainingBelow, TiltBelow,
-              SpeedBelow, Done)
+    for c in (
+        ForceAbove,
+        TimeAbove,
+        DepthAbove,
+        LateralAbove,
+        RemainingBelow,
+        TiltBelow,
+        SpeedBelow,
+        Done,
+    )
 }
 
 

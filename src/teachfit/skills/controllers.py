@@ -26,8 +26,12 @@ from teachfit.skills.params import LearnedParam
 
 CONTROLLERS = ("adaptive", "impedance")
 _META = ("alpha", "beta", "gamma_a", "gamma_b")
-_UNITS = {"alpha": "N/(m/s)/tick", "beta": "N/m/(m²/s)/tick", "gamma_a": "(m/s)/N",
-          "gamma_b": "(m²/s)/(N/m)"}
+_UNITS = {
+    "alpha": "N/(m/s)/tick",
+    "beta": "N/m/(m²/s)/tick",
+    "gamma_a": "(m/s)/N",
+    "gamma_b": "(m²/s)/(N/m)",
+}
 #: largest tolerated errors behind the meta-parameter bounds (translation, rotation)
 E_MAX = (0.01,) * 3 + (0.1,) * 3
 DE_MAX = (0.1,) * 3 + (1.0,) * 3
@@ -47,8 +51,9 @@ def controller_params(kind: str, period: float = 0.001) -> dict[str, LearnedPara
         for g, i in (("t", 0), ("r", 3)):
             dom = ParamDomain(hi[i] * 1e-3, hi[i], log=True)
             val = float(np.clip(default[i], dom.low, dom.high))
-            out[f"{meta}_{g}"] = LearnedParam(val, dom, _UNITS[meta],
-                                             f"adaptive controller {meta}, group {g}")
+            out[f"{meta}_{g}"] = LearnedParam(
+                val, dom, _UNITS[meta], f"adaptive controller {meta}, group {g}"
+            )
     return out
 
 

@@ -127,8 +127,14 @@ class _Log:
 
     def freeze(self) -> ExecutionLog:
         k = self.k
-        return ExecutionLog(self.t[:k].copy(), self.pos[:k].copy(), self.quat[:k].copy(),
-                            self.wrench[:k].copy(), self.depth[:k].copy(), self.node[:k].copy())
+        return ExecutionLog(
+            self.t[:k].copy(),
+            self.pos[:k].copy(),
+            self.quat[:k].copy(),
+            self.wrench[:k].copy(),
+            self.depth[:k].copy(),
+            self.node[:k].copy(),
+        )
 
 
 def _holding(cond: Condition, values: dict[str, float], pc: Percept) -> str:
@@ -197,10 +203,16 @@ def execute(
         k = cmd.stiffness
         k_w[:3, :3] = (rot * k[:3]) @ rot.T
         k_w[3:, 3:] = (rot * k[3:]) @ rot.T
-        robot.command(ImpedanceCommand(
-            pos=pos_w, quat=quat_w, lin_vel=rot @ v, ang_vel=rot @ w,
-            wrench_ff=np.concatenate([rot @ cmd.wrench[:3], rot @ cmd.wrench[3:]]),
-            stiffness=k_w))
+        robot.command(
+            ImpedanceCommand(
+                pos=pos_w,
+                quat=quat_w,
+                lin_vel=rot @ v,
+                ang_vel=rot @ w,
+                wrench_ff=np.concatenate([rot @ cmd.wrench[:3], rot @ cmd.wrench[3:]]),
+                stiffness=k_w,
+            )
+        )
         pc.p_d += v * dt
         ang = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * dt
         if ang > 0.0:
@@ -270,8 +282,10 @@ def execute(
             pc.hold_here()
         recovery.run.enter(pc)
         try:
-            while pc.t_node < cfg.recovery_time and not recovery.error(pc) and not (
-                pc.done and pc.t_node > 0
+            while (
+                pc.t_node < cfg.recovery_time
+                and not recovery.error(pc)
+                and not (pc.done and pc.t_node > 0)
             ):
                 cmd.clear()
                 recovery.run.command(pc, cmd)
@@ -282,8 +296,16 @@ def execute(
             why = f"diverged: {exc}"
         visits.append(NodeVisit(recovery.name, t_enter, pc.t, why))
     return ExecutionTrace(
-        skill=skill.name, outcome=outcome, reason=reason, visits=tuple(visits),
-        t_first_contact=t_contact, t_end=t_end, remaining=remaining, inserted=inserted,
-        log=log.freeze(), node_names=names, steps=steps,
+        skill=skill.name,
+        outcome=outcome,
+        reason=reason,
+        visits=tuple(visits),
+        t_first_contact=t_contact,
+        t_end=t_end,
+        remaining=remaining,
+        inserted=inserted,
+        log=log.freeze(),
+        node_names=names,
+        steps=steps,
         wall_s=time.perf_counter() - wall0,
     )

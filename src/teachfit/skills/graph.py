@@ -96,8 +96,9 @@ class Skill:
             if not isinstance(node.primitive, Primitive):
                 raise SkillError("a node needs a primitive", node=node.name)
             if node.error is None:
-                raise SkillError("primitive has no error exit (set its error condition)",
-                                 node=node.name)
+                raise SkillError(
+                    "primitive has no error exit (set its error condition)", node=node.name
+                )
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup or (self.recovery is not None and self.recovery.name in names):
             raise SkillError(f"duplicate node name(s) {dup or [self.recovery.name]}")  # type: ignore[union-attr]
@@ -107,8 +108,9 @@ class Skill:
             if tr.source not in names:
                 raise SkillError(f"transition from unknown node {tr.source!r}", node=tr.source)
             if tr.target not in names:
-                raise SkillError(f"transition to unknown node {tr.target!r}; nodes: {names}",
-                                 node=tr.source)
+                raise SkillError(
+                    f"transition to unknown node {tr.target!r}; nodes: {names}", node=tr.source
+                )
             if tr.source == tr.target:
                 raise SkillError("transition to itself", node=tr.source)
         reached = {self.start}
@@ -125,7 +127,8 @@ class Skill:
         known = self.params.names
         for node in self._all_nodes():
             refs = node.refs() | set().union(
-                *(t.condition.refs() for t in self.transitions if t.source == node.name))
+                *(t.condition.refs() for t in self.transitions if t.source == node.name)
+            )
             missing = sorted(refs - known)
             if missing:
                 raise SkillError(f"undeclared parameter(s) {missing}", node=node.name)
@@ -155,16 +158,27 @@ class Skill:
         out: dict[str, list[str]] = {}
         for node in self._all_nodes():
             refs = node.refs() | set().union(
-                *(t.condition.refs() for t in self.transitions if t.source == node.name))
+                *(t.condition.refs() for t in self.transitions if t.source == node.name)
+            )
             for r in refs:
                 out.setdefault(r, []).append(node.name)
         return out
 
     def with_context(self, values: Mapping[str, float]) -> Skill:
         """The same skill with context parameter values replaced (e.g. from a task)."""
-        return Skill(self.name, self.nodes, self.transitions, self.start,
-                     self.params.with_context(values), self.success, self.error, self.pre,
-                     self.recovery, self.doc, self.frame)
+        return Skill(
+            self.name,
+            self.nodes,
+            self.transitions,
+            self.start,
+            self.params.with_context(values),
+            self.success,
+            self.error,
+            self.pre,
+            self.recovery,
+            self.doc,
+            self.frame,
+        )
 
     # ------------------------------------------------------------------------- compiling
     def resolve(self, learned: Mapping[str, float] | None = None) -> dict[str, float]:
@@ -189,7 +203,9 @@ class Skill:
                 err = node.error.compile(values)  # type: ignore[union-attr]
                 trs = tuple(
                     (t.condition.compile(values), index[t.target], t.condition.describe())
-                    for t in self.transitions if t.source == node.name)
+                    for t in self.transitions
+                    if t.source == node.name
+                )
             except SkillError as exc:
                 if exc.node is not None:
                     raise

@@ -93,17 +93,24 @@ def skill_from_dict(data: Mapping[str, Any], where: str = "skill") -> Skill:
     for tr in data.get("transitions", []):
         if set(tr) != {"from", "to", "when"}:
             raise SkillError(
-                f"{where}: a transition needs exactly from, to, when; got {sorted(tr)}")
+                f"{where}: a transition needs exactly from, to, when; got {sorted(tr)}"
+            )
         try:
             transitions.append(Transition(tr["from"], tr["to"], condition_from_toml(tr["when"])))
         except SkillError as exc:
             raise SkillError(f"transition to {tr['to']!r}: {exc}", node=tr["from"]) from exc
     return Skill(
-        name=str(head["name"]), nodes=tuple(nodes), transitions=tuple(transitions),
-        start=str(head["start"]), params=SkillParams(context, learned),
-        success=condition_from_toml(head["success"]), error=condition_from_toml(head["error"]),
-        pre=condition_from_toml(head["pre"]) if "pre" in head else None, recovery=recovery,
-        doc=str(head.get("doc", "")), frame=str(head.get("frame", Skill.frame)),
+        name=str(head["name"]),
+        nodes=tuple(nodes),
+        transitions=tuple(transitions),
+        start=str(head["start"]),
+        params=SkillParams(context, learned),
+        success=condition_from_toml(head["success"]),
+        error=condition_from_toml(head["error"]),
+        pre=condition_from_toml(head["pre"]) if "pre" in head else None,
+        recovery=recovery,
+        doc=str(head.get("doc", "")),
+        frame=str(head.get("frame", Skill.frame)),
     )
 
 
@@ -125,19 +132,32 @@ def load_skill(path: str | Path) -> Skill:
 # ---------------------------------------------------------------------------------- writing
 def skill_to_dict(skill: Skill) -> dict[str, Any]:
     """The TOML layout of ``skill`` as nested dicts (``None`` fields left out)."""
-    head: dict[str, Any] = {"name": skill.name, "doc": skill.doc, "frame": skill.frame,
-                            "start": skill.start}
+    head: dict[str, Any] = {
+        "name": skill.name,
+        "doc": skill.doc,
+        "frame": skill.frame,
+        "start": skill.start,
+    }
     if skill.recovery is not None:
         head["recovery"] = skill.recovery.name
     head["success"] = skill.success.to_toml()
     head["error"] = skill.error.to_toml()
     if skill.pre is not None:
         head["pre"] = skill.pre.to_toml()
-    context = {n: {"value": p.value, "unit": p.unit, "doc": p.doc}
-               for n, p in skill.params.context.items()}
-    learned = {n: {"default": p.default, "low": p.domain.low, "high": p.domain.high,
-                   "log": p.domain.log, "unit": p.unit, "doc": p.doc}
-               for n, p in skill.params.learned.items()}
+    context = {
+        n: {"value": p.value, "unit": p.unit, "doc": p.doc} for n, p in skill.params.context.items()
+    }
+    learned = {
+        n: {
+            "default": p.default,
+            "low": p.domain.low,
+            "high": p.domain.high,
+            "log": p.domain.log,
+            "unit": p.unit,
+            "doc": p.doc,
+        }
+        for n, p in skill.params.learned.items()
+    }
     nodes = {}
     for node in skill.nodes + ((skill.recovery,) if skill.recovery else ()):
         table = node.primitive.to_toml()
@@ -145,10 +165,16 @@ def skill_to_dict(skill: Skill) -> dict[str, Any]:
         table["doc"] = node.doc
         table["reset_setpoint"] = node.reset_setpoint
         nodes[node.name] = table
-    transitions = [{"from": t.source, "to": t.target, "when": t.condition.to_toml()}
-                   for t in skill.transitions]
-    return {"skill": head, "context": context, "learned": learned, "nodes": nodes,
-            "transitions": transitions}
+    transitions = [
+        {"from": t.source, "to": t.target, "when": t.condition.to_toml()} for t in skill.transitions
+    ]
+    return {
+        "skill": head,
+        "context": context,
+        "learned": learned,
+        "nodes": nodes,
+        "transitions": transitions,
+    }
 
 
 _BARE = re.compile(r"^[A-Za-z0-9_-]+$")

@@ -97,46 +97,105 @@ def build(controller: str = "adaptive") -> Skill:
     (``"adaptive"``) to the learned ones."""
     learned = dict(LEARNED) | controller_params(controller)
     params = SkillParams(dict(CONTEXT), learned)
-    fast = dict(v_max="v_max", a_max="a_max", w_max="w_max", dw_max="dw_max",
-                speed_factor="speed_factor")
+    fast = dict(
+        v_max="v_max", a_max="a_max", w_max="w_max", dw_max="dw_max", speed_factor="speed_factor"
+    )
     roi = LateralAbove("roi")
     nodes = (
-        Node("approach", MoveTo(goal=("-lateral_offset", 0.0, "approach_height"), yaw=0.0,
-                                tilt="-tilt", rz_period="rz_period", stiffness=_STIFF_FREE,
-                                **fast),
-             TimeAbove("t_approach"), "trapezoidal profile to the approach pose"),
-        Node("contact", Move(direction=(0.0, 0.0, -1.0), speed="v_contact",
-                             speed_factor="speed_factor",
-                             stiffness=(2000.0, 2000.0, 1500.0, 80.0, 80.0, 80.0)),
-             TimeAbove("t_contact") | roi, "down until contact"),
-        Node("lateral", Move(direction=(1.0, 0.0, 0.0), speed="v_lateral",
-                             speed_factor="speed_factor", push="f_push",
-                             stiffness=(1500.0, 300.0, 300.0, 80.0, 80.0, 80.0)),
-             TimeAbove("t_lateral") | roi, "sideways until constrained"),
-        Node("align", MoveTo(yaw=0.0, tilt=0.0, rz_period="rz_period", push="f_push",
-                             stiffness=(300.0, 300.0, 300.0, 80.0, 80.0, 80.0), **fast),
-             TimeAbove("t_align") | roi, "rotate into the hole orientation in contact"),
-        Node("insert", Insert(force="force", depth="depth", sink="v_insert", a_t="a_t",
-                              f_t="f_t", a_r="a_r", f_r="f_r",
-                              stiffness=(400.0, 400.0, 200.0, 30.0, 30.0, 20.0)),
-             roi, "push with oscillations"),
+        Node(
+            "approach",
+            MoveTo(
+                goal=("-lateral_offset", 0.0, "approach_height"),
+                yaw=0.0,
+                tilt="-tilt",
+                rz_period="rz_period",
+                stiffness=_STIFF_FREE,
+                **fast,
+            ),
+            TimeAbove("t_approach"),
+            "trapezoidal profile to the approach pose",
+        ),
+        Node(
+            "contact",
+            Move(
+                direction=(0.0, 0.0, -1.0),
+                speed="v_contact",
+                speed_factor="speed_factor",
+                stiffness=(2000.0, 2000.0, 1500.0, 80.0, 80.0, 80.0),
+            ),
+            TimeAbove("t_contact") | roi,
+            "down until contact",
+        ),
+        Node(
+            "lateral",
+            Move(
+                direction=(1.0, 0.0, 0.0),
+                speed="v_lateral",
+                speed_factor="speed_factor",
+                push="f_push",
+                stiffness=(1500.0, 300.0, 300.0, 80.0, 80.0, 80.0),
+            ),
+            TimeAbove("t_lateral") | roi,
+            "sideways until constrained",
+        ),
+        Node(
+            "align",
+            MoveTo(
+                yaw=0.0,
+                tilt=0.0,
+                rz_period="rz_period",
+                push="f_push",
+                stiffness=(300.0, 300.0, 300.0, 80.0, 80.0, 80.0),
+                **fast,
+            ),
+            TimeAbove("t_align") | roi,
+            "rotate into the hole orientation in contact",
+        ),
+        Node(
+            "insert",
+            Insert(
+                force="force",
+                depth="depth",
+                sink="v_insert",
+                a_t="a_t",
+                f_t="f_t",
+                a_r="a_r",
+                f_r="f_r",
+                stiffness=(400.0, 400.0, 200.0, 30.0, 30.0, 20.0),
+            ),
+            roi,
+            "push with oscillations",
+        ),
     )
-    constrained = Any_((ForceAbove("f_lateral", axis="-x"), DepthAbove("drop_depth"),
-                        TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1)))
+    constrained = Any_(
+        (
+            ForceAbove("f_lateral", axis="-x"),
+            DepthAbove("drop_depth"),
+            TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
+        )
+    )
     transitions = (
         Transition("approach", "contact", Done() & RemainingBelow(0.001)),
         Transition("contact", "lateral", ForceAbove("f_contact", axis="+z")),
         Transition("lateral", "align", constrained),
         Transition("align", "insert", Done()),
     )
-    recovery = Node("retract", MoveTo(goal=(0.0, 0.0, "retract_height"), relative=True,
-                                      stiffness=_STIFF_FREE, **fast),
-                    TimeAbove(1.0), "retract upwards")
+    recovery = Node(
+        "retract",
+        MoveTo(goal=(0.0, 0.0, "retract_height"), relative=True, stiffness=_STIFF_FREE, **fast),
+        TimeAbove(1.0),
+        "retract upwards",
+    )
     return Skill(
-        name=NAME, nodes=nodes, transitions=transitions, start="approach", params=params,
+        name=NAME,
+        nodes=nodes,
+        transitions=transitions,
+        start="approach",
+        params=params,
         success=DepthAbove("depth"),
         error=TimeAbove("t_max", scope="skill") | ForceAbove("f_max", axis="norm"),
-        pre=~ForceAbove("f_contact", axis="norm"), recovery=recovery,
+        pre=~ForceAbove("f_contact", axis="norm"),
+        recovery=recovery,
         doc="seed B's peg-in-hole: approach, contact, lateral move until constrained, align, "
         "insert with oscillations",
     )
@@ -169,8 +228,11 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
         return pose
     s_xy, s_z, s_rz = HOLE_ERROR
     yaw_matters = "rz" in getattr(task, "search_dims", ()) or getattr(task, "rz_period", 0) > 0
-    err = Pose.from_xyz_rz(*rng.normal(0.0, s_xy, 2), rng.normal(0.0, s_z),
-                           rng.normal(0.0, s_rz) if yaw_matters else 0.0)
+    err = Pose.from_xyz_rz(
+        *rng.normal(0.0, s_xy, 2),
+        rng.normal(0.0, s_z),
+        rng.normal(0.0, s_rz) if yaw_matters else 0.0,
+    )
     return task.hole2world.compose(err)
 
 

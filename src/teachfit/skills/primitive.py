@@ -173,16 +173,30 @@ class MoveTo(Primitive):
         )
 
     def describe(self) -> str:
-        where = "keep position" if self.goal is None else (
-            f"{'by' if self.relative else 'to'} ({', '.join(map(str, self.goal))})")
+        where = (
+            "keep position"
+            if self.goal is None
+            else (f"{'by' if self.relative else 'to'} ({', '.join(map(str, self.goal))})")
+        )
         rot = "" if self.yaw is None else f", yaw {self.yaw}, tilt {self.tilt}"
         return f"trapezoid {where}{rot}"
 
 
 class _MoveToRun(PrimitiveRun):
-    def __init__(self, *, goal: np.ndarray | None, relative: bool, q_goal: np.ndarray | None,
-                 rz_period: float, v: float, a: float, w: float, dw: float, push: float,
-                 stiffness: np.ndarray) -> None:
+    def __init__(
+        self,
+        *,
+        goal: np.ndarray | None,
+        relative: bool,
+        q_goal: np.ndarray | None,
+        rz_period: float,
+        v: float,
+        a: float,
+        w: float,
+        dw: float,
+        push: float,
+        stiffness: np.ndarray,
+    ) -> None:
         self.goal_spec, self.relative, self.q_goal_spec = goal, relative, q_goal
         self.rz_period, self.v, self.a, self.w, self.dw = rz_period, v, a, w, dw
         self.push, self.k = push, stiffness
@@ -193,8 +207,11 @@ class _MoveToRun(PrimitiveRun):
 
     def enter(self, pc: Percept) -> None:
         self.p0[:] = pc.p_d
-        goal = self.p0.copy() if self.goal_spec is None else (
-            self.goal_spec + self.p0 if self.relative else self.goal_spec.copy())
+        goal = (
+            self.p0.copy()
+            if self.goal_spec is None
+            else (self.goal_spec + self.p0 if self.relative else self.goal_spec.copy())
+        )
         self.dp[:] = goal - self.p0
         pc.goal[:] = goal
         self.rotvec[:] = 0.0
@@ -206,8 +223,9 @@ class _MoveToRun(PrimitiveRun):
                 w, x, y, z = q_goal
                 yaw_goal = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
                 k = round((yaw_now - yaw_goal) / self.rz_period)
-                shift = np.array([math.cos(k * self.rz_period / 2), 0, 0,
-                                  math.sin(k * self.rz_period / 2)])
+                shift = np.array(
+                    [math.cos(k * self.rz_period / 2), 0, 0, math.sin(k * self.rz_period / 2)]
+                )
                 mujoco.mju_mulQuat(q_goal, shift, self.q_goal_spec)
             # rotation vector r (task frame) with exp(r) q_d = q_goal
             dq, inv = np.zeros(4), np.zeros(4)
@@ -255,8 +273,11 @@ class Move(Primitive):
             raise SkillError("move: direction must not be zero")
         speed = _positive("speed", resolve(self.speed, values))
         speed *= _positive("speed_factor", resolve(self.speed_factor, values))
-        return _MoveRun(d / n * speed, _nonneg("push", resolve(self.push, values)),
-                        _stiffness(values, self.stiffness))
+        return _MoveRun(
+            d / n * speed,
+            _nonneg("push", resolve(self.push, values)),
+            _stiffness(values, self.stiffness),
+        )
 
     def describe(self) -> str:
         d = ", ".join(f"{v:g}" if isinstance(v, float | int) else v for v in self.direction)
@@ -306,8 +327,11 @@ class Insert(Primitive):
         _check_len("stiffness", self.stiffness, 6)
 
     def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
-        r = {f.name: resolve(getattr(self, f.name), values)
-             for f in fields(self) if f.name != "stiffness"}
+        r = {
+            f.name: resolve(getattr(self, f.name), values)
+            for f in fields(self)
+            if f.name != "stiffness"
+        }
         for name in ("force", "depth", "a_t", "a_r"):
             _nonneg(name, r[name])
         for name in ("sink", "f_t", "f_r"):
@@ -315,8 +339,10 @@ class Insert(Primitive):
         return _InsertRun(r, _stiffness(values, self.stiffness))
 
     def describe(self) -> str:
-        return (f"push {self.force} to depth {self.depth}; osc. a_t {self.a_t} @ {self.f_t}, "
-                f"a_r {self.a_r} @ {self.f_r}")
+        return (
+            f"push {self.force} to depth {self.depth}; osc. a_t {self.a_t} @ {self.f_t}, "
+            f"a_r {self.a_r} @ {self.f_r}"
+        )
 
 
 class _InsertRun(PrimitiveRun):
@@ -359,8 +385,9 @@ def primitive_from_toml(data: Mapping[str, Any]) -> Primitive:
         raise SkillError(f"unknown primitive {kind!r}; known: {sorted(PRIMITIVES)}")
     cls = PRIMITIVES[kind]
     known = {f.name for f in fields(cls)}
-    kwargs = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()
-              if k != "primitive"}
+    kwargs = {
+        k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k != "primitive"
+    }
     unknown = sorted(set(kwargs) - known)
     if unknown:
         raise SkillError(f"primitive {kind!r}: unknown field(s) {unknown}; known: {sorted(known)}")

@@ -42,7 +42,10 @@ class SkillSetup:
 
 
 def peg_in_hole_setup(
-    task: Task, seed: int = 0, n_starts: int = 4, controller: str = "adaptive",
+    task: Task,
+    seed: int = 0,
+    n_starts: int = 4,
+    controller: str = "adaptive",
     skill: Skill | None = None,
 ) -> SkillSetup:
     """The peg-in-hole set-up for ``task``: hole estimate and starts drawn from ``seed``."""
@@ -50,8 +53,9 @@ def peg_in_hole_setup(
     ctx = peg_in_hole.hole_context(task, rng)
     base = skill if skill is not None else peg_in_hole.build(controller)
     starts = peg_in_hole.default_starts(task, n_starts, rng)
-    return SkillSetup(base.with_context(ctx.values), task, ctx.hole2world_est, ctx.goal2world,
-                      tuple(starts))
+    return SkillSetup(
+        base.with_context(ctx.values), task, ctx.hole2world_est, ctx.goal2world, tuple(starts)
+    )
 
 
 @dataclass(frozen=True)
@@ -72,9 +76,14 @@ class TrialOutcome:
 
     def as_result(self) -> TrialResult:
         """For :mod:`teachfit.learning`: mean cost, feasible if any start succeeded."""
-        return TrialResult(self.cost, any(self.successes),
-                           {"success_rate": self.success_rate,
-                            "wall_s": float(sum(t.wall_s for t in self.traces))})
+        return TrialResult(
+            self.cost,
+            any(self.successes),
+            {
+                "success_rate": self.success_rate,
+                "wall_s": float(sum(t.wall_s for t in self.traces)),
+            },
+        )
 
 
 class SkillTrial:
@@ -90,9 +99,13 @@ class SkillTrial:
     """
 
     def __init__(
-        self, setup: SkillSetup, controller: str = "adaptive",
-        metric: LearningMetric | None = None, config: ExecConfig | None = None,
-        robot_params: FloatingToolParams | None = None, seed: int = 0,
+        self,
+        setup: SkillSetup,
+        controller: str = "adaptive",
+        metric: LearningMetric | None = None,
+        config: ExecConfig | None = None,
+        robot_params: FloatingToolParams | None = None,
+        seed: int = 0,
     ) -> None:
         self.setup = setup
         self.controller = controller
@@ -106,10 +119,18 @@ class SkillTrial:
         s = self.setup
         values = s.skill.resolve(learned)
         self.robot.controller = make_controller(
-            self.controller, values, self.robot.params.apparent_mass, self.robot.control_period)
-        return execute(s.skill, self.robot, start, s.task2world,
-                       {k: values[k] for k in s.skill.params.learned},
-                       task=s.task, goal2world=s.goal2world, config=self.config)
+            self.controller, values, self.robot.params.apparent_mass, self.robot.control_period
+        )
+        return execute(
+            s.skill,
+            self.robot,
+            start,
+            s.task2world,
+            {k: values[k] for k in s.skill.params.learned},
+            task=s.task,
+            goal2world=s.goal2world,
+            config=self.config,
+        )
 
     def __call__(
         self, learned: Mapping[str, float] | None = None, starts: Sequence[Pose] | None = None

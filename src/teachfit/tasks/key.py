@@ -66,8 +66,16 @@ class KeyParams(SkillProtocolParams):
     def __post_init__(self) -> None:
         super().__post_init__()
         for key in (
-            "blade_width", "blade_thickness", "blade_length", "clearance", "slot_depth",
-            "bow_width", "bow_thickness", "bow_height", "block_half_width", "block_height",
+            "blade_width",
+            "blade_thickness",
+            "blade_length",
+            "clearance",
+            "slot_depth",
+            "bow_width",
+            "bow_thickness",
+            "bow_height",
+            "block_half_width",
+            "block_height",
             "success_depth",
         ):
             self.require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
@@ -165,22 +173,36 @@ class Key(SkillTask):
             scene.worldbody, "body", name="fixture", euler=fmt([0.0, 0.0, p.hole_yaw])
         )
         ET.SubElement(
-            block, "geom", name="fixture_base", type="box",
+            block,
+            "geom",
+            name="fixture_base",
+            type="box",
             size=fmt([p.block_half_width, p.block_half_width, z_bot / 2]),
-            pos=fmt([0, 0, z_bot / 2]), material="metal", **kw,
+            pos=fmt([0, 0, z_bot / 2]),
+            material="metal",
+            **kw,
         )
         hx, hy = self.slot_half_size
         outline = rectangle(p.block_half_width, p.block_half_width)
-        sides = {"east": ((1.0, 0.0), hx), "west": ((-1.0, 0.0), hx),
-                 "north": ((0.0, 1.0), hy), "south": ((0.0, -1.0), hy)}
+        sides = {
+            "east": ((1.0, 0.0), hx),
+            "west": ((-1.0, 0.0), hx),
+            "north": ((0.0, 1.0), hy),
+            "south": ((0.0, -1.0), hy),
+        }
         for side, (normal, offset) in sides.items():
             verts = beyond_edge_block(
                 outline, np.array(normal), offset, z_bot, p.block_height, p.slot_chamfer
             )
             scene.add_mesh(f"slot_{side}", verts)
             ET.SubElement(
-                block, "geom", name=f"slot_wall_{side}", type="mesh", mesh=f"slot_{side}",
-                material="metal", **kw,
+                block,
+                "geom",
+                name=f"slot_wall_{side}",
+                type="mesh",
+                mesh=f"slot_{side}",
+                material="metal",
+                **kw,
             )
 
     def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
@@ -189,12 +211,23 @@ class Key(SkillTask):
         blade = rectangle(p.blade_width / 2, p.blade_thickness / 2)
         scene.add_mesh("key_blade", chamfered_prism(blade, p.blade_length, p.blade_chamfer))
         ET.SubElement(
-            body, "geom", name="key_blade", type="mesh", mesh="key_blade", material="tool",
-            mass="0.005", **kw,
+            body,
+            "geom",
+            name="key_blade",
+            type="mesh",
+            mesh="key_blade",
+            material="tool",
+            mass="0.005",
+            **kw,
         )
         ET.SubElement(
-            body, "geom", name="key_bow", type="box",
+            body,
+            "geom",
+            name="key_bow",
+            type="box",
             size=fmt([p.bow_width / 2, p.bow_thickness / 2, p.bow_height / 2]),
-            pos=fmt([0, 0, p.blade_length + p.bow_height / 2]), material="tool", mass="0.01",
+            pos=fmt([0, 0, p.blade_length + p.bow_height / 2]),
+            material="tool",
+            mass="0.01",
             **kw,
         )

@@ -60,8 +60,15 @@ class AluminiumPegParams(SkillProtocolParams):
     def __post_init__(self) -> None:
         super().__post_init__()
         for key in (
-            "peg_diameter", "clearance", "peg_length", "hole_depth", "boss_diameter",
-            "boss_height", "base_height", "base_half_width", "success_depth",
+            "peg_diameter",
+            "clearance",
+            "peg_length",
+            "hole_depth",
+            "boss_diameter",
+            "boss_height",
+            "base_height",
+            "base_half_width",
+            "success_depth",
         ):
             self.require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         for key in ("peg_chamfer", "hole_chamfer"):
@@ -141,22 +148,39 @@ class AluminiumPeg(SkillTask):
         kw = contact_attrs(contact)
         fixture = ET.SubElement(scene.worldbody, "body", name="fixture")
         ET.SubElement(
-            fixture, "geom", name="fixture_base", type="box",
+            fixture,
+            "geom",
+            name="fixture_base",
+            type="box",
             size=fmt([p.base_half_width, p.base_half_width, p.base_height / 2]),
-            pos=fmt([0, 0, p.base_height / 2]), material="metal", **kw,
+            pos=fmt([0, 0, p.base_height / 2]),
+            material="metal",
+            **kw,
         )
         core_half = (z_hole - p.base_height) / 2
         ET.SubElement(
-            fixture, "geom", name="boss_core", type="cylinder", size=fmt([boss_r, core_half]),
-            pos=fmt([0, 0, p.base_height + core_half]), material="metal", **kw,
+            fixture,
+            "geom",
+            name="boss_core",
+            type="cylinder",
+            size=fmt([boss_r, core_half]),
+            pos=fmt([0, 0, p.base_height + core_half]),
+            material="metal",
+            **kw,
         )
         scene.add_mesh(
             "boss_sector", ring_sector(hole_r, boss_r, z_hole, top, p.n_sectors, p.hole_chamfer)
         )
         for i in range(p.n_sectors):
             ET.SubElement(
-                fixture, "geom", name=f"hole_wall_{i}", type="mesh", mesh="boss_sector",
-                euler=fmt([0, 0, 2 * np.pi * i / p.n_sectors]), material="metal", **kw,
+                fixture,
+                "geom",
+                name=f"hole_wall_{i}",
+                type="mesh",
+                mesh="boss_sector",
+                euler=fmt([0, 0, 2 * np.pi * i / p.n_sectors]),
+                material="metal",
+                **kw,
             )
 
     def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
@@ -165,6 +189,12 @@ class AluminiumPeg(SkillTask):
         scene.add_mesh("alu_peg", chamfered_cylinder(r, p.peg_length, p.peg_chamfer, 48))
         mass = ALUMINIUM_DENSITY * np.pi * r**2 * p.peg_length
         ET.SubElement(
-            body, "geom", name="peg", type="mesh", mesh="alu_peg", material="tool",
-            mass=fmt(mass), **contact_attrs(contact),
+            body,
+            "geom",
+            name="peg",
+            type="mesh",
+            mesh="alu_peg",
+            material="tool",
+            mass=fmt(mass),
+            **contact_attrs(contact),
         )

@@ -68,8 +68,13 @@ class PuzzleParams(SkillProtocolParams):
     def __post_init__(self) -> None:
         super().__post_init__()
         for key in (
-            "side_length", "clearance", "hole_depth", "piece_height", "block_half_width",
-            "block_height", "success_depth",
+            "side_length",
+            "clearance",
+            "hole_depth",
+            "piece_height",
+            "block_half_width",
+            "block_height",
+            "success_depth",
         ):
             self.require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
         self.require(self.hole_chamfer >= 0, f"hole_chamfer must be >= 0, got {self.hole_chamfer}")
@@ -150,9 +155,14 @@ class Puzzle(SkillTask):
             scene.worldbody, "body", name="fixture", euler=fmt([0.0, 0.0, p.hole_yaw])
         )
         ET.SubElement(
-            block, "geom", name="fixture_base", type="box",
+            block,
+            "geom",
+            name="fixture_base",
+            type="box",
             size=fmt([p.block_half_width, p.block_half_width, z_bot / 2]),
-            pos=fmt([0, 0, z_bot / 2]), material="metal", **kw,
+            pos=fmt([0, 0, z_bot / 2]),
+            material="metal",
+            **kw,
         )
         outline = rectangle(p.block_half_width, p.block_half_width)
         for i, n in enumerate(edge_normals(3, _PHASE)):
@@ -161,8 +171,13 @@ class Puzzle(SkillTask):
             )
             scene.add_mesh(f"puzzle_wall_{i}", verts)
             ET.SubElement(
-                block, "geom", name=f"hole_wall_{i}", type="mesh", mesh=f"puzzle_wall_{i}",
-                material="metal", **kw,
+                block,
+                "geom",
+                name=f"hole_wall_{i}",
+                type="mesh",
+                mesh=f"puzzle_wall_{i}",
+                material="metal",
+                **kw,
             )
 
     def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
@@ -170,7 +185,12 @@ class Puzzle(SkillTask):
         tri = regular_polygon(3, p.piece_inradius, _PHASE)
         scene.add_mesh("puzzle_piece", chamfered_prism(tri, p.piece_height))
         ET.SubElement(
-            body, "geom", name="puzzle_piece", type="mesh", mesh="puzzle_piece",
-            material="tool", mass="0.05", **contact_attrs(contact),
+            body,
+            "geom",
+            name="puzzle_piece",
+            type="mesh",
+            mesh="puzzle_piece",
+            material="tool",
+            mass="0.05",
+            **contact_attrs(contact),
         )
-

@@ -71,9 +71,21 @@ class Socket3DParams:
 
     def __post_init__(self) -> None:
         positive = [
-            "pin_diameter", "pin_spacing", "pin_length", "clearance_small", "clearance_large",
-            "hole_depth", "valley_radius", "recess_diameter", "recess_depth", "wall_thickness",
-            "floor_height", "body_diameter", "body_height", "success_depth", "start_rz",
+            "pin_diameter",
+            "pin_spacing",
+            "pin_length",
+            "clearance_small",
+            "clearance_large",
+            "hole_depth",
+            "valley_radius",
+            "recess_diameter",
+            "recess_depth",
+            "wall_thickness",
+            "floor_height",
+            "body_diameter",
+            "body_height",
+            "success_depth",
+            "start_rz",
         ]
         for name in positive:
             if not getattr(self, name) > 0:
@@ -217,20 +229,38 @@ class Socket3D(Task):
         kw = contact_attrs(contact)
         block = ET.SubElement(scene.worldbody, "body", name="fixture")
         ET.SubElement(
-            block, "geom", name="socket_base", type="cylinder", size=fmt([r_out, z_bot / 2]),
-            pos=fmt([0, 0, z_bot / 2]), material="metal", **kw,
+            block,
+            "geom",
+            name="socket_base",
+            type="cylinder",
+            size=fmt([r_out, z_bot / 2]),
+            pos=fmt([0, 0, z_bot / 2]),
+            material="metal",
+            **kw,
         )
         k = p.n_wedges
         for side, (sign, r_hole) in enumerate(zip((-1.0, 1.0), self.hole_radii, strict=True)):
             for i in range(k):
                 verts = valley_wedge(
-                    (sign * half, 0.0), 2 * np.pi * i / k, 2 * np.pi * (i + 1) / k, r_hole,
-                    half, z_bot, z_entry, p.floor_height, p.valley_radius,
+                    (sign * half, 0.0),
+                    2 * np.pi * i / k,
+                    2 * np.pi * (i + 1) / k,
+                    r_hole,
+                    half,
+                    z_bot,
+                    z_entry,
+                    p.floor_height,
+                    p.valley_radius,
                 )
                 scene.add_mesh(f"valley_{side}_{i}", verts)
                 ET.SubElement(
-                    block, "geom", name=f"valley_{side}_{i}", type="mesh",
-                    mesh=f"valley_{side}_{i}", material="metal", **kw,
+                    block,
+                    "geom",
+                    name=f"valley_{side}_{i}",
+                    type="mesh",
+                    mesh=f"valley_{side}_{i}",
+                    material="metal",
+                    **kw,
                 )
         fillers = {  # the floor outside the two tiles: x in [-2 half, 2 half], |y| <= half
             "north": [(0.0, 1.0, half)],
@@ -241,15 +271,26 @@ class Socket3D(Task):
         for name, planes in fillers.items():
             scene.add_mesh(f"floor_{name}", disc_segment(r_out, z_bot, p.floor_height, planes))
             ET.SubElement(
-                block, "geom", name=f"floor_{name}", type="mesh", mesh=f"floor_{name}",
-                material="metal", **kw,
+                block,
+                "geom",
+                name=f"floor_{name}",
+                type="mesh",
+                mesh=f"floor_{name}",
+                material="metal",
+                **kw,
             )
         rim = p.floor_height + p.recess_depth
         scene.add_mesh("recess_wall", ring_sector(r_in, r_out, z_bot, rim, p.n_wall_sectors))
         for i in range(p.n_wall_sectors):
             ET.SubElement(
-                block, "geom", name=f"recess_wall_{i}", type="mesh", mesh="recess_wall",
-                euler=fmt([0, 0, 2 * np.pi * i / p.n_wall_sectors]), material="metal", **kw,
+                block,
+                "geom",
+                name=f"recess_wall_{i}",
+                type="mesh",
+                mesh="recess_wall",
+                euler=fmt([0, 0, 2 * np.pi * i / p.n_wall_sectors]),
+                material="metal",
+                **kw,
             )
 
     def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
@@ -258,8 +299,15 @@ class Socket3D(Task):
         scene.add_mesh("pin", rounded_pin(p.pin_diameter / 2, p.pin_length, p.pin_tip_radius))
         for name, x in (("pin_small", -p.pin_spacing / 2), ("pin_large", p.pin_spacing / 2)):
             ET.SubElement(
-                body, "geom", name=name, type="mesh", mesh="pin", pos=fmt([x, 0, 0]),
-                material="tool", mass="0.01", **kw,
+                body,
+                "geom",
+                name=name,
+                type="mesh",
+                mesh="pin",
+                pos=fmt([x, 0, 0]),
+                material="tool",
+                mass="0.01",
+                **kw,
             )
         # a convex mesh, not a primitive cylinder: MuJoCo gives a cylinder up to 4 contacts per
         # floor piece, a mesh one, which keeps the plug seated on ~30 pieces cheap to simulate
@@ -267,8 +315,15 @@ class Socket3D(Task):
             "plug_body", chamfered_cylinder(p.body_diameter / 2, p.body_height, 0.001, 32)
         )
         ET.SubElement(
-            body, "geom", name="plug_body", type="mesh", mesh="plug_body",
-            pos=fmt([0, 0, p.pin_length]), material="tool", mass="0.08", **kw,
+            body,
+            "geom",
+            name="plug_body",
+            type="mesh",
+            mesh="plug_body",
+            pos=fmt([0, 0, p.pin_length]),
+            material="tool",
+            mass="0.08",
+            **kw,
         )
 
     # ------------------------------------------------------------------------- ground truth

@@ -77,8 +77,9 @@ def valley_wedge(
         corner_ang = np.pi / 4 + k * np.pi / 2
         rel = (corner_ang - angle0) % (2 * np.pi)
         if 1e-9 < rel < angle1 - angle0 - 1e-9:
-            poly.append(c + half_width * np.sqrt(2.0) * np.array([np.cos(corner_ang),
-                                                                  np.sin(corner_ang)]))
+            poly.append(
+                c + half_width * np.sqrt(2.0) * np.array([np.cos(corner_ang), np.sin(corner_ang)])
+            )
     poly += [c + _square_exit(rays[1], half_width) * rays[1], c + inner * rays[1]]
 
     def depth_along(p: np.ndarray) -> float:
@@ -147,9 +148,10 @@ def disc_segment(
                 pts.append(np.linalg.solve(mat, np.array([l1[2], l2[2]])))
     tol = 1e-12
     kept = [
-        p for p in pts
-        if p @ p <= radius**2 * (1 + 1e-9) and all(a * p[0] + b * p[1] >= cc - tol
-                                                    for a, b, cc in lines)
+        p
+        for p in pts
+        if p @ p <= radius**2 * (1 + 1e-9)
+        and all(a * p[0] + b * p[1] >= cc - tol for a, b, cc in lines)
     ]
     verts = [(p[0], p[1], z) for p in kept for z in (z_bottom, z_top)]
     return np.unique(np.round(np.asarray(verts), 12), axis=0)

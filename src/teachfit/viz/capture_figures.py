@@ -50,8 +50,14 @@ def track_figure(track: Track, out: str | Path, truth: Demonstration | None = No
     axes[2].plot(t, track.std_deg, label="predicted 1-sigma (deg)")
     axes[2].plot(t, track.rms_px, label="reprojection RMS (px)")
     ax2 = axes[2].twinx()
-    ax2.step(t, track.n_markers.sum(axis=1), where="mid", color="0.4", lw=0.8,
-             label="markers used (right axis)")
+    ax2.step(
+        t,
+        track.n_markers.sum(axis=1),
+        where="mid",
+        color="0.4",
+        lw=0.8,
+        label="markers used (right axis)",
+    )
     ax2.set_ylabel("markers used")
     ax2.yaxis.set_major_locator(MaxNLocator(integer=True))
     axes[2].set_yscale("log")

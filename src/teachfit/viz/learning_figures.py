@@ -38,14 +38,21 @@ def plot_learning_curves(
     task, one column per method (``bands[(task, method)]``)."""
     tasks = list(dict.fromkeys(t for t, _ in bands))
     methods = list(dict.fromkeys(m for _, m in bands))
-    fig, axes = plt.subplots(len(tasks), len(methods), squeeze=False, sharex=True,
-                             figsize=(3.2 * len(methods), 2.6 * len(tasks)),
-                             constrained_layout=True)
+    fig, axes = plt.subplots(
+        len(tasks),
+        len(methods),
+        squeeze=False,
+        sharex=True,
+        figsize=(3.2 * len(methods), 2.6 * len(tasks)),
+        constrained_layout=True,
+    )
     for i, task in enumerate(tasks):
         row = [b for (t, _), b in bands.items() if t == task]
         # one scale per task; a wide early band (failed first trials) may leave the frame
-        top = min(max(float(np.nanmax(b.high)) for b in row),
-                  1.5 * max(float(np.nanmax(b.mean)) for b in row))
+        top = min(
+            max(float(np.nanmax(b.high)) for b in row),
+            1.5 * max(float(np.nanmax(b.mean)) for b in row),
+        )
         low = min(float(np.nanmin(b.low)) for b in row)
         for j, method in enumerate(methods):
             ax = axes[i, j]
@@ -53,10 +60,18 @@ def plot_learning_curves(
             if b is None:
                 ax.set_axis_off()
                 continue
-            ax.fill_between(b.trials, b.low, b.high, color="0.75", lw=0, step="post",
-                            label="95 % CI" if b.n > 1 else None)
-            ax.step(b.trials, b.mean, where="post", color="tab:blue", lw=1.6,
-                    label=f"mean of {b.n}")
+            ax.fill_between(
+                b.trials,
+                b.low,
+                b.high,
+                color="0.75",
+                lw=0,
+                step="post",
+                label="95 % CI" if b.n > 1 else None,
+            )
+            ax.step(
+                b.trials, b.mean, where="post", color="tab:blue", lw=1.6, label=f"mean of {b.n}"
+            )
             ax.set_ylim(max(0.0, low * 0.9), top * 1.05 + 1e-9)
             ax.grid(alpha=0.3)
             if i == 0:
@@ -101,8 +116,15 @@ def plot_param_traces(
     names = space.names
     ncol = 4
     nrow = int(np.ceil(len(names) / ncol))
-    fig, axes = plt.subplots(nrow, ncol, squeeze=False, sharex=True, sharey=True,
-                             figsize=(3.0 * ncol, 1.9 * nrow), constrained_layout=True)
+    fig, axes = plt.subplots(
+        nrow,
+        ncol,
+        squeeze=False,
+        sharex=True,
+        sharey=True,
+        figsize=(3.0 * ncol, 1.9 * nrow),
+        constrained_layout=True,
+    )
     k = np.arange(1, len(records) + 1)
     units = np.array([space.to_unit(r.params) for r in records]).reshape(len(records), -1)
     ok = np.array([r.feasible for r in records], dtype=bool)
@@ -133,8 +155,9 @@ def plot_best_execution(trace: ExecutionTrace, path: str | Path, title: str = ""
     """One execution over time: wrench on the tool (N), TCP position relative to its start
     (mm), orientation (tilt from vertical and yaw, rad); node changes dotted."""
     log = trace.log
-    fig, (ax0, ax1, ax2) = plt.subplots(3, 1, sharex=True, figsize=(7.0, 7.0),
-                                        constrained_layout=True)
+    fig, (ax0, ax1, ax2) = plt.subplots(
+        3, 1, sharex=True, figsize=(7.0, 7.0), constrained_layout=True
+    )
     for i, lab in enumerate(("F_x", "F_y", "F_z")):
         ax0.plot(log.t, log.wrench[:, i], lw=1.0, label=lab)
     ax0.plot(log.t, np.linalg.norm(log.wrench[:, :3], axis=1), color="k", lw=0.8, label="|F|")
@@ -156,9 +179,19 @@ def plot_best_execution(trace: ExecutionTrace, path: str | Path, title: str = ""
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper left")
     for v in trace.visits:
-        ax0.text(v.t_enter, 1.0, f" {v.node}", transform=ax0.get_xaxis_transform(),
-                 fontsize=7, va="bottom", rotation=30)
+        ax0.text(
+            v.t_enter,
+            1.0,
+            f" {v.node}",
+            transform=ax0.get_xaxis_transform(),
+            fontsize=7,
+            va="bottom",
+            rotation=30,
+        )
     outcome = "success" if trace.success else trace.outcome
-    ax0.set_title(title or f"{trace.skill}: {outcome}, contact at {trace.t_first_contact:.2f} s",
-                  fontsize=9, pad=18)
+    ax0.set_title(
+        title or f"{trace.skill}: {outcome}, contact at {trace.t_first_contact:.2f} s",
+        fontsize=9,
+        pad=18,
+    )
     return _save(fig, path)

@@ -36,21 +36,51 @@ def _order(skill: Skill) -> list[str]:
 
 def _box(ax: plt.Axes, xy: tuple[float, float], title: str, body: str, color: str) -> None:
     x, y = xy
-    ax.add_patch(FancyBboxPatch((x - 0.42, y - 0.32), 0.84, 0.64,
-                                boxstyle="round,pad=0.02", fc=color, ec="k", lw=1.2))
+    ax.add_patch(
+        FancyBboxPatch(
+            (x - 0.42, y - 0.32), 0.84, 0.64, boxstyle="round,pad=0.02", fc=color, ec="k", lw=1.2
+        )
+    )
     ax.text(x, y + 0.2, title, ha="center", va="center", fontsize=10, weight="bold")
     ax.text(x, y - 0.05, textwrap.fill(body, 26), ha="center", va="center", fontsize=6.5)
 
 
-def _arrow(ax: plt.Axes, a: tuple[float, float], b: tuple[float, float], label: str,
-           color: str = "k", style: str = "-", rad: float = 0.0, dy: float = 0.0,
-           frac: float = 0.5) -> None:
-    ax.annotate("", xy=b, xytext=a, arrowprops=dict(
-        arrowstyle="-|>", color=color, ls=style, lw=1.2,
-        connectionstyle=f"arc3,rad={rad}", shrinkA=2, shrinkB=2))
+def _arrow(
+    ax: plt.Axes,
+    a: tuple[float, float],
+    b: tuple[float, float],
+    label: str,
+    color: str = "k",
+    style: str = "-",
+    rad: float = 0.0,
+    dy: float = 0.0,
+    frac: float = 0.5,
+) -> None:
+    ax.annotate(
+        "",
+        xy=b,
+        xytext=a,
+        arrowprops=dict(
+            arrowstyle="-|>",
+            color=color,
+            ls=style,
+            lw=1.2,
+            connectionstyle=f"arc3,rad={rad}",
+            shrinkA=2,
+            shrinkB=2,
+        ),
+    )
     mx, my = a[0] + frac * (b[0] - a[0]), a[1] + frac * (b[1] - a[1]) + dy
-    ax.text(mx, my, textwrap.fill(label, 22), ha="center", va="bottom", fontsize=6.5,
-            color=color, bbox=dict(fc="white", ec="none", alpha=0.8, pad=0.5))
+    ax.text(
+        mx,
+        my,
+        textwrap.fill(label, 22),
+        ha="center",
+        va="bottom",
+        fontsize=6.5,
+        color=color,
+        bbox=dict(fc="white", ec="none", alpha=0.8, pad=0.5),
+    )
 
 
 def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
@@ -66,30 +96,59 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
     ax.add_patch(plt.Circle(end, 0.09, color="green"))
     ax.text(end[0], end[1] - 0.3, "success", ha="center", fontsize=8, color="green")
     pre = skill.pre.describe() if skill.pre is not None else "always"
-    _arrow(ax, (start[0] + 0.12, 0.0), (pos[skill.start][0] - 0.44, 0.0), f"pre: {pre}",
-           dy=0.05)
+    _arrow(ax, (start[0] + 0.12, 0.0), (pos[skill.start][0] - 0.44, 0.0), f"pre: {pre}", dy=0.05)
     for node in skill.nodes:
         _box(ax, pos[node.name], node.name, node.primitive.describe(), "#dbe9f6")
     for tr in skill.transitions:
         a, b = pos[tr.source], pos[tr.target]
         forward = b[0] > a[0] and order.index(tr.target) == order.index(tr.source) + 1
         rad = 0.0 if forward else -0.35
-        _arrow(ax, (a[0] + 0.44, a[1]), (b[0] - 0.44, b[1]), tr.condition.describe(),
-               rad=rad, dy=0.05 if forward else 0.45)
+        _arrow(
+            ax,
+            (a[0] + 0.44, a[1]),
+            (b[0] - 0.44, b[1]),
+            tr.condition.describe(),
+            rad=rad,
+            dy=0.05 if forward else 0.45,
+        )
     last = pos[order[-1]]
-    _arrow(ax, (last[0] + 0.44, 0.0), (end[0] - 0.16, 0.0), skill.success.describe(),
-           color="green", dy=0.05)
+    _arrow(
+        ax,
+        (last[0] + 0.44, 0.0),
+        (end[0] - 0.16, 0.0),
+        skill.success.describe(),
+        color="green",
+        dy=0.05,
+    )
     if skill.recovery is not None:
         rec = ((pos[order[0]][0] + last[0]) / 2, -1.6)
-        _box(ax, rec, f"recovery: {skill.recovery.name}", skill.recovery.primitive.describe(),
-             "#f6dbdb")
+        _box(
+            ax,
+            rec,
+            f"recovery: {skill.recovery.name}",
+            skill.recovery.primitive.describe(),
+            "#f6dbdb",
+        )
         for node in skill.nodes:
             a = pos[node.name]
-            _arrow(ax, (a[0], a[1] - 0.33), (rec[0] + 0.2 * (a[0] - rec[0]) / n, rec[1] + 0.33),
-                   node.error.describe() if node.error else "", color="firebrick",
-                   style="--", dy=-0.1, frac=0.3)
-    ax.text(0.0, 1.05, f"skill {skill.name!r} — global error: {skill.error.describe()}",
-            fontsize=8, color="firebrick", transform=ax.transData)
+            _arrow(
+                ax,
+                (a[0], a[1] - 0.33),
+                (rec[0] + 0.2 * (a[0] - rec[0]) / n, rec[1] + 0.33),
+                node.error.describe() if node.error else "",
+                color="firebrick",
+                style="--",
+                dy=-0.1,
+                frac=0.3,
+            )
+    ax.text(
+        0.0,
+        1.05,
+        f"skill {skill.name!r} — global error: {skill.error.describe()}",
+        fontsize=8,
+        color="firebrick",
+        transform=ax.transData,
+    )
     ax.text(0.0, 0.85, f"task frame: {skill.frame}", fontsize=7, color="0.3")
     ax.set_xlim(-0.4, end[0] + 0.4)
     ax.set_ylim(-2.1, 1.25)
@@ -105,17 +164,26 @@ def plot_traces(traces: Sequence[ExecutionTrace], path: str | Path) -> Path:
     """Executions over time: node timeline, contact force and depth (one column each)."""
     path = Path(path)
     k = len(traces)
-    fig, axes = plt.subplots(3, k, figsize=(4.6 * k, 7.5), squeeze=False, sharex="col",
-                             constrained_layout=True, height_ratios=(1.0, 1.6, 1.6))
-    names = sorted({v.node for tr in traces for v in tr.visits},
-                   key=lambda n: next(i for tr in traces for i, v in enumerate(tr.visits)
-                                      if v.node == n))
+    fig, axes = plt.subplots(
+        3,
+        k,
+        figsize=(4.6 * k, 7.5),
+        squeeze=False,
+        sharex="col",
+        constrained_layout=True,
+        height_ratios=(1.0, 1.6, 1.6),
+    )
+    names = sorted(
+        {v.node for tr in traces for v in tr.visits},
+        key=lambda n: next(i for tr in traces for i, v in enumerate(tr.visits) if v.node == n),
+    )
     colors = {n: plt.cm.tab10(i % 10) for i, n in enumerate(names)}
     for j, tr in enumerate(traces):
         ax0, ax1, ax2 = axes[:, j]
         for i, v in enumerate(tr.visits):
-            ax0.broken_barh([(v.t_enter, max(v.t_exit - v.t_enter, 1e-3))], (i - 0.4, 0.8),
-                            color=colors[v.node])
+            ax0.broken_barh(
+                [(v.t_enter, max(v.t_exit - v.t_enter, 1e-3))], (i - 0.4, 0.8), color=colors[v.node]
+            )
             ax0.text(v.t_exit, i, f" {v.node}", va="center", fontsize=7)
         ax0.set_yticks([])
         ax0.invert_yaxis()
