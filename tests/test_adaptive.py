@@ -12,10 +12,11 @@ from teachfit.control.adaptive import (
     meta_bounds,
 )
 from teachfit.control.base import Controller
-from teachfit.control.impedance import CartesianImpedance, ImpedanceLimits
-from teachfit.errors import ControlError
+from teachfit.control.impedance import CartesianImpedance
+from teachfit.core.control import AdaptiveSpec, FixedGainSpec, ImpedanceLimits
+from teachfit.core.errors import ControlError
 from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import get_task
 
 MASS = np.array([1.0, 1.0, 1.0, 0.004, 0.004, 0.004])
@@ -29,8 +30,11 @@ def _hold(stiffness: object = (500.0,) * 3 + (50.0,) * 3) -> ImpedanceCommand:
     return ImpedanceCommand(pos=np.zeros(3), stiffness=stiffness)
 
 
-def _free_space_error(controller: object, force: np.ndarray, ticks: int) -> np.ndarray:
-    """Hold a pose in free space against a constant external force; return the final offset."""
+def _free_space_error(
+    controller: object, force: np.ndarray, ticks: int
+) -> tuple[np.ndarray, object]:
+    """Hold a pose in free space against a constant external force; the final offset and the
+    law that ran."""
     task = get_task("peg2d")
     robot = FloatingToolRobot(
         task, controller=controller, params=FloatingToolParams(ft_noise=(0.0, 0.0))
@@ -39,23 +43,21 @@ def _free_space_error(controller: object, force: np.ndarray, ticks: int) -> np.n
     robot.reset(start)
     robot.data.xfrc_applied[robot._body, :3] = force  # a constant disturbance at the tool's COM
     state = robot.step(ticks)
-    return state.pos - start.pos
+    return state.pos - start.pos, robot.law
 
 
 def test_is_a_controller_and_runs_on_the_floating_tool() -> None:
-    ctrl = AdaptiveImpedance(MASS)
-    assert isinstance(ctrl, Controller)
-    offset = _free_space_error(ctrl, np.zeros(3), 200)
+    offset, law = _free_space_error(AdaptiveSpec(), np.zeros(3), 200)
+    assert isinstance(law, AdaptiveImpedance) and isinstance(law, Controller)
     assert np.linalg.norm(offset) < 1e-6
 
 
 def test_feedforward_converges_to_cancel_a_constant_disturbance() -> None:
     force = np.array([5.0, -3.0, 2.0])
     params = AdaptiveParams(gamma_a=(0.0,) * 3 + (1e-2,) * 3)
-    ctrl = AdaptiveImpedance(MASS, params=params)
-    offset = _free_space_error(ctrl, force, 3000)
+    offset, ctrl = _free_space_error(AdaptiveSpec(params=params), force, 3000)
     assert ctrl.feedforward[:3] == pytest.approx(-force, abs=0.05)
-    fixed = _free_space_error(CartesianImpedance(MASS), force, 3000)
+    fixed, _ = _free_space_error(FixedGainSpec(), force, 3000)
     assert np.linalg.norm(fixed) > 5e-3  # F / K with K = 1000 N/m
     assert np.linalg.norm(offset) < 0.02 * np.linalg.norm(fixed)
 

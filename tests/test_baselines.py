@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
 
 

@@ -14,7 +14,7 @@ from teachfit.capture.markers import (
     write_markers,
 )
 from teachfit.capture.rig import Camera, Rig, read_rig, write_rig
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 from teachfit.plans.parts import pose_from_xyz_rpy
 
 

@@ -22,7 +22,7 @@ from teachfit.capture.synth_calib import write_charuco_shots
 from teachfit.capture.track import STATUS, track_frames
 from teachfit.cli import app
 from teachfit.demonstrations.dataset import read_demo
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 CFG = SynthConfig(resolutions=((640, 480),) * 3, distance=0.35, stride=15, noise=1.0)
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.plans import CollisionChecker, build_assembly, pose_from_xyz_rpy
 
 

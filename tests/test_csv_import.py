@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from teachfit.demonstrations.csv_import import ColumnMap, import_csv
-from teachfit.errors import DatasetError
+from teachfit.core.errors import DatasetError
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 LOG = EXAMPLES / "robot_log.csv"

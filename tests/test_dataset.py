@@ -19,7 +19,7 @@ from teachfit.demonstrations.dataset import (
     read_demo,
     write_dataset,
 )
-from teachfit.errors import DatasetError
+from teachfit.core.errors import DatasetError
 
 
 def make_demo(

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import ModelError
+from teachfit.core.errors import ModelError
 from teachfit.models.dynamics import DynamicsModel, fit_dynamics
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.ergodic import CosineBasis, ergodic_trajectory, search_box
 from teachfit.trajectories.ergodic_opt import ergodic_cost_and_gradient, optimise_ergodic

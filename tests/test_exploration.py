@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import ModelError, TeachfitError
+from teachfit.core.errors import ModelError, TeachfitError
 from teachfit.models.exploration import ExplorationDistribution, fit_exploration
 
 

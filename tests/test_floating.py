@@ -1,9 +1,10 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import SimulationDiverged
+from teachfit.core.errors import SimulationDiverged
 from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
-from teachfit.robot.interface import ImpedanceCommand, Robot
+from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.interface import Robot
 from teachfit.tasks import get_task
 
 

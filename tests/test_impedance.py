@@ -7,10 +7,10 @@ from teachfit.control.impedance import (
     aligned_stiffness,
     critical_damping,
 )
-from teachfit.errors import ControlError
-from teachfit.pose import quat_from_rz
+from teachfit.core.errors import ControlError
+from teachfit.core.geometry import quat_from_rz
 from teachfit.robot.floating import FloatingToolRobot
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import get_task
 
 
@@ -55,7 +55,10 @@ def test_tracks_a_moving_setpoint_in_free_space():
     start = task.contact_pose([0.0, 0.0]).translated([0, 0, 0.05])  # well above the block
     robot.reset(start)
     v = np.array([0.02, -0.01, 0.0])
-    robot.command(ImpedanceCommand(pos=start.pos, lin_vel=v, stiffness=[2000] * 3 + [50] * 3))
+    cmd = ImpedanceCommand(
+        pos=start.pos, lin_vel=v, stiffness=[2000] * 3 + [50] * 3, expires_after=2.0
+    )
+    robot.command(cmd)
     state = robot.step(1000)
     expected = start.pos + v * state.t
     assert np.linalg.norm(state.pos - expected) < 1e-3  # < 1 mm lag at 2 cm/s
@@ -63,9 +66,22 @@ def test_tracks_a_moving_setpoint_in_free_space():
     assert np.linalg.norm(state.wrench[:3]) < 0.5  # nothing touched
 
 
+def test_an_expired_command_stops_moving_the_setpoint():
+    task = get_task("peg2d")
+    robot = FloatingToolRobot(task)
+    start = task.contact_pose([0.0, 0.0]).translated([0, 0, 0.05])
+    robot.reset(start)
+    v = np.array([0.02, 0.0, 0.0])
+    robot.command(ImpedanceCommand(pos=start.pos, lin_vel=v, expires_after=0.2))
+    robot.step(1500)  # 1.5 s: the set-point moved for 0.2 s only, then held
+    state = robot.step(1)
+    assert state.pos[0] - start.pos[0] == pytest.approx(0.02 * 0.2, abs=5e-4)
+    assert np.linalg.norm(state.lin_vel) < 1e-3
+
+
 def test_velocity_limit_clips_the_setpoint_motion():
     ctrl = CartesianImpedance(np.ones(6), ImpedanceLimits(max_speed=0.1, max_force=1e4))
-    ctrl.set_command(ImpedanceCommand(pos=np.zeros(3), lin_vel=[1.0, 0, 0]), 0.0)
+    ctrl.set_command(ImpedanceCommand(pos=np.zeros(3), lin_vel=[1.0, 0, 0], expires_after=5.0), 0.0)
     w = ctrl.compute(1.0, np.zeros(3), np.array([1.0, 0, 0, 0]), np.zeros(3), np.zeros(3))
     # after 1 s the set-point moved 0.1 m, not 1 m: force = K * 0.1 + D * 0.1
     k = 1000.0

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot, build_scene
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import Key, KeyParams, get_task
 from teachfit.tasks.prism_geometry import beyond_edge_block, rectangle
 

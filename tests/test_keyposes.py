@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.plans import build_assembly, rank_key_poses, synth_demo
 
 

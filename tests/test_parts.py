@@ -2,7 +2,7 @@
 
 import pytest
 
-from teachfit.errors import TaskError
+from teachfit.core.errors import TaskError
 from teachfit.plans import PARTS, CollisionChecker, LGrooveParams, TenonParams, build_assembly
 
 

@@ -2,9 +2,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from teachfit.errors import TaskError
+from teachfit.core.errors import TaskError
 from teachfit.robot.floating import FloatingToolRobot, build_scene
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import Peg2D, Peg2DParams, get_task, load_task
 
 

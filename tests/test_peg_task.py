@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose, rotation_to_wxyz
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose, rotation_to_wxyz
 from teachfit.robot.floating import FloatingToolRobot, build_scene
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import AluminiumPeg, AluminiumPegParams, get_task
 
 

@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.plans import MotionPlanner, PlannerConfig, build_assembly, synth_demo
 
 

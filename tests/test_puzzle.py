@@ -6,10 +6,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot, build_scene
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import Puzzle, PuzzleParams, SkillTask, get_task, load_task
 
 STIFF = [300, 300, 300, 50, 50, 50]

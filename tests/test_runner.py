@@ -1,8 +1,8 @@
 import numpy as np
 
-from teachfit.errors import SimulationDiverged
+from teachfit.core.errors import SimulationDiverged
 from teachfit.execution.runner import ExecutionConfig, run_trajectory
-from teachfit.execution.setpoints import SetpointTrajectory
+from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks import get_task
 

@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from teachfit.demonstrations.teacher import BlindTeacher
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.execution.search import plan_search, run_search, search_setpoints
 from teachfit.models.search_model import SearchModel
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks import get_task
 from teachfit.trajectories import SearchTrajectory

@@ -3,7 +3,7 @@ import json
 import numpy as np
 import pytest
 
-from teachfit.errors import ModelError
+from teachfit.core.errors import ModelError
 from teachfit.models.search_data import DemoArrays, search_data, yaw_relative
 from teachfit.models.search_model import SearchModel
 

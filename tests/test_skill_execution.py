@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from teachfit.errors import SimulationDiverged
-from teachfit.pose import Pose
+from teachfit.core.errors import SimulationDiverged
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.skills import peg_in_hole
 from teachfit.skills.conditions import TimeAbove

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from teachfit.errors import SkillError
+from teachfit.core.errors import SkillError
 from teachfit.learning.base import ParamDomain
-from teachfit.pose import Pose
-from teachfit.robot.interface import RobotState
+from teachfit.core.geometry import Pose
+from teachfit.core.state import RobotState
 from teachfit.skills import peg_in_hole
 from teachfit.skills.conditions import (
     All,

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot, build_scene
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks import Socket3D, Socket3DParams, get_task
 from teachfit.tasks.socket_geometry import valley_wedge
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.metrics.stats import summarize, wilson_interval
 
 

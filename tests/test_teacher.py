@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from teachfit.demonstrations.teacher import BlindTeacher, TeacherStyle
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.tasks import get_task
 
 

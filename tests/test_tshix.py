@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from teachfit.errors import PlanningError, TeachfitError
+from teachfit.core.errors import PlanningError, TeachfitError
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.tshix import SearchTrajectory, TshixPlanner, timed_path, tshix
 

@@ -3,7 +3,7 @@ import itertools
 import numpy as np
 import pytest
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.trajectories.tsp import open_tour, path_length
 
 

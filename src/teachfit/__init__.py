@@ -8,7 +8,7 @@ with ``tasks`` (the simulated assembly cells), ``robot`` (the robot interface an
 implementation), ``control`` (impedance control laws) and ``viz`` (figures, video) beside them.
 """
 
-from teachfit.errors import (
+from teachfit.core.errors import (
     ControlError,
     DatasetError,
     ModelError,

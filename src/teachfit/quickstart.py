@@ -26,7 +26,7 @@ from teachfit.execution.runner import Outcome, run_trajectory
 from teachfit.execution.search import plan_search, run_search
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.registry import get_task
 from teachfit.viz import search_figures

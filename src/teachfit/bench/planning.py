@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.plans.parts import PARTS, build_assembly
 from teachfit.plans.planner import MotionPlanner, PlannerConfig
 from teachfit.plans.synth import synth_demo

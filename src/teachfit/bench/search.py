@@ -24,10 +24,10 @@ import numpy as np
 from teachfit.bench.search_jobs import JobResult, SearchJob, model_json, pose_tuple, run_jobs
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.demonstrations.teacher import BlindTeacher
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.tasks.registry import get_task
 
 #: the paper's real-robot results (successes, trials)

@@ -20,7 +20,7 @@ import numpy as np
 
 from teachfit.execution.search import plan_search, run_search
 from teachfit.models.search_model import SearchModel
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task

@@ -26,7 +26,7 @@ import numpy as np
 from teachfit.capture.geometry import invert
 from teachfit.capture.markers import aruco_dictionary
 from teachfit.capture.rig import Camera, Rig
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["CalibrationReport", "CharucoSpec", "calibrate_folder", "calibrate_rig", "load_views"]
 

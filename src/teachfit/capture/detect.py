@@ -16,7 +16,7 @@ import cv2
 import numpy as np
 
 from teachfit.capture.markers import aruco_dictionary, square_points
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = [
     "DetectorConfig",

@@ -34,7 +34,7 @@ from teachfit.capture.detect import Detection, square_poses
 from teachfit.capture.geometry import invert, rotation_angle_deg, skew
 from teachfit.capture.markers import Marker
 from teachfit.capture.rig import Rig
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["FusionConfig", "PartPose", "fuse_part", "relative_pose"]
 

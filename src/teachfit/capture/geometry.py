@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = [
     "ROTATION_TOL",

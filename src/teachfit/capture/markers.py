@@ -29,7 +29,7 @@ import cv2
 import numpy as np
 
 from teachfit.capture.geometry import checked_transform, toml_matrix
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = [
     "DICTIONARIES",

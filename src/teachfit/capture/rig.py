@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from teachfit.capture.geometry import checked_transform, invert, toml_matrix
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["Camera", "Rig", "read_rig", "write_rig"]
 

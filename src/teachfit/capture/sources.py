@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 from teachfit.capture.rig import Rig
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["CameraSet", "VideoSet"]
 

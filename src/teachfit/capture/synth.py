@@ -26,7 +26,7 @@ from teachfit.capture.markers import Marker, MarkerSet, marker_image, write_mark
 from teachfit.capture.rig import Camera, Rig, write_rig
 from teachfit.capture.scene import Carrier, Quad, camera_K, look_at, scene_xml
 from teachfit.demonstrations.dataset import Demonstration, write_dataset
-from teachfit.errors import CaptureError, RenderError
+from teachfit.core.errors import CaptureError, RenderError
 from teachfit.plans.parts import Assembly, build_assembly, pose_from_xyz_rpy
 from teachfit.plans.synth import synth_demo
 

@@ -19,7 +19,7 @@ from teachfit.capture.calibrate import CharucoSpec
 from teachfit.capture.rig import Rig
 from teachfit.capture.scene import Quad, scene_xml
 from teachfit.capture.synth import SynthConfig, synth_rig
-from teachfit.errors import RenderError
+from teachfit.core.errors import RenderError
 from teachfit.plans.parts import pose_from_xyz_rpy
 
 __all__ = ["write_charuco_shots"]

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["FilterConfig", "PoseFilter"]
 

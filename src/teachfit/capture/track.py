@@ -22,7 +22,7 @@ from teachfit.capture.markers import MarkerSet
 from teachfit.capture.rig import Rig
 from teachfit.capture.temporal import FilterConfig, PoseFilter
 from teachfit.demonstrations.dataset import Demonstration
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["STATUS", "Track", "TrackConfig", "Tracker", "track_frames"]
 

@@ -11,7 +11,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 
 TABLES = ("1", "2", "ablation", "3", "all")
 _COLS = ("method", "ours [95 % CI]", "paper [95 % CI]", "median time", "plan", "length", "E")

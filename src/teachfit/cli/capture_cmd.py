@@ -13,7 +13,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
-from teachfit.errors import CaptureError
+from teachfit.core.errors import CaptureError
 
 __all__ = ["bench_capture_cmd", "capture_app"]
 

@@ -9,7 +9,7 @@ from typing import ParamSpec, TypeVar
 import typer
 from rich.console import Console
 
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 
 console = Console()
 err_console = Console(stderr=True)

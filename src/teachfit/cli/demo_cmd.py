@@ -17,7 +17,7 @@ from teachfit.demonstrations.dataset import (
     write_dataset,
 )
 from teachfit.demonstrations.teacher import PATTERNS, BlindTeacher, TeacherStyle
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.tasks.registry import load_task
 
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)

@@ -45,7 +45,7 @@ def render(
 ) -> None:
     """Render a recorded demonstration with MuJoCo's offscreen renderer to an mp4."""
     from teachfit.demonstrations.dataset import read_demo
-    from teachfit.errors import DatasetError
+    from teachfit.core.errors import DatasetError
     from teachfit.viz.video import render_motion
 
     the_task = load_task(task)
@@ -80,7 +80,7 @@ def bench_sim(
     repeats: int = 3,
 ) -> None:
     """Raw mj_step steps/s vs. steps/s with the controller in the loop, in contact."""
-    from teachfit.bench.sim import measure_sim_speed
+    from teachfit.robot.speed import measure_sim_speed
 
     the_task = load_task(task)
     s = measure_sim_speed(the_task, steps, repeats)

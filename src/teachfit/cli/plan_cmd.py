@@ -18,7 +18,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 
 __all__ = [
     "app",

@@ -11,7 +11,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
 
@@ -141,7 +141,7 @@ def run(
     demo_start = None
     if demo is not None:
         from teachfit.demonstrations.dataset import read_demo
-        from teachfit.pose import Pose
+        from teachfit.core.geometry import Pose
 
         d = read_demo(demo)
         if d.task != the_task.name:

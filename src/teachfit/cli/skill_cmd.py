@@ -96,7 +96,7 @@ def run(
     height: int = 480,
 ) -> None:
     """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
-    from teachfit.errors import SkillError
+    from teachfit.core.errors import SkillError
     from teachfit.skills.library import get_skill
     from teachfit.skills.params import read_params_toml
     from teachfit.skills.trial import SkillTrial, peg_in_hole_setup

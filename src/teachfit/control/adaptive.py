@@ -35,21 +35,21 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from teachfit.control.adaptive_params import (
+from teachfit.core.control import (
     AdaptiveLimits,
     AdaptiveParams,
+    ImpedanceLimits,
     MetaBounds,
     meta_bounds,
 )
 from teachfit.control.impedance import (
-    ImpedanceLimits,
     SetpointError,
     clip_wrench,
     clipped_twist,
     critical_damping,
 )
-from teachfit.errors import ControlError
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.errors import ControlError
+from teachfit.core.state import ImpedanceCommand
 
 __all__ = ["AdaptiveImpedance", "AdaptiveLimits", "AdaptiveParams", "MetaBounds", "meta_bounds"]
 

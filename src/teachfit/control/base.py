@@ -6,7 +6,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 
 
 @runtime_checkable

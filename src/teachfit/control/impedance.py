@@ -13,28 +13,16 @@ for the floating tool, applies it directly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
-import mujoco
 import numpy as np
 
-from teachfit.errors import ControlError
-from teachfit.robot.interface import ImpedanceCommand
-
-
-@dataclass(frozen=True)
-class ImpedanceLimits:
-    """Safety limits of the impedance controller (N, N·m, m/s, rad/s)."""
-
-    max_force: float = 60.0
-    max_torque: float = 6.0
-    max_speed: float = 0.25
-    max_ang_speed: float = 1.5
-
-    def __post_init__(self) -> None:
-        for name in ("max_force", "max_torque", "max_speed", "max_ang_speed"):
-            if not getattr(self, name) > 0:
-                raise ControlError(f"{name} must be > 0, got {getattr(self, name)}")
+from teachfit.core.control import ImpedanceLimits
+from teachfit.core.errors import ControlError
+from teachfit.core.geometry import (
+    quat_diff_into,
+    quat_integrate_into,
+    quat_rotate_into,
+)
+from teachfit.core.state import ImpedanceCommand
 
 
 def clipped_twist(cmd: ImpedanceCommand, limits: ImpedanceLimits) -> np.ndarray:
@@ -87,6 +75,9 @@ class SetpointError:
     ``e = [x_d(t) - x; r]`` with ``q ⊗ exp(r_tool) = q_d(t)`` and ``r`` the rotation vector in the
     world frame, and ``de = v_d - [v; ω]`` (m, rad, m/s, rad/s, world frame at the TCP). Shared by
     the fixed-gain and the adaptive controller; buffers are allocated once (1 kHz path).
+
+    The command expires ``expires_after`` s after ``t_0``: from then on ``t - t_0`` is held at
+    ``expires_after`` and ``v_d = 0`` (the set-point stays where it got to; ``lapsed`` is set).
     """
 
     def __init__(self) -> None:
@@ -96,6 +87,9 @@ class SetpointError:
         self._qd = np.array([1.0, 0.0, 0.0, 0.0])
         self._vd = np.zeros(6)
         self._t0 = 0.0
+        self._expiry = np.inf
+        #: the last command expired: its set-point is held where it got to
+        self.lapsed = False
         self._qtmp = np.zeros(4)
         self._rtmp = np.zeros(3)
         self._spinning = False
@@ -107,12 +101,25 @@ class SetpointError:
         self._xd[:] = cmd.pos
         self._qd[:] = cmd.quat
         self._t0 = t
+        self._expiry = t + cmd.expires_after
+        self.lapsed = False
 
     def update(
         self, t: float, pos: np.ndarray, quat: np.ndarray, lin_vel: np.ndarray, ang_vel: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
         """``(e, de)`` (6,) each at time ``t``; views of buffers overwritten by the next call."""
         dt = t - self._t0
+        if t > self._expiry:  # hold the set-point where the expired command left it
+            dt = self._expiry - self._t0
+            self._xd += self._vd[:3] * dt
+            if self._spinning:
+                quat_integrate_into(self._qd, self._vd[3:], dt)
+            self._vd[:] = 0.0
+            self._spinning = False
+            self._t0 = t
+            self._expiry = np.inf
+            self.lapsed = True
+            dt = 0.0
         err, derr = self.err, self.derr
         np.subtract(self._xd, pos, out=err[:3])
         err[:3] += self._vd[:3] * dt
@@ -120,10 +127,10 @@ class SetpointError:
         if self._spinning:
             qd = self._qtmp
             qd[:] = self._qd
-            mujoco.mju_quatIntegrate(qd, self._vd[3:], dt)
+            quat_integrate_into(qd, self._vd[3:], dt)
         # rotation vector r with q * exp(r) = q_d (tool frame), then expressed in the world
-        mujoco.mju_subQuat(self._rtmp, qd, quat)
-        mujoco.mju_rotVecQuat(err[3:], self._rtmp, quat)
+        quat_diff_into(self._rtmp, qd, quat)
+        quat_rotate_into(err[3:], quat, self._rtmp)
         np.subtract(self._vd[:3], lin_vel, out=derr[:3])
         np.subtract(self._vd[3:], ang_vel, out=derr[3:])
         return err, derr

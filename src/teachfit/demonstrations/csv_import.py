@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from teachfit.demonstrations.dataset import MIN_SAMPLES, QUAT_NORM_TOL, Demonstration
-from teachfit.errors import DatasetError
+from teachfit.core.errors import DatasetError
 
 POSITION_KEYS = ("time", "x", "y", "z")
 QUAT_KEYS = ("qw", "qx", "qy", "qz")

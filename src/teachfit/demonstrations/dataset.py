@@ -35,7 +35,7 @@ import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from teachfit.errors import DatasetError
+from teachfit.core.errors import DatasetError
 
 SOURCES: tuple[str, ...] = ("simulated-teacher", "imported", "captured", "synthetic")
 MIN_SAMPLES = 2

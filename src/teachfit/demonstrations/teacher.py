@@ -26,10 +26,10 @@ import numpy as np
 from rich.progress import Progress
 
 from teachfit.demonstrations.dataset import Demonstration
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.execution.runner import ExecutionConfig, run_trajectory
-from teachfit.execution.setpoints import SetpointTrajectory
-from teachfit.pose import Pose, quat_from_rz
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.core.geometry import Pose, quat_from_rz
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.base import Task
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from teachfit.demonstrations.dataset import Demonstration
-from teachfit.execution.setpoints import SetpointTrajectory
-from teachfit.pose import Pose
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.core.geometry import Pose
 
 
 def replay_trajectory(

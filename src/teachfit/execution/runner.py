@@ -14,10 +14,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from teachfit.control.impedance import aligned_stiffness
-from teachfit.errors import ControlError, SimulationDiverged
-from teachfit.execution.setpoints import SetpointTrajectory
-from teachfit.pose import Pose
-from teachfit.robot.interface import ImpedanceCommand, Robot, RobotState
+from teachfit.core.errors import ControlError, SimulationDiverged
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.interface import Robot
 from teachfit.tasks.base import Task
 
 

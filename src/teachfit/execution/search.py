@@ -13,11 +13,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from teachfit.errors import TeachfitError
+from teachfit.core.errors import TeachfitError
 from teachfit.execution.runner import ExecutionConfig, ExecutionLog, Outcome, run_trajectory
-from teachfit.execution.setpoints import SetpointTrajectory
+from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.models.search_model import SearchModel
-from teachfit.pose import Pose, quat_from_rz
+from teachfit.core.geometry import Pose, quat_from_rz
 from teachfit.robot.interface import Robot
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory

@@ -24,7 +24,7 @@ from typing import Any, Literal
 import numpy as np
 from scipy.special import softmax
 
-from teachfit.errors import ModelError
+from teachfit.core.errors import ModelError
 from teachfit.models.exploration import component_logpdf, fit_regularised_gmm
 
 #: Absolute standard-deviation floors: steps (m or rad per sample) and actions (N or N m).

@@ -25,7 +25,7 @@ from scipy.special import logsumexp
 from scipy.stats.qmc import MultivariateNormalQMC
 from sklearn.mixture import GaussianMixture
 
-from teachfit.errors import ModelError
+from teachfit.core.errors import ModelError
 
 #: Default absolute standard-deviation floor per kind of DOF (m for lengths, rad for angles).
 ABS_FLOOR = {"x": 1e-4, "y": 1e-4, "z": 1e-4, "rz": 1e-3}

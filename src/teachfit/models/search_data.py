@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from teachfit.errors import ModelError
+from teachfit.core.errors import ModelError
 
 TASK_DIMS: dict[str, tuple[str, ...]] = {"peg2d": ("x", "y"), "socket3d": ("x", "y", "rz")}
 _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rx": 3, "ry": 4, "rz": 5}

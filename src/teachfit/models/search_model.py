@@ -29,7 +29,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from teachfit.errors import ModelError
+from teachfit.core.errors import ModelError
 from teachfit.models.dynamics import DynamicsModel, fit_dynamics
 from teachfit.models.exploration import ExplorationDistribution, fit_exploration
 from teachfit.models.search_data import dims_for_task, search_data, validate_dims

@@ -14,7 +14,7 @@ import coal
 import numpy as np
 import trimesh
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 
 __all__ = ["CollisionChecker", "pose_to_matrix", "quat_to_matrix", "validate_mesh"]
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 
 __all__ = ["PARAMS", "KeyPoses", "pose_parameters", "rank_key_poses", "select_candidates"]
 

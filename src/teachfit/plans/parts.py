@@ -30,7 +30,7 @@ import numpy as np
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from teachfit.errors import TaskError
+from teachfit.core.errors import TaskError
 
 __all__ = [
     "PARTS",

@@ -22,7 +22,7 @@ import ompl.geometric as og
 import ompl.util as ou
 from scipy.spatial.transform import Rotation, Slerp
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
 from teachfit.plans.keyposes import KeyPoses, rank_key_poses
 from teachfit.plans.parts import Assembly

@@ -15,7 +15,7 @@ from scipy.signal import butter, sosfiltfilt
 from scipy.spatial.transform import Rotation
 
 from teachfit.demonstrations.dataset import Demonstration
-from teachfit.errors import TaskError
+from teachfit.core.errors import TaskError
 from teachfit.plans.collision import CollisionChecker
 from teachfit.plans.parts import Assembly
 

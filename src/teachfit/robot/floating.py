@@ -15,11 +15,11 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from teachfit.control.base import Controller
-from teachfit.control.impedance import CartesianImpedance
-from teachfit.errors import ControlError, SimulationDiverged
-from teachfit.pose import Pose
-from teachfit.robot.interface import ImpedanceCommand, RobotState
+from teachfit.control import make_law
+from teachfit.core.control import ControllerSpec, FixedGainSpec
+from teachfit.core.errors import ControlError, SimulationDiverged
+from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.tasks.base import ContactParams, Task
 from teachfit.tasks.mjcf import SceneXml, fmt
 
@@ -114,15 +114,20 @@ def build_scene(task: Task, params: FloatingToolParams | None = None) -> str:
 
 
 class FloatingToolRobot:
-    """The simulated robot: MuJoCo floating tool + controller + wrist F/T sensor.
+    """The simulated robot: MuJoCo floating tool + control law + wrist F/T sensor.
 
     Implements :class:`~teachfit.robot.interface.Robot`. One control tick is one physics step.
+    The control law is built from ``controller`` (data; default fixed-gain impedance) and
+    replaced by the one a :meth:`reset` names.
     """
+
+    name = "floating"
+    wrench_source = "wrist-ft"
 
     def __init__(
         self,
         task: Task,
-        controller: Controller | None = None,
+        controller: ControllerSpec | None = None,
         params: FloatingToolParams | None = None,
         seed: int = 0,
     ) -> None:
@@ -131,7 +136,8 @@ class FloatingToolRobot:
         self.xml = build_scene(task, self.params)
         self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
-        self.controller = controller or CartesianImpedance(self.params.apparent_mass)
+        self.controller_spec: ControllerSpec = controller or FixedGainSpec()
+        self._law = make_law(self.controller_spec, self.params.apparent_mass, self.control_period)
         self.rng = np.random.default_rng(seed)
         m = self.model
         self._body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "tool")
@@ -157,6 +163,7 @@ class FloatingToolRobot:
         self._warnings = 0
         self._warning_numbers = self.data.warning.number
         self._cmd: ImpedanceCommand | None = None
+        self._fault: SimulationDiverged | None = None
 
     # ------------------------------------------------------------------ Robot protocol
     @property
@@ -167,26 +174,50 @@ class FloatingToolRobot:
     def time(self) -> float:
         return float(self.data.time)
 
-    def reset(self, pose: Pose) -> RobotState:
-        """Place the TCP at ``pose`` at rest, hold it, and tare the F/T sensor."""
+    def reset(self, pose: Pose, controller: ControllerSpec | None = None) -> RobotState:
+        """Place the TCP at ``pose`` at rest, hold it, and tare the F/T sensor; from now on run
+        ``controller`` (``None``: keep the current law, its adapted state cleared)."""
+        if controller is not None:
+            self.controller_spec = controller
+            self._law = make_law(controller, self.params.apparent_mass, self.control_period)
+        self._fault = None
         mujoco.mj_resetData(self.model, self.data)
         self._pos[:] = pose.pos
         self._quat[:] = pose.quat
         mujoco.mj_forward(self.model, self.data)
         self._ft_filt[:] = self._ft_raw
-        self.controller.reset()
+        self._law.reset()
         self.command(ImpedanceCommand.hold(pose))
         self._tare[:] = self._raw_wrench()  # tared at rest in free space, like a real sensor
         self._warnings = self._warning_count()
         return self.state()
 
     def command(self, cmd: ImpedanceCommand) -> None:
+        if self._fault is not None:
+            raise self._fault
         self._cmd = cmd
-        self.controller.set_command(cmd, self.data.time)
+        self._law.set_command(cmd, self.data.time)
+
+    def close(self) -> None:
+        """Nothing to release but the simulator's memory (kept until garbage collection)."""
+        self._cmd = None
+
+    def __enter__(self) -> FloatingToolRobot:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def law(self) -> object:
+        """The control law object running in the loop (inspection and tests only)."""
+        return self._law
 
     def step(self, n: int = 1) -> RobotState:
+        if self._fault is not None:
+            raise self._fault
         m, d = self.model, self.data
-        ctrl = self.controller
+        ctrl = self._law
         qfrc = d.qfrc_applied
         body = self._body
         pos, quat, linvel = self._pos, self._quat, self._linvel
@@ -258,8 +289,10 @@ class FloatingToolRobot:
                 mujoco.mjtWarning(i).name for i, w in enumerate(self.data.warning) if w.number > 0
             ]
             self._warnings = count
-            raise SimulationDiverged(
+            self._fault = SimulationDiverged(
                 f"MuJoCo warning(s) {kinds} at t={self.data.time:.3f} s: simulation invalid"
             )
+            raise self._fault
         if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
-            raise SimulationDiverged(f"NaN/inf in the state at t={self.data.time:.3f} s")
+            self._fault = SimulationDiverged(f"NaN/inf in the state at t={self.data.time:.3f} s")
+            raise self._fault

@@ -1,11 +1,21 @@
-"""The robot interface everything above the simulator talks to.
+"""The robot interface everything above the robot layer talks to.
 
-A robot reports :class:`RobotState` and accepts :class:`ImpedanceCommand`: a desired pose and
-twist, a feed-forward wrench, and the Cartesian stiffness and damping to track them with. This
-is what torque-controlled arms expose (KUKA FRI Cartesian impedance, Franka's
-``cartesian_impedance`` example); the simulated floating tool implements it with MuJoCo, and a
-7-DOF arm or a real driver implements the same protocol. Nothing above this interface touches
-MuJoCo.
+A robot reports :class:`~teachfit.core.state.RobotState` and accepts
+:class:`~teachfit.core.state.ImpedanceCommand`: a desired pose and twist, a feed-forward
+wrench, and the Cartesian stiffness and damping to track them with. This is what
+torque-controlled arms expose (KUKA FRI Cartesian impedance, Franka's ``cartesian_impedance``
+example). The robot runs its control loop itself, at its own rate; which control law that loop
+runs is *data* (:data:`~teachfit.core.control.ControllerSpec`, fixed-gain or adaptive
+impedance) handed over at :meth:`Robot.reset`. The simulated floating tool implements this
+protocol with MuJoCo; a 7-DOF arm or a real driver implements the same one and registers
+itself in :mod:`teachfit.robot.registry`. Nothing above this layer touches MuJoCo.
+
+A command expires: ``expires_after`` seconds after it was sent the set-point stops moving with
+the commanded twist. Faults are typed (:class:`~teachfit.core.errors.RobotFault` and its
+subclasses :class:`~teachfit.core.errors.ReflexFault`,
+:class:`~teachfit.core.errors.LimitViolation`, :class:`~teachfit.core.errors.ConnectionLost`,
+:class:`~teachfit.core.errors.SimulationDiverged`); after one, the robot accepts no command until
+the next :meth:`Robot.reset`.
 
 Frames and units: positions in metres, quaternions ``w, x, y, z``, twists ``[v; w]`` in m/s and
 rad/s, wrenches ``[f; tau]`` in N and N·m, all in the world frame at the tool centre point (TCP).
@@ -14,121 +24,24 @@ The measured wrench is the one the *environment exerts on the tool*.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
-import numpy as np
-
-from teachfit.errors import ControlError
-from teachfit.pose import IDENTITY_QUAT, Pose
-
-
-def _vec(value: object, n: int, name: str) -> np.ndarray:
-    arr = np.array(value, dtype=float).reshape(-1)
-    if arr.shape != (n,):
-        raise ControlError(f"{name} must have {n} elements, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ControlError(f"{name} contains NaN or inf")
-    arr.setflags(write=False)
-    return arr
-
-
-def _gain(value: object, name: str) -> np.ndarray:
-    """A (6, 6) symmetric positive semi-definite gain from a scalar, (6,) diagonal or (6, 6)."""
-    arr = np.array(value, dtype=float)
-    if arr.ndim == 0:
-        arr = np.full(6, float(arr))
-    if arr.shape == (6,):
-        arr = np.diag(arr)
-    if arr.shape != (6, 6):
-        raise ControlError(f"{name} must be a scalar, (6,) or (6, 6), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ControlError(f"{name} contains NaN or inf")
-    if not np.allclose(arr, arr.T, atol=1e-9 * max(1.0, np.abs(arr).max())):
-        raise ControlError(f"{name} must be symmetric")
-    if np.linalg.eigvalsh(arr).min() < -1e-9 * max(1.0, np.abs(arr).max()):
-        raise ControlError(f"{name} must be positive semi-definite")
-    arr.setflags(write=False)
-    return arr
-
-
-@dataclass(frozen=True)
-class RobotState:
-    """What the robot measures at one instant (world frame, at the TCP)."""
-
-    t: float
-    pos: np.ndarray
-    quat: np.ndarray
-    lin_vel: np.ndarray
-    ang_vel: np.ndarray
-    wrench: np.ndarray
-
-    @property
-    def pose(self) -> Pose:
-        return Pose(self.pos, self.quat)
-
-    @property
-    def twist(self) -> np.ndarray:
-        return np.concatenate([self.lin_vel, self.ang_vel])
-
-
-@dataclass(frozen=True)
-class ImpedanceCommand:
-    """A Cartesian impedance set-point (world frame, at the TCP).
-
-    The controller tracks ``x_d(t) = pos + lin_vel (t - t0)`` (and likewise the orientation)
-    between commands, so a robot can be commanded at a lower rate than it controls.
-
-    Parameters
-    ----------
-    pos, quat : desired TCP pose (m; w-x-y-z).
-    lin_vel, ang_vel : desired twist (m/s, rad/s).
-    wrench_ff : feed-forward wrench ``[f; tau]`` the robot adds (N, N·m).
-    stiffness : scalar, (6,) diagonal, or (6, 6) Cartesian stiffness (N/m, N·m/rad).
-    damping : same shapes (N·s/m, N·m·s/rad); ``None`` = critically damped for the robot's
-        apparent mass (``damping_ratio``).
-    """
-
-    pos: np.ndarray
-    quat: np.ndarray = field(default_factory=lambda: IDENTITY_QUAT.copy())
-    lin_vel: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    ang_vel: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    wrench_ff: np.ndarray = field(default_factory=lambda: np.zeros(6))
-    stiffness: np.ndarray = field(default_factory=lambda: np.array([1000.0] * 3 + [50.0] * 3))
-    damping: np.ndarray | None = None
-    damping_ratio: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "pos", _vec(self.pos, 3, "pos"))
-        quat = _vec(self.quat, 4, "quat")
-        norm = float(np.linalg.norm(quat))
-        if abs(norm - 1.0) > 1e-3:
-            raise ControlError(f"quat must have unit norm, has {norm:.6f}")
-        quat = quat / norm
-        quat.setflags(write=False)
-        object.__setattr__(self, "quat", quat)
-        object.__setattr__(self, "lin_vel", _vec(self.lin_vel, 3, "lin_vel"))
-        object.__setattr__(self, "ang_vel", _vec(self.ang_vel, 3, "ang_vel"))
-        object.__setattr__(self, "wrench_ff", _vec(self.wrench_ff, 6, "wrench_ff"))
-        object.__setattr__(self, "stiffness", _gain(self.stiffness, "stiffness"))
-        if self.damping is not None:
-            object.__setattr__(self, "damping", _gain(self.damping, "damping"))
-        if not self.damping_ratio >= 0:
-            raise ControlError(f"damping_ratio must be >= 0, got {self.damping_ratio}")
-
-    @classmethod
-    def hold(cls, pose: Pose, **kwargs: object) -> ImpedanceCommand:
-        """A command that holds ``pose`` still."""
-        return cls(pos=pose.pos, quat=pose.quat, **kwargs)  # type: ignore[arg-type]
+from teachfit.core.control import ControllerSpec
+from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand, RobotState
 
 
 @runtime_checkable
 class Robot(Protocol):
     """A robot that tracks Cartesian impedance commands at its own control rate."""
 
+    name: str
+    #: how the robot measures the external wrench: "wrist-ft" or "joint-torques"
+    wrench_source: str
+
     @property
     def control_period(self) -> float:
-        """Seconds per control tick (1 ms for the simulated robots)."""
+        """Seconds per control tick (1 ms for the simulated robots and the Franka)."""
         ...
 
     @property
@@ -136,8 +49,10 @@ class Robot(Protocol):
         """Seconds since the last reset."""
         ...
 
-    def reset(self, pose: Pose) -> RobotState:
-        """Place (simulation) or move (real robot) the TCP to ``pose`` at rest; zero the F/T."""
+    def reset(self, pose: Pose, controller: ControllerSpec | None = None) -> RobotState:
+        """Place (simulation) or move (real robot) the TCP to ``pose`` at rest, zero the wrench
+        reading, and run ``controller`` from now on (``None``: keep the current law; a fresh
+        robot runs fixed-gain impedance). Clears a latched fault."""
         ...
 
     def state(self) -> RobotState:
@@ -145,9 +60,16 @@ class Robot(Protocol):
         ...
 
     def command(self, cmd: ImpedanceCommand) -> None:
-        """Set the impedance set-point tracked from now on."""
+        """Set the impedance set-point tracked from now on (until it expires)."""
         ...
 
     def step(self, n: int = 1) -> RobotState:
-        """Let ``n`` control ticks pass (simulation: integrate; real robot: wait) and report."""
+        """Let ``n`` control ticks pass (simulation: integrate; real robot: wait) and report.
+
+        Raises a :class:`~teachfit.core.errors.RobotFault` when the robot faulted meanwhile.
+        """
+        ...
+
+    def close(self) -> None:
+        """Release the robot (stop the control loop, free the connection or the simulator)."""
         ...

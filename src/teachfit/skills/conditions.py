@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from teachfit.errors import SkillError
+from teachfit.core.errors import SkillError
 from teachfit.skills.params import Value, ref_name, resolve
 from teachfit.skills.percept import Percept
 

@@ -17,11 +17,11 @@ from collections.abc import Mapping
 import numpy as np
 
 from teachfit.control.adaptive import AdaptiveImpedance
-from teachfit.control.adaptive_params import AdaptiveLimits, AdaptiveParams, meta_bounds
+from teachfit.core.control import AdaptiveLimits, AdaptiveParams, meta_bounds
 from teachfit.control.base import Controller
 from teachfit.control.impedance import CartesianImpedance
-from teachfit.errors import SkillError
-from teachfit.learning.base import ParamDomain
+from teachfit.core.errors import SkillError
+from teachfit.core.params import ParamDomain
 from teachfit.skills.params import LearnedParam
 
 CONTROLLERS = ("adaptive", "impedance")

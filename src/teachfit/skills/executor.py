@@ -27,9 +27,10 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from teachfit.errors import ControlError, SimulationDiverged, SkillError
-from teachfit.pose import Pose
-from teachfit.robot.interface import ImpedanceCommand, Robot
+from teachfit.core.errors import ControlError, SimulationDiverged, SkillError
+from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.interface import Robot
 from teachfit.skills.conditions import Any_, Condition
 from teachfit.skills.graph import Skill
 from teachfit.skills.percept import MPCommand, Percept

@@ -7,7 +7,7 @@ condition (stop, positive: the edge to the terminal node, checked in every node)
 error condition (stop, negative, e.g. the time limit) and a recovery node run after an error.
 Parameters are :class:`~teachfit.skills.params.SkillParams`.
 
-A skill is validated when built; every problem raises :class:`~teachfit.errors.SkillError`
+A skill is validated when built; every problem raises :class:`~teachfit.core.errors.SkillError`
 naming the node at fault: an unreachable node, a primitive without an error exit, a transition
 to an unknown node, a reference to an undeclared parameter, a learned default outside its
 domain, or a primitive whose resolved values are invalid (e.g. a negative speed).
@@ -18,8 +18,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
-from teachfit.errors import SkillError
-from teachfit.learning.base import ParamSpace
+from teachfit.core.errors import SkillError
+from teachfit.core.params import ParamSpace
 from teachfit.skills.conditions import Check, Condition
 from teachfit.skills.params import SkillParams
 from teachfit.skills.primitive import Primitive, PrimitiveRun

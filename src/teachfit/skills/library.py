@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from teachfit.errors import SkillError
+from teachfit.core.errors import SkillError
 from teachfit.skills import peg_in_hole
 from teachfit.skills.graph import Skill
 from teachfit.skills.loader import load_skill

@@ -27,7 +27,7 @@ Layout (see ``examples/skills/peg_in_hole.toml``)::
     when = { all = [ { kind = "done" }, { kind = "remaining_below", value = 0.001 } ] }
 
 Values are numbers or (optionally negated) parameter names. The skill is validated as it is
-built, so a bad file fails with a :class:`~teachfit.errors.SkillError` naming the node.
+built, so a bad file fails with a :class:`~teachfit.core.errors.SkillError` naming the node.
 Python's standard library reads TOML but does not write it; :func:`skill_to_toml` writes this
 one layout (tables of scalars, arrays and inline tables) itself.
 """
@@ -42,8 +42,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from teachfit.errors import SkillError
-from teachfit.learning.base import LearningError, ParamDomain
+from teachfit.core.errors import SkillError
+from teachfit.core.params import LearningError, ParamDomain
 from teachfit.skills.conditions import condition_from_toml
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, LearnedParam, SkillParams

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from teachfit.errors import SkillError
+from teachfit.core.errors import SkillError
 from teachfit.skills.executor import ExecutionTrace
 
 

@@ -19,8 +19,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from teachfit.errors import SkillError
-from teachfit.learning.base import ParamDomain, ParamSpace
+from teachfit.core.errors import SkillError
+from teachfit.core.params import ParamDomain, ParamSpace
 
 #: a literal number or a (possibly negated) parameter name
 Value = float | str

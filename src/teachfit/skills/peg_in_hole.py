@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from teachfit.errors import SkillError
-from teachfit.learning.base import ParamDomain
-from teachfit.pose import Pose
+from teachfit.core.errors import SkillError
+from teachfit.core.params import ParamDomain
+from teachfit.core.geometry import Pose
 from teachfit.skills.conditions import (
     Any_,
     DepthAbove,

@@ -14,8 +14,8 @@ import math
 import mujoco
 import numpy as np
 
-from teachfit.pose import Pose
-from teachfit.robot.interface import RobotState
+from teachfit.core.geometry import Pose
+from teachfit.core.state import RobotState
 
 
 class Percept:

@@ -28,7 +28,7 @@ from typing import Any, ClassVar
 import mujoco
 import numpy as np
 
-from teachfit.errors import SkillError
+from teachfit.core.errors import SkillError
 from teachfit.skills.params import Value, ref_name, resolve
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.profile import Trapezoid, synchronized

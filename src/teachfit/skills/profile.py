@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from teachfit.errors import SkillError
+from teachfit.core.errors import SkillError
 
 
 @dataclass(frozen=True)

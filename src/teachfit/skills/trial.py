@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from teachfit.learning.base import TrialResult
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.skills import peg_in_hole
 from teachfit.skills.controllers import make_controller

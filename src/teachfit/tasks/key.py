@@ -27,7 +27,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.tasks.base import ContactParams
 from teachfit.tasks.mjcf import SceneXml, contact_attrs, fmt
 from teachfit.tasks.prism_geometry import beyond_edge_block, chamfered_prism, rectangle

@@ -25,7 +25,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from teachfit.pose import Pose
+from teachfit.core.geometry import Pose
 from teachfit.tasks.base import ContactParams
 from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
 from teachfit.tasks.skill_protocol import (

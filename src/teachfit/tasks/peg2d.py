@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose
 from teachfit.tasks.base import ContactParams, Task
 from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
 

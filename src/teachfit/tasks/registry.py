@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from teachfit.errors import TaskError
+from teachfit.core.errors import TaskError
 from teachfit.tasks.base import Task
 from teachfit.tasks.key import Key
 from teachfit.tasks.peg import AluminiumPeg

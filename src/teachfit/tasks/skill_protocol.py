@@ -23,8 +23,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose
 from teachfit.tasks.base import Task
 
 

@@ -33,8 +33,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from teachfit.errors import TaskError
-from teachfit.pose import Pose
+from teachfit.core.errors import TaskError
+from teachfit.core.geometry import Pose
 from teachfit.tasks.base import ContactParams, Task
 from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
 from teachfit.tasks.socket_geometry import disc_segment, rounded_pin, valley_wedge

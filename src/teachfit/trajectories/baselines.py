@@ -10,7 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.trajectories.tshix import SearchTrajectory, timed_path
 
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.tshix import (
     SearchTrajectory,

@@ -26,7 +26,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.optimize import minimize
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.ergodic import CosineBasis, _default_coeffs, ergodic_metric, search_box
 from teachfit.trajectories.tshix import SearchTrajectory, metric_weights, timed_path

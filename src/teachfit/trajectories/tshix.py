@@ -19,7 +19,7 @@ from typing import Any, Literal
 import numpy as np
 from scipy.signal import savgol_filter
 
-from teachfit.errors import ModelError, PlanningError
+from teachfit.core.errors import ModelError, PlanningError
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.tsp import open_tour
 

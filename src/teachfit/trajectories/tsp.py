@@ -27,7 +27,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.distance import cdist
 
-from teachfit.errors import PlanningError
+from teachfit.core.errors import PlanningError
 
 
 @dataclass(frozen=True)

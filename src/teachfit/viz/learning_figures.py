@@ -17,7 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from teachfit.learning.base import ParamSpace  # noqa: E402
+from teachfit.core.params import ParamSpace  # noqa: E402
 from teachfit.learning.curves import Band, best_so_far  # noqa: E402
 from teachfit.learning.study import TrialRecord  # noqa: E402
 from teachfit.skills.executor import ExecutionTrace  # noqa: E402

@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from teachfit.errors import RenderError  # noqa: E402
+from teachfit.core.errors import RenderError  # noqa: E402
 from teachfit.plans.collision import pose_to_matrix  # noqa: E402
 from teachfit.plans.parts import Assembly  # noqa: E402
 from teachfit.viz.plan_figures import MOVING_COLOR, _frame_axes, add_mesh  # noqa: E402

@@ -13,11 +13,10 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import imageio.v2 as imageio
-import mujoco
 import numpy as np
 
-from teachfit.errors import RenderError
-from teachfit.robot.floating import build_scene
+from teachfit.core.errors import RenderError
+from teachfit.robot.render import motion_frames
 from teachfit.tasks.base import Task
 
 
@@ -31,18 +30,6 @@ def video_writer(path: str | Path, fps: int = 30) -> Iterator[imageio.core.Forma
         yield writer
     finally:
         writer.close()
-
-
-def make_renderer(model: mujoco.MjModel, width: int, height: int) -> mujoco.Renderer:
-    """A MuJoCo offscreen renderer, or a :class:`RenderError` saying how to get one."""
-    try:
-        return mujoco.Renderer(model, height=height, width=width)
-    except Exception as exc:  # noqa: BLE001 - GL back-ends raise many unrelated types
-        backend = os.environ.get("MUJOCO_GL", "(unset)")
-        raise RenderError(
-            f"offscreen rendering is unavailable (MUJOCO_GL={backend}): {exc}. On a headless "
-            "machine set MUJOCO_GL=egl (Mesa's EGL works without a GPU) or MUJOCO_GL=osmesa."
-        ) from exc
 
 
 def render_motion(
@@ -64,29 +51,10 @@ def render_motion(
     t : (T,) s;  pos : (T, 3) m;  quat : (T, 4) w-x-y-z
     slowdown : play back this many times slower than real time.
     """
-    t = np.asarray(t, dtype=float)
-    if t.size < 2:
-        raise RenderError("need at least two poses to render a motion")
-    model = mujoco.MjModel.from_xml_string(build_scene(task))
-    data = mujoco.MjData(model)
-    renderer = make_renderer(model, width, height)
-    jnt = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "tool_free")
-    adr = int(model.jnt_qposadr[jnt])
-    cam = mujoco.MjvCamera()
-    cam.lookat[:] = task.hole2world.pos + np.array([0.0, 0.0, 0.01])
-    cam.distance = 0.16
-    cam.azimuth = 135.0
-    cam.elevation = -28.0
-    frame_times = np.arange(t[0], t[-1] + 1e-9, 1.0 / (fps * slowdown))
-    idx = np.clip(np.searchsorted(t, frame_times), 0, t.size - 1)
-    try:
-        with video_writer(out, fps=fps) as writer:
-            for i in idx:
-                data.qpos[adr : adr + 3] = pos[i]
-                data.qpos[adr + 3 : adr + 7] = quat[i]
-                mujoco.mj_forward(model, data)
-                renderer.update_scene(data, camera=cam)
-                writer.append_data(renderer.render())
-    finally:
-        renderer.close()
+    frames = motion_frames(
+        task, t, pos, quat, fps=fps, width=width, height=height, slowdown=slowdown
+    )
+    with video_writer(out, fps=fps) as writer:
+        for frame in frames:
+            writer.append_data(frame)
     return Path(out)

@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from teachfit.errors import ControlError
-from teachfit.pose import Pose, rotation_to_wxyz, wxyz_to_rotation
+from teachfit.core.errors import ControlError
+from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 
 
 @dataclass(frozen=True)

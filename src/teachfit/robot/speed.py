@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 
 from teachfit.robot.floating import FloatingToolRobot
-from teachfit.robot.interface import ImpedanceCommand
+from teachfit.core.state import ImpedanceCommand
 from teachfit.tasks.base import Task
 
 

@@ -1,5 +1,13 @@
-"""Meta-parameters of the adaptive impedance controller, the system limits, and the bounds
-the limits imply on the meta-parameters (METHODS.md B).
+"""Controller settings as data: which control law a robot runs, with its parameters.
+
+A robot runs its 1 kHz loop itself (a real arm's firmware callback, the simulator's step), so
+what the layers above hand it is data: a :data:`ControllerSpec`, either
+:class:`FixedGainSpec` (Cartesian impedance with the gains each command carries, seed A
+eqs. 8-9) or :class:`AdaptiveSpec` (seed B's adaptive impedance with its meta-parameters).
+The laws themselves are in :mod:`teachfit.control`.
+
+Also here: the meta-parameters of the adaptive impedance controller, the system limits, and the
+bounds the limits imply on the meta-parameters (METHODS.md B).
 
 All quantities are per task coordinate (x, y, z, rx, ry, rz; world frame at the TCP) and
 stored as 6-tuples of floats so that the dataclasses are frozen, hashable and comparable.
@@ -9,13 +17,29 @@ See :mod:`teachfit.control.adaptive` for the control law they parameterise.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
+from typing import ClassVar
 
 import numpy as np
 
-from teachfit.errors import ControlError
+from teachfit.core.errors import ControlError
 
 Vec6 = tuple[float, float, float, float, float, float]
+
+
+@dataclass(frozen=True)
+class ImpedanceLimits:
+    """Safety limits of the impedance controller (N, N·m, m/s, rad/s)."""
+
+    max_force: float = 60.0
+    max_torque: float = 6.0
+    max_speed: float = 0.25
+    max_ang_speed: float = 1.5
+
+    def __post_init__(self) -> None:
+        for name in ("max_force", "max_torque", "max_speed", "max_ang_speed"):
+            if not getattr(self, name) > 0:
+                raise ControlError(f"{name} must be > 0, got {getattr(self, name)}")
 
 
 def _six(value: float | Sequence[float] | np.ndarray, name: str, *, positive: bool) -> Vec6:
@@ -129,3 +153,34 @@ def meta_bounds(
         gamma_a=t6(eps / np.asarray(limits.f_max)),
         gamma_b=t6(eps * e / np.asarray(limits.k_max)),
     )
+
+
+@dataclass(frozen=True)
+class FixedGainSpec:
+    """Fixed-gain Cartesian impedance: stiffness and damping come with each command."""
+
+    kind: ClassVar[str] = "impedance"
+    limits: ImpedanceLimits = field(default_factory=ImpedanceLimits)
+
+
+@dataclass(frozen=True)
+class AdaptiveSpec:
+    """Seed B's adaptive impedance: the command's stiffness is the floor, adapted on top.
+
+    ``damping_ratio`` is ``xi`` of the adaptive damping term (``None``: each command's).
+    """
+
+    kind: ClassVar[str] = "adaptive"
+    params: AdaptiveParams = field(default_factory=AdaptiveParams)
+    limits: AdaptiveLimits = field(default_factory=AdaptiveLimits)
+    impedance_limits: ImpedanceLimits = field(default_factory=ImpedanceLimits)
+    damping_ratio: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.damping_ratio is not None and not self.damping_ratio >= 0:
+            raise ControlError(f"damping_ratio must be >= 0, got {self.damping_ratio}")
+
+
+#: what a robot is told to run
+ControllerSpec = FixedGainSpec | AdaptiveSpec
+CONTROLLER_KINDS = ("adaptive", "impedance")

@@ -43,7 +43,27 @@ class ControlError(TeachfitError):
     """Invalid controller gains, limits or commands."""
 
 
-class SimulationDiverged(TeachfitError):
+class RobotFault(TeachfitError):
+    """The robot stopped executing: what a real arm reports as a fault, or a broken simulation.
+
+    The execution engine ends the run with the matching :class:`~teachfit.core.outcome.Outcome`
+    and keeps everything recorded so far; nothing more is commanded to a faulted robot.
+    """
+
+
+class ReflexFault(RobotFault):
+    """A safety reflex stopped the arm (contact force/torque or joint torque over its threshold)."""
+
+
+class LimitViolation(RobotFault):
+    """A command or the measured motion broke a limit (joint, speed, wrench, workspace box)."""
+
+
+class ConnectionLost(RobotFault):
+    """The connection to the robot (or its control loop) was lost."""
+
+
+class SimulationDiverged(RobotFault):
     """The physics simulation produced NaN/inf or MuJoCo raised a warning that invalidates it."""
 
 

@@ -1,0 +1,120 @@
+"""What a robot measures and what it is commanded: values every layer shares.
+
+Frames and units: positions in metres, quaternions ``w, x, y, z``, twists ``[v; w]`` in m/s and
+rad/s, wrenches ``[f; tau]`` in N and N·m, all in the world frame at the tool centre point (TCP).
+The measured wrench is the one the *environment exerts on the tool*.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from teachfit.core.errors import ControlError
+from teachfit.core.geometry import IDENTITY_QUAT, Pose
+
+
+def _vec(value: object, n: int, name: str) -> np.ndarray:
+    arr = np.array(value, dtype=float).reshape(-1)
+    if arr.shape != (n,):
+        raise ControlError(f"{name} must have {n} elements, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ControlError(f"{name} contains NaN or inf")
+    arr.setflags(write=False)
+    return arr
+
+
+def _gain(value: object, name: str) -> np.ndarray:
+    """A (6, 6) symmetric positive semi-definite gain from a scalar, (6,) diagonal or (6, 6)."""
+    arr = np.array(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(6, float(arr))
+    if arr.shape == (6,):
+        arr = np.diag(arr)
+    if arr.shape != (6, 6):
+        raise ControlError(f"{name} must be a scalar, (6,) or (6, 6), got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ControlError(f"{name} contains NaN or inf")
+    if not np.allclose(arr, arr.T, atol=1e-9 * max(1.0, np.abs(arr).max())):
+        raise ControlError(f"{name} must be symmetric")
+    if np.linalg.eigvalsh(arr).min() < -1e-9 * max(1.0, np.abs(arr).max()):
+        raise ControlError(f"{name} must be positive semi-definite")
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """What the robot measures at one instant (world frame, at the TCP)."""
+
+    t: float
+    pos: np.ndarray
+    quat: np.ndarray
+    lin_vel: np.ndarray
+    ang_vel: np.ndarray
+    wrench: np.ndarray
+
+    @property
+    def pose(self) -> Pose:
+        return Pose(self.pos, self.quat)
+
+    @property
+    def twist(self) -> np.ndarray:
+        return np.concatenate([self.lin_vel, self.ang_vel])
+
+
+@dataclass(frozen=True)
+class ImpedanceCommand:
+    """A Cartesian impedance set-point (world frame, at the TCP).
+
+    The controller tracks ``x_d(t) = pos + lin_vel (t - t0)`` (and likewise the orientation)
+    between commands, so a robot can be commanded at a lower rate than it controls.
+
+    Parameters
+    ----------
+    pos, quat : desired TCP pose (m; w-x-y-z).
+    lin_vel, ang_vel : desired twist (m/s, rad/s).
+    wrench_ff : feed-forward wrench ``[f; tau]`` the robot adds (N, N·m).
+    stiffness : scalar, (6,) diagonal, or (6, 6) Cartesian stiffness (N/m, N·m/rad).
+    damping : same shapes (N·s/m, N·m·s/rad); ``None`` = critically damped for the robot's
+        apparent mass (``damping_ratio``).
+    expires_after : s after which the set-point stops being extrapolated with the desired
+        twist and is held where it got to (commands that stop arriving cannot drive the robot
+        away).
+    """
+
+    pos: np.ndarray
+    quat: np.ndarray = field(default_factory=lambda: IDENTITY_QUAT.copy())
+    lin_vel: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    ang_vel: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    wrench_ff: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    stiffness: np.ndarray = field(default_factory=lambda: np.array([1000.0] * 3 + [50.0] * 3))
+    damping: np.ndarray | None = None
+    damping_ratio: float = 1.0
+    expires_after: float = 0.25
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "pos", _vec(self.pos, 3, "pos"))
+        quat = _vec(self.quat, 4, "quat")
+        norm = float(np.linalg.norm(quat))
+        if abs(norm - 1.0) > 1e-3:
+            raise ControlError(f"quat must have unit norm, has {norm:.6f}")
+        quat = quat / norm
+        quat.setflags(write=False)
+        object.__setattr__(self, "quat", quat)
+        object.__setattr__(self, "lin_vel", _vec(self.lin_vel, 3, "lin_vel"))
+        object.__setattr__(self, "ang_vel", _vec(self.ang_vel, 3, "ang_vel"))
+        object.__setattr__(self, "wrench_ff", _vec(self.wrench_ff, 6, "wrench_ff"))
+        object.__setattr__(self, "stiffness", _gain(self.stiffness, "stiffness"))
+        if self.damping is not None:
+            object.__setattr__(self, "damping", _gain(self.damping, "damping"))
+        if not self.expires_after > 0:
+            raise ControlError(f"expires_after must be > 0 s, got {self.expires_after}")
+        if not self.damping_ratio >= 0:
+            raise ControlError(f"damping_ratio must be >= 0, got {self.damping_ratio}")
+
+    @classmethod
+    def hold(cls, pose: Pose, **kwargs: object) -> ImpedanceCommand:
+        """A command that holds ``pose`` still."""
+        return cls(pos=pose.pos, quat=pose.quat, **kwargs)  # type: ignore[arg-type]

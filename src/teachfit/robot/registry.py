@@ -1,0 +1,81 @@
+"""Every robot teachfit can drive, by name: the one place that builds a robot.
+
+``make_robot("floating", task)`` returns a ready :class:`~teachfit.robot.interface.Robot`.
+A new robot (a simulated arm, a real driver) is one module and one :func:`register` call;
+every command that runs a robot takes ``--robot NAME`` from :data:`ROBOTS`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from teachfit.core.control import ControllerSpec
+from teachfit.core.errors import TeachfitError
+from teachfit.robot.interface import Robot
+from teachfit.tasks.base import Task
+
+Factory = Callable[..., Robot]
+
+
+@dataclass(frozen=True)
+class RobotEntry:
+    """A registered robot: how to build it and what it is (one line for ``--help``)."""
+
+    name: str
+    factory: Factory
+    description: str
+    simulated: bool = True
+
+
+ROBOTS: dict[str, RobotEntry] = {}
+
+
+def register(entry: RobotEntry) -> None:
+    """Add a robot to :data:`ROBOTS` (a second entry of the same name is an error)."""
+    if entry.name in ROBOTS:
+        raise TeachfitError(f"robot {entry.name!r} is registered twice")
+    ROBOTS[entry.name] = entry
+
+
+def make_robot(
+    name: str,
+    task: Task,
+    *,
+    controller: ControllerSpec | None = None,
+    seed: int = 0,
+    **options: Any,
+) -> Robot:
+    """The robot ``name`` for ``task``'s cell, running ``controller`` (default fixed-gain).
+
+    ``seed`` seeds a simulated robot's sensor noise; ``options`` are the robot's own (e.g. a
+    real robot's ``host``). Unknown names raise :class:`TeachfitError` listing the known ones.
+    """
+    try:
+        entry = ROBOTS[name]
+    except KeyError:
+        raise TeachfitError(f"unknown robot {name!r}; known robots: {sorted(ROBOTS)}") from None
+    return entry.factory(task, controller=controller, seed=seed, **options)
+
+
+def _floating(
+    task: Task, *, controller: ControllerSpec | None = None, seed: int = 0, **options: Any
+) -> Robot:
+    from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
+
+    params = options.pop("params", None)
+    if options:
+        raise TeachfitError(f"robot 'floating' takes no option(s) {sorted(options)}")
+    return FloatingToolRobot(
+        task, controller=controller, params=params or FloatingToolParams(), seed=seed
+    )
+
+
+register(
+    RobotEntry(
+        "floating",
+        _floating,
+        "a free 6-DOF tool pushed by the impedance wrench, wrist F/T sensor (MuJoCo)",
+    )
+)
