@@ -22,17 +22,17 @@ def push_down(task, offset):
 def test_peg_enters_when_aligned_and_is_blocked_1mm_off(clearance):
     task = get_task("peg2d", clearance=clearance, peg_chamfer=0.0, hole_chamfer=0.0)
     aligned = push_down(task, 0.0)
-    assert task.is_inserted(aligned.pose)
+    assert task.ground_truth_inserted(aligned.pose)
     assert task.insertion_depth(aligned.pose) > 0.019  # reaches the bottom (20 mm)
     off = push_down(task, 0.001)
-    assert not task.is_inserted(off.pose)
+    assert not task.ground_truth_inserted(off.pose)
     assert abs(task.insertion_depth(off.pose)) < 2e-4  # rests on the surface
     assert off.wrench[2] > 5.0  # and the surface pushes back
 
 
 def test_chamfers_guide_a_1mm_offset_in():
     task = get_task("peg2d")  # default chamfers 1 mm (peg) and 0.5 mm (hole)
-    assert task.is_inserted(push_down(task, 0.001).pose)
+    assert task.ground_truth_inserted(push_down(task, 0.001).pose)
 
 
 def test_impossible_parameters_are_named():

@@ -59,43 +59,43 @@ def test_scene_is_a_free_standing_boss(task: AluminiumPeg) -> None:
 def test_aligned_or_chamfer_guided_peg_enters(robot, task, x) -> None:
     pose = push(robot, x)
     assert task.insertion_depth(pose) > task.params.hole_depth - 2e-4
-    assert task.is_inserted(pose)
+    assert task.ground_truth_inserted(pose)
 
 
 @pytest.mark.parametrize("x", [0.002, -0.002])
 def test_peg_2mm_off_is_blocked_on_the_rim(robot, task, x) -> None:
     pose = push(robot, x)
     assert abs(task.insertion_depth(pose)) < 2e-4
-    assert not task.is_inserted(pose)
+    assert not task.ground_truth_inserted(pose)
 
 
 def test_peg_beside_the_boss_is_deep_but_not_inserted(robot, task) -> None:
     pose = push(robot, 0.022)  # clear of the 12 mm boss: nothing stops it
     assert task.insertion_depth(pose) > task.success_depth
-    assert not task.is_inserted(pose)
+    assert not task.ground_truth_inserted(pose)
 
 
 def test_peg_slides_off_the_wall_less_hole(robot, task) -> None:
     pose = push(robot, 0.006, shove=0.03)  # pushed down and sideways from the boss top
     assert task.lateral_error(pose) > task.params.boss_diameter / 2
     assert task.insertion_depth(pose) > 0.01  # below the boss top, beside it
-    assert not task.is_inserted(pose)
+    assert not task.ground_truth_inserted(pose)
 
 
 def test_stiffly_tilted_peg_jams_compliant_one_enters(robot, task) -> None:
     stuck = push(robot, 0.0, tilt_deg=3.0, steps=1000)
     assert 0.002 < task.insertion_depth(stuck) < task.success_depth  # wedged part-way in
     assert task.tilt(stuck) > np.deg2rad(2.0)
-    assert not task.is_inserted(stuck)
+    assert not task.ground_truth_inserted(stuck)
     free = push(robot, 0.0, tilt_deg=3.0, rot_stiffness=0.5, steps=1500)
-    assert task.is_inserted(free)
+    assert task.ground_truth_inserted(free)
     assert task.tilt(free) < np.deg2rad(1.0)
 
 
-def test_is_inserted_needs_the_axis(task: AluminiumPeg) -> None:
+def test_ground_truth_inserted_needs_the_axis(task: AluminiumPeg) -> None:
     z = task.surface_z - 0.02
-    assert task.is_inserted(Pose.from_xyz_rz(0, 0, z, 1.0))  # round: any yaw
-    assert not task.is_inserted(Pose.from_xyz_rz(0.001, 0, z))
+    assert task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, 1.0))  # round: any yaw
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0.001, 0, z))
     assert task.overhang_offset == pytest.approx(0.004)
 
 

@@ -48,40 +48,40 @@ def test_scene_is_three_convex_walls_and_a_base(task: Puzzle) -> None:
 def test_aligned_piece_enters_to_the_bottom(robot, task, rz) -> None:
     pose = push(robot, 0.0, 0.0, rz)
     assert task.insertion_depth(pose) > task.params.hole_depth - 2e-4
-    assert task.is_inserted(pose)
+    assert task.ground_truth_inserted(pose)
 
 
 @pytest.mark.parametrize("offset", [(0.0015, 0.0), (-0.0015, 0.0), (0.0, 0.0015)])
 def test_offset_piece_is_blocked(robot, task, offset) -> None:
     pose = push(robot, *offset, 0.0)
     assert abs(task.insertion_depth(pose)) < 2e-4  # rests on the block: no chamfer guides it
-    assert not task.is_inserted(pose)
+    assert not task.ground_truth_inserted(pose)
 
 
 @pytest.mark.parametrize("deg", [3.0, 25.0])
 def test_rotated_piece_is_blocked(robot, task, deg) -> None:
     pose = push(robot, 0.0, 0.0, np.deg2rad(deg))
     assert abs(task.insertion_depth(pose)) < 2e-4
-    assert not task.is_inserted(pose)
+    assert not task.ground_truth_inserted(pose)
 
 
 def test_turned_hole_needs_the_turned_piece() -> None:
     turned = Puzzle(PuzzleParams(hole_yaw=0.4))
     robot = FloatingToolRobot(turned)
-    assert turned.is_inserted(push(robot, 0.0, 0.0, 0.0))  # in the hole frame: aligned
+    assert turned.ground_truth_inserted(push(robot, 0.0, 0.0, 0.0))  # in the hole frame: aligned
     start = Pose.from_xyz_rz(0.0, 0.0, turned.surface_z + 0.002, 0.0)  # world yaw 0: 0.4 off
     robot.reset(start)
     robot.command(ImpedanceCommand(pos=start.pos - [0, 0, 0.03], quat=start.quat, stiffness=STIFF))
-    assert not turned.is_inserted(robot.step(800).pose)
+    assert not turned.ground_truth_inserted(robot.step(800).pose)
 
 
-def test_is_inserted_checks_depth_axis_and_yaw(task: Puzzle) -> None:
+def test_ground_truth_inserted_checks_depth_axis_and_yaw(task: Puzzle) -> None:
     z = task.surface_z - 0.012
-    assert task.is_inserted(Pose.from_xyz_rz(0, 0, z, 0.0))
-    assert task.is_inserted(Pose.from_xyz_rz(0, 0, z, 4 * np.pi / 3))  # 3-fold symmetric
-    assert not task.is_inserted(Pose.from_xyz_rz(0, 0, z, 0.2))
-    assert not task.is_inserted(Pose.from_xyz_rz(0.001, 0, z, 0.0))
-    assert not task.is_inserted(Pose.from_xyz_rz(0, 0, task.surface_z - 0.005, 0.0))
+    assert task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, 0.0))
+    assert task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, 4 * np.pi / 3))  # 3-fold symmetric
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, 0.2))
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0.001, 0, z, 0.0))
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, task.surface_z - 0.005, 0.0))
     assert task.yaw_error(Pose.from_xyz_rz(0, 0, z, 2 * np.pi / 3 + 0.1)) == pytest.approx(0.1)
 
 

@@ -25,7 +25,7 @@ def test_success_outcome():
     assert 0.009 < outcome.path_length < 0.04
     assert outcome.peak_force > 3.0
     assert log.t.size == log.pos.shape[0] > 10
-    assert task.is_inserted(type(start)(log.pos[-1], log.quat[-1]))
+    assert task.ground_truth_inserted(type(start)(log.pos[-1], log.quat[-1]))
 
 
 def test_failure_outcome_when_the_path_misses():

@@ -58,14 +58,14 @@ def test_registered() -> None:
 def test_aligned_plug_enters(robot: FloatingToolRobot, task: Socket3D, rz: float) -> None:
     pose = push(robot, 0.0, 0.0, rz)
     assert task.insertion_depth(pose) > task.success_depth
-    assert task.is_inserted(pose)
+    assert task.ground_truth_inserted(pose)
 
 
 @pytest.mark.parametrize("deg", [20.0, 90.0])
 def test_rotated_plug_is_blocked(robot: FloatingToolRobot, task: Socket3D, deg: float) -> None:
     pose = push(robot, 0.0, 0.0, np.deg2rad(deg))
     assert task.insertion_depth(pose) < 0.0  # pins stay above the hole entries
-    assert not task.is_inserted(pose)
+    assert not task.ground_truth_inserted(pose)
 
 
 @pytest.mark.parametrize("offset", [(0.003, 0.0), (0.0, 0.003), (-0.002, 0.002)])
@@ -73,7 +73,7 @@ def test_valleys_guide_an_offset_plug_in(
     robot: FloatingToolRobot, task: Socket3D, offset: tuple[float, float]
 ) -> None:
     pose = push(robot, *offset, 0.0)
-    assert task.is_inserted(pose)
+    assert task.ground_truth_inserted(pose)
 
 
 @pytest.mark.parametrize("offset", [(0.003, 0.0), (0.0, 0.003)])
@@ -82,16 +82,16 @@ def test_offset_plug_is_blocked_without_valleys(offset: tuple[float, float]) -> 
     assert flat.hole2world.pos[2] == flat.surface_z
     pose = push(FloatingToolRobot(flat), *offset, 0.0)
     assert abs(flat.insertion_depth(pose)) < 1e-4  # resting on the flat floor
-    assert not flat.is_inserted(pose)
+    assert not flat.ground_truth_inserted(pose)
 
 
-def test_is_inserted_needs_both_pins(task: Socket3D) -> None:
+def test_ground_truth_inserted_needs_both_pins(task: Socket3D) -> None:
     z = task.hole2world.pos[2] - 0.012
-    assert task.is_inserted(Pose.from_xyz_rz(0, 0, z, 0.0))
-    assert task.is_inserted(Pose.from_xyz_rz(0, 0, z, np.pi))  # pins swap holes
-    assert not task.is_inserted(Pose.from_xyz_rz(0, 0, z, 0.1))  # one pin 1 mm off
-    assert not task.is_inserted(Pose.from_xyz_rz(0.0012, 0, z, 0.0))
-    assert not task.is_inserted(Pose.from_xyz_rz(0, 0, z + 0.004, 0.0))  # too shallow
+    assert task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, 0.0))
+    assert task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, np.pi))  # pins swap holes
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z, 0.1))  # one pin 1 mm off
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0.0012, 0, z, 0.0))
+    assert not task.ground_truth_inserted(Pose.from_xyz_rz(0, 0, z + 0.004, 0.0))  # too shallow
 
 
 def test_search_pose_composes_rz(task: Socket3D) -> None:

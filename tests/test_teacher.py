@@ -12,7 +12,7 @@ def test_teacher_demos_succeed_and_look_kinesthetic():
     for demo in demos:
         assert demo.source == "simulated-teacher" and demo.task == "peg2d"
         assert demo.rate_hz == pytest.approx(100.0, rel=0.01)
-        assert task.is_inserted(type(task.hole2world)(demo.pos[-1], demo.quat[-1]))
+        assert task.ground_truth_inserted(type(task.hole2world)(demo.pos[-1], demo.quat[-1]))
         start = demo.pos[0, :2]
         assert np.linalg.norm(start) == pytest.approx(task.params.demo_offset, abs=0.002)
         # kept contact: pressing on the surface most of the time

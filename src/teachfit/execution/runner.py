@@ -158,7 +158,7 @@ def run_trajectory(
         path += float(np.linalg.norm(state.pos - prev))
         prev = state.pos
         peak = max(peak, float(np.linalg.norm(state.wrench[:3])))
-        if task.is_inserted(state.pose):
+        if task.detect_success(state.pose):
             reason = "inserted"
             t_ins = state.t - t0
             rec.add(state, pos, cmd_ff)

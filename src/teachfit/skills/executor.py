@@ -274,7 +274,7 @@ def execute(
     if outcome != "precondition":
         visits.append(NodeVisit(active.name, t_enter, t_end, reason))
     remaining = float(np.linalg.norm(last_pos - goal))
-    inserted = None if task is None or diverged else bool(task.is_inserted(Pose(pc.pos, pc.quat)))
+    inserted = None if task is None or diverged else bool(task.ground_truth_inserted(Pose(pc.pos, pc.quat)))
     if outcome == "error" and recovery is not None and cfg.recovery_time > 0:
         t_enter = pc.t
         pc.t_node = 0.0

@@ -92,12 +92,24 @@ class Task(ABC):
         rel = self.hole2world.inverse().compose(tool2world)
         return float(np.hypot(rel.pos[0], rel.pos[1]))
 
-    def is_inserted(self, tool2world: Pose) -> bool:
-        """Success test: the TCP is deeper than :attr:`success_depth` and on the hole axis."""
+    def ground_truth_inserted(self, tool2world: Pose) -> bool:
+        """Simulator ground truth (benchmarks only): the TCP is deeper than
+        :attr:`success_depth` below the *true* hole entry and on the true hole axis."""
         return (
             self.insertion_depth(tool2world) >= self.success_depth
             and self.lateral_error(tool2world) < self.capture_radius
         )
+
+    @property
+    def entry_height(self) -> float:
+        """Nominal height of the hole entry (m, world z): what the cell's drawing says."""
+        return float(self.hole2world.pos[2])
+
+    def detect_success(self, tool2world: Pose) -> bool:
+        """The success detector, from what a robot measures: its TCP is at least
+        :attr:`success_depth` below the nominal entry height. Nothing but a hole lets the part
+        that low, so no knowledge of where the hole is is needed."""
+        return self.entry_height - float(tool2world.pos[2]) >= self.success_depth
 
     @property
     def contact(self) -> ContactParams:

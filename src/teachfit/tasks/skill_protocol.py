@@ -115,9 +115,9 @@ class SkillTask(Task):
         axis = rel.rotation.apply([0.0, 0.0, 1.0])
         return float(np.arccos(np.clip(axis[2], -1.0, 1.0)))
 
-    def is_inserted(self, tool2world: Pose) -> bool:
+    def ground_truth_inserted(self, tool2world: Pose) -> bool:
         """Deeper than :attr:`success_depth`, on the hole axis and (rz tasks) yaw-aligned."""
-        if not super().is_inserted(tool2world):
+        if not super().ground_truth_inserted(tool2world):
             return False
         return not self.has_rz or abs(self.yaw_error(tool2world)) < self.rz_tolerance
 

@@ -15,7 +15,7 @@ midpoint between the holes at the height of the hole entries (the valley bottoms
 ``floor_height - valley_depth``; the floor itself when ``valley_depth = 0``), z up, so
 :meth:`insertion_depth` is how deep the pins are in their holes. The plug is two-fold
 symmetric: ``rz = pi`` inserts as well (each pin then enters the other hole; the pins are equal,
-so :meth:`is_inserted` accepts both). The search is in x, y and rz.
+so :meth:`ground_truth_inserted` accepts both). The search is in x, y and rz.
 
 Convex pieces (MuJoCo collides meshes as convex hulls): per hole a square tile of half-width
 ``pin_spacing / 2`` split into ``n_wedges`` valley wedges (the tiles meet between the holes),
@@ -333,7 +333,7 @@ class Socket3D(Task):
         local = np.column_stack([self.hole_xy, np.zeros(2)])  # pins match holes at rz = 0
         return rel.rotation.apply(local) + rel.pos
 
-    def is_inserted(self, tool2world: Pose) -> bool:
+    def ground_truth_inserted(self, tool2world: Pose) -> bool:
         """Both pins are deeper than :attr:`success_depth` and each lies in a hole.
 
         Either assignment of pins to holes counts (``rz`` near 0 or pi): the pins are equal.
