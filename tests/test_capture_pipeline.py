@@ -21,8 +21,8 @@ from teachfit.capture.synth import SynthConfig, write_synth_capture
 from teachfit.capture.synth_calib import write_charuco_shots
 from teachfit.capture.track import STATUS, track_frames
 from teachfit.cli import app
-from teachfit.demonstrations.dataset import read_demo
 from teachfit.core.errors import CaptureError
+from teachfit.demonstrations.dataset import read_demo
 
 CFG = SynthConfig(resolutions=((640, 480),) * 3, distance=0.35, stride=15, noise=1.0)
 

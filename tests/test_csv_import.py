@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from teachfit.demonstrations.csv_import import ColumnMap, import_csv
 from teachfit.core.errors import DatasetError
+from teachfit.demonstrations.csv_import import ColumnMap, import_csv
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 LOG = EXAMPLES / "robot_log.csv"

@@ -9,8 +9,8 @@ from scipy.spatial import ConvexHull
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
-from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Key, KeyParams, get_task
 from teachfit.tasks.prism_geometry import beyond_edge_block, rectangle
 

@@ -1,11 +1,11 @@
 import numpy as np
 import pytest
 
-from teachfit.demonstrations.teacher import BlindTeacher
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.search import plan_search, run_search, search_setpoints
-from teachfit.models.search_model import SearchModel
 from teachfit.core.geometry import Pose
+from teachfit.execution.search import plan_search, run_search, search_setpoints
+from teachfit.execution.teacher import BlindTeacher
+from teachfit.models.search_model import SearchModel
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks import get_task
 from teachfit.trajectories import SearchTrajectory
@@ -55,8 +55,8 @@ def test_search_finds_the_hole_from_the_demo_start(peg_model):
     for seed in range(2):
         traj = plan_search(model, "tshix", 300, np.random.default_rng(seed))
         run = run_search(robot, task, model, start, traj)
-        successes += run.outcome.success
-        assert run.log.pos.shape[0] > 10
+        successes += run.result.success
+        assert run.result.log.pos.shape[0] > 10
     assert successes >= 1
 
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from teachfit.core.errors import SkillError
-from teachfit.learning.base import ParamDomain
 from teachfit.core.geometry import Pose
+from teachfit.core.params import ParamDomain
 from teachfit.core.state import RobotState
 from teachfit.skills import peg_in_hole
 from teachfit.skills.conditions import (

@@ -19,15 +19,17 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from teachfit.core.geometry import Pose
 from teachfit.demonstrations.dataset import write_dataset
-from teachfit.demonstrations.teacher import BlindTeacher
+from teachfit.execution.batch import episode_rng
+from teachfit.execution.engine import ExecutionResult
+from teachfit.execution.follow import run_trajectory
 from teachfit.execution.replay import replay_trajectory
-from teachfit.execution.runner import Outcome, run_trajectory
 from teachfit.execution.search import plan_search, run_search
+from teachfit.execution.teacher import BlindTeacher
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
-from teachfit.core.geometry import Pose
-from teachfit.robot.floating import FloatingToolRobot
+from teachfit.robot.registry import make_robot
 from teachfit.tasks.registry import get_task
 from teachfit.viz import search_figures
 from teachfit.viz.figures import plot_demonstrations, plot_executions
@@ -38,7 +40,7 @@ class QuickstartResult:
     replay: SuccessSummary
     search: SuccessSummary
     random_walk: SuccessSummary
-    outcomes: dict[str, list[Outcome]]
+    outcomes: dict[str, list[ExecutionResult]]
     files: dict[str, Path]
 
 
@@ -49,12 +51,13 @@ def run_quickstart(
     n_starts: int = 10,
     seed: int = 0,
     console: Console | None = None,
+    robot_name: str = "floating",
 ) -> QuickstartResult:
     console = console or Console()
     out.mkdir(parents=True, exist_ok=True)
     task = get_task(task_name)
     console.rule(f"[bold]teachfit quickstart[/]: {task.name} - {task.description}")
-    teacher = BlindTeacher(task, seed=seed)
+    teacher = BlindTeacher(task, seed=seed, robot=robot_name)
     demos, discarded = teacher.record(n_demos, progress=True)
     demo_file = write_dataset(out / "demos.h5", demos, overwrite=True)
     fig_demos = plot_demonstrations(demos, out / "demos.png", task)
@@ -66,31 +69,31 @@ def run_quickstart(
     rng = np.random.default_rng(seed + 1)
     demo_start = Pose(demo.pos[0], demo.quat[0])
     starts = task.protocol_starts("table1", n_starts, rng, demo_start)
-    robot = FloatingToolRobot(task, seed=seed)
+    robot = make_robot(robot_name, task, seed=seed)
     model = SearchModel.fit([demo], task.name)
     model_file = model.save(out / "search.model")
     console.print(
         f"2. learned the exploration distribution and dynamics from {demo.name} -> {model_file}"
     )
-    outcomes: dict[str, list[Outcome]] = {"replay": [], "tshix": [], "random-walk": []}
+    outcomes: dict[str, list[ExecutionResult]] = {"replay": [], "tshix": [], "random-walk": []}
     paths: dict[str, list] = {k: [] for k in outcomes}
     fig_plan = out / "tshix_plan.png"
     with Progress(console=console, transient=True) as bar:
         job = bar.add_task("executing from new starts", total=3 * len(starts))
         for i, start in enumerate(starts):
-            outcome, log = run_trajectory(robot, task, replay_trajectory(demo, start), start)
+            outcome = run_trajectory(robot, task, replay_trajectory(demo, start), start)
             outcomes["replay"].append(outcome)
-            paths["replay"].append((log.pos, outcome.success))
+            paths["replay"].append((outcome.log.pos, outcome.success))
             bar.advance(job)
-            traj = plan_search(model, "tshix", 300, np.random.default_rng(seed * 1000 + i))
+            traj = plan_search(model, "tshix", 300, episode_rng(seed, i))
             if i == 0:
                 search_figures.save(search_figures.tshix_stages(traj, model.exploration), fig_plan)
             steps = max(1, int(traj.path_length() / 0.003))  # random-walk moves average 3 mm
             walk = plan_search(model, "random-walk", steps, np.random.default_rng(seed + i))
             for key, tr in (("tshix", traj), ("random-walk", walk)):
                 run = run_search(robot, task, model, start, tr)
-                outcomes[key].append(run.outcome)
-                paths[key].append((run.log.pos, run.outcome.success))
+                outcomes[key].append(run.result)
+                paths[key].append((run.result.log.pos, run.result.success))
                 bar.advance(job)
     fig_replay = plot_executions(paths["replay"], out / "replay.png", task, title="demo replay")
     fig_search = plot_executions(paths["tshix"], out / "tshix.png", task, title="TSHIX search")
@@ -98,7 +101,7 @@ def run_quickstart(
         paths["random-walk"], out / "random_walk.png", task, title="random-walk search"
     )
     summaries = {
-        k: summarize([o.success for o in v], [o.time_to_insertion for o in v])
+        k: summarize([o.success for o in v], [o.time_to_success for o in v])
         for k, v in outcomes.items()
     }
     table = Table(title=f"3. execution from {len(starts)} new starts (Table I protocol)")

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from teachfit.learning.base import LearningError
+from teachfit.core.params import LearningError
 from teachfit.learning.curves import Band, band, best_so_far, first_feasible
 from teachfit.learning.objective import SkillObjective
 from teachfit.learning.runner import run_study
@@ -210,6 +210,7 @@ def run_learning_bench(
     seed: int = 0,
     overrides: Mapping[str, float] | None = None,
     on_trial: Callable[[str, TrialRecord], None] | None = None,
+    robot: str = "floating",
 ) -> LearningBench:
     """Every task x method x experiment; ``on_trial(label, record)`` reports progress."""
     if experiments < 1 or trials < 1:
@@ -225,7 +226,12 @@ def run_learning_bench(
             mine = []
             for e in range(experiments):
                 obj = SkillObjective(
-                    task, controller=controller, seed=seed + e, n_starts=n_starts, task_overrides=ov
+                    task,
+                    controller=controller,
+                    seed=seed + e,
+                    n_starts=n_starts,
+                    task_overrides=ov,
+                    robot=robot,
                 )
                 label = f"{task}/{method} #{e + 1}"
                 cb = None if on_trial is None else (lambda r, lb=label: on_trial(lb, r))

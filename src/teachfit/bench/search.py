@@ -22,12 +22,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from teachfit.bench.search_jobs import JobResult, SearchJob, model_json, pose_tuple, run_jobs
-from teachfit.demonstrations.dataset import Demonstration
-from teachfit.demonstrations.teacher import BlindTeacher
 from teachfit.core.errors import TeachfitError
+from teachfit.core.geometry import Pose
+from teachfit.demonstrations.dataset import Demonstration
+from teachfit.execution.batch import episode_seed
+from teachfit.execution.teacher import BlindTeacher
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
-from teachfit.core.geometry import Pose
 from teachfit.tasks.registry import get_task
 
 #: the paper's real-robot results (successes, trials)
@@ -76,6 +77,19 @@ def _row(
     )
 
 
+#: the robot every table runs on (set by :func:`use_robot`; one name, read by the job builders)
+ROBOT = ["floating"]
+
+
+def use_robot(name: str) -> None:
+    """Run the following tables on robot ``name`` (a registry name, e.g. ``"fr3"``)."""
+    from teachfit.robot.registry import ROBOTS
+
+    if name not in ROBOTS:
+        raise TeachfitError(f"unknown robot {name!r}; known robots: {sorted(ROBOTS)}")
+    ROBOT[0] = name
+
+
 def _jobs(
     task: str,
     overrides: dict[str, float],
@@ -88,6 +102,7 @@ def _jobs(
 ) -> list[SearchJob]:
     doc = model_json(model)
     ov = tuple(sorted(overrides.items()))
+    kw.setdefault("robot", ROBOT[0])
     return [
         SearchJob(task, ov, doc, pose_tuple(p), method, n_points, s, **kw)  # type: ignore[arg-type]
         for p, s in zip(starts, seeds, strict=True)
@@ -97,7 +112,7 @@ def _jobs(
 def _peg_setup(seed: int, clearance: float) -> tuple[dict[str, float], Demonstration, SearchModel]:
     overrides = {"clearance": clearance}
     task = get_task("peg2d", **overrides)
-    demos, _ = BlindTeacher(task, seed=seed).record(1)
+    demos, _ = BlindTeacher(task, seed=seed, robot=ROBOT[0]).record(1)
     return overrides, demos[0], SearchModel.fit(demos, task.name)
 
 
@@ -114,7 +129,7 @@ def table1(
     task = get_task("peg2d", **overrides)
     rng = np.random.default_rng(seed + 1)
     starts = task.protocol_starts("table1", n_starts, rng, Pose(demo.pos[0], demo.quat[0]))
-    seeds = [seed * 1000 + i for i in range(n_starts)]
+    seeds = [episode_seed(seed, i) for i in range(n_starts)]
     tshix = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds)
     iid = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds, sampling="random")
     res = run_jobs(tshix + iid, workers, progress)
@@ -151,10 +166,10 @@ def table2(
     starts = [start] * n_traj
     jobs: list[SearchJob] = []
     for n in sizes:
-        seeds = [seed * 100_000 + n * 100 + k for k in range(n_traj)]
+        seeds = [episode_seed(seed, n * 100 + k) for k in range(n_traj)]
         jobs += _jobs("peg2d", overrides, model, starts, "tshix", n, seeds)
     for n in ablation:
-        seeds = [seed * 100_000 + n * 100 + k for k in range(n_traj)]
+        seeds = [episode_seed(seed, n * 100 + k) for k in range(n_traj)]
         jobs += _jobs("peg2d", overrides, model, starts, "tshix", n, seeds, feedforward=False)
     res = run_jobs(jobs, workers, progress)
     rows, abl = [], []
@@ -177,7 +192,7 @@ def _socket_demos(task: object, seed: int) -> list[Demonstration]:
     """
     rng = np.random.default_rng(seed)
     dist = task.play - task.params.start_wall_gap  # type: ignore[attr-defined]
-    teacher = BlindTeacher(task, seed=seed)  # type: ignore[arg-type]
+    teacher = BlindTeacher(task, seed=seed, robot=ROBOT[0])  # type: ignore[arg-type]
     demos: list[Demonstration] = []
     rz_max = task.params.start_rz  # type: ignore[attr-defined]
     for (lo, hi), sign in (((0.05, 0.25), 1.0), ((0.75, 0.95), -1.0)):
@@ -208,7 +223,7 @@ def table3(
     two = SearchModel.fit(demos, task.name)
     two_diag = SearchModel.fit(demos, task.name, covariance="diag")
     starts = task.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
-    seeds = [seed * 1000 + i for i in range(n_starts)]
+    seeds = [episode_seed(seed, i) for i in range(n_starts)]
     t1 = _jobs("socket3d", {}, one, starts, "tshix", n_points, seeds)
     t2 = _jobs("socket3d", {}, two, starts, "tshix", n_points, seeds)
     t2d = _jobs("socket3d", {}, two_diag, starts, "tshix", n_points, seeds)

@@ -9,19 +9,19 @@ model from it without pickling any user object. Workers cache the robot per task
 from __future__ import annotations
 
 import json
-import os
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from functools import cache
 
 import numpy as np
 
+from teachfit.core.geometry import Pose
+from teachfit.execution.batch import run_batch
 from teachfit.execution.search import plan_search, run_search
 from teachfit.models.search_model import SearchModel
-from teachfit.core.geometry import Pose
-from teachfit.robot.floating import FloatingToolRobot
+from teachfit.robot.interface import Robot
+from teachfit.robot.registry import make_robot
 from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task
 from teachfit.trajectories.ergodic import ergodic_metric
@@ -33,7 +33,7 @@ class SearchJob:
 
     ``length`` fixes an ergodic trajectory's path length (m); ``traj_seed`` seeds TSHIX and the
     random walk; ``sampling`` is TSHIX's sampler (``"qmc"`` or ``"random"``); ``passes`` its
-    number of re-sampled passes.
+    number of re-sampled passes; ``robot`` the robot's registry name.
     """
 
     task: str
@@ -48,6 +48,7 @@ class SearchJob:
     sampling: str = "qmc"
     robot_seed: int = 0
     passes: int = 1
+    robot: str = "floating"
 
 
 @dataclass(frozen=True)
@@ -70,8 +71,8 @@ def _task(name: str, overrides: tuple[tuple[str, float], ...]) -> Task:
 
 
 @cache
-def _robot(name: str, overrides: tuple[tuple[str, float], ...], seed: int) -> FloatingToolRobot:
-    return FloatingToolRobot(_task(name, overrides), seed=seed)
+def _robot(name: str, overrides: tuple[tuple[str, float], ...], seed: int, robot: str) -> Robot:
+    return make_robot(robot, _task(name, overrides), seed=seed)
 
 
 @cache
@@ -87,7 +88,7 @@ def model_json(model: SearchModel) -> str:
 def run_job(job: SearchJob) -> JobResult:
     """Plan and execute one job (in this process)."""
     task = _task(job.task, job.overrides)
-    robot = _robot(job.task, job.overrides, job.robot_seed)
+    robot = _robot(job.task, job.overrides, job.robot_seed, job.robot)
     model = _model(job.model_json)
     rng = np.random.default_rng(job.traj_seed)
     t0 = time.perf_counter()
@@ -106,13 +107,13 @@ def run_job(job: SearchJob) -> JobResult:
     metric = float(traj.meta.get("ergodic_metric", np.nan))
     if not np.isfinite(metric):
         metric = ergodic_metric(traj.states, model.exploration, t=traj.t)
-    o = run.outcome
+    o = run.result
     xy = np.linalg.norm(np.diff(traj.states[:, :2], axis=0), axis=1).sum()
     scale = float(traj.meta.get("length_scale", 1.0))
     return JobResult(
         o.success,
-        o.reason,
-        o.time_to_insertion,
+        f"{o.outcome.value}: {o.reason}",
+        o.time_to_success,
         plan_s,
         float(xy),
         metric,
@@ -131,18 +132,4 @@ def run_jobs(
     progress: Callable[[], None] | None = None,
 ) -> list[JobResult]:
     """Run ``jobs`` in order-preserving parallel (``workers=None``: one per core; 0: inline)."""
-    n = (os.cpu_count() or 1) if workers is None else int(workers)
-    if n <= 1 or len(jobs) <= 1:
-        out = []
-        for job in jobs:
-            out.append(run_job(job))
-            if progress:
-                progress()
-        return out
-    with ProcessPoolExecutor(min(n, len(jobs))) as pool:
-        results = []
-        for res in pool.map(run_job, jobs, chunksize=1):
-            results.append(res)
-            if progress:
-                progress()
-        return results
+    return run_batch(run_job, jobs, workers, progress)

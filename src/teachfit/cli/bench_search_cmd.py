@@ -10,7 +10,7 @@ import typer
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.core.errors import TeachfitError
 
 TABLES = ("1", "2", "ablation", "3", "all")
@@ -65,6 +65,7 @@ def bench_search(
     trajectories: Annotated[int, typer.Option(help="Table II trajectories per N")] = 20,
     workers: Annotated[int | None, typer.Option(help="processes (default: all cores)")] = None,
     markdown: Annotated[Path | None, typer.Option(help="append the tables as markdown")] = None,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Seed A's search experiments in simulation, beside the paper's numbers.
 
@@ -76,6 +77,7 @@ def bench_search(
     if table not in TABLES:
         raise TeachfitError(f"unknown table {table!r}; available: {list(TABLES)}")
     todo = TABLES[:-1] if table == "all" else (table,)
+    bs.use_robot(robot)
     with Progress(console=console, transient=True) as bar:
         if "1" in todo:
             n = starts or 30

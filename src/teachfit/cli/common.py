@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from typing import ParamSpec, TypeVar
+from typing import Annotated, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
@@ -13,6 +13,12 @@ from teachfit.core.errors import TeachfitError
 
 console = Console()
 err_console = Console(stderr=True)
+
+#: ``--robot NAME``: every command that runs a robot takes it (names from the robot registry)
+RobotOpt = Annotated[
+    str,
+    typer.Option("--robot", help="robot to run on (teachfit robot list; simulated: floating)"),
+]
 
 P = ParamSpec("P")
 R = TypeVar("R")

@@ -8,7 +8,8 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.core.errors import TeachfitError
 from teachfit.demonstrations.csv_import import ColumnMap, import_csv
 from teachfit.demonstrations.dataset import (
     append_dataset,
@@ -16,8 +17,7 @@ from teachfit.demonstrations.dataset import (
     read_dataset,
     write_dataset,
 )
-from teachfit.demonstrations.teacher import PATTERNS, BlindTeacher, TeacherStyle
-from teachfit.core.errors import TeachfitError
+from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
 from teachfit.tasks.registry import load_task
 
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)
@@ -33,10 +33,11 @@ def record(
     pattern: Annotated[str, typer.Option(help=f"search pattern: {', '.join(PATTERNS)}")] = "sweep",
     append: Annotated[bool, typer.Option(help="append to an existing file")] = False,
     overwrite: Annotated[bool, typer.Option(help="replace an existing file")] = False,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Record demonstrations with the simulated blind teacher."""
     the_task = load_task(task)
-    teacher = BlindTeacher(the_task, TeacherStyle(pattern=pattern), seed=seed)
+    teacher = BlindTeacher(the_task, TeacherStyle(pattern=pattern), seed=seed, robot=robot)
     demos, discarded = teacher.record(n, progress=True)
     if append:
         append_dataset(out, demos)

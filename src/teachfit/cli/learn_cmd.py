@@ -10,8 +10,8 @@ import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
-from teachfit.learning.base import LearningError
+from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.core.params import LearningError
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
 _TASK_PARAM = typer.Option("--task-param", help="task parameter override NAME=VALUE (SI units)")
@@ -79,6 +79,7 @@ def learn_skill(
         Path | None,
         typer.Option(help="re-run the best parameters once and plot force and pose over time"),
     ] = None,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.bench.learning import method_options
@@ -92,7 +93,7 @@ def learn_skill(
     if method not in METHODS:
         raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
     get_task(task)  # an unknown task fails here, before any study file is created
-    obj = SkillObjective(task, skill, controller, seed, starts, _overrides(task_param))
+    obj = SkillObjective(task, skill, controller, seed, starts, _overrides(task_param), robot)
     tags = stored_tags(study)  # resuming keeps the stored options (e.g. the LHS design size)
     same = tags is not None and tags.get("method") == method
     options = tags.get("options", {}) if same else method_options(method, trials)
@@ -231,6 +232,7 @@ def bench_learning(
         int, typer.Option(help="trials of the 1-vs-N-worker speed-up study (0: skip)")
     ] = 24,
     markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")] = None,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
     import os
@@ -254,6 +256,7 @@ def bench_learning(
             seed=seed,
             overrides=dict(_overrides(task_param)),
             on_trial=lambda label, _r: bar.update(job, advance=1, description=label),
+            robot=robot,
         )
     extra = "".join(f" --task-param {p}" for p in task_param or [])
     text = (

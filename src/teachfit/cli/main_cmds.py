@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.tasks.registry import TASKS, load_task
 
 
@@ -42,10 +42,11 @@ def render(
     fps: Annotated[int, typer.Option(help="frames per second")] = 25,
     width: int = 640,
     height: int = 480,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Render a recorded demonstration with MuJoCo's offscreen renderer to an mp4."""
-    from teachfit.demonstrations.dataset import read_demo
     from teachfit.core.errors import DatasetError
+    from teachfit.demonstrations.dataset import read_demo
     from teachfit.viz.video import render_motion
 
     the_task = load_task(task)
@@ -53,7 +54,9 @@ def render(
     if d.task != the_task.name:
         raise DatasetError(f"demonstration is of task {d.task!r}, not {the_task.name!r}")
     with console.status(f"rendering {d.duration:.1f} s at {fps} fps"):
-        path = render_motion(the_task, d.t, d.pos, d.quat, out, fps=fps, width=width, height=height)
+        path = render_motion(
+            the_task, d.t, d.pos, d.quat, out, fps=fps, width=width, height=height, robot=robot
+        )
     console.print(f"video -> {path}")
 
 
@@ -66,11 +69,12 @@ def quickstart(
     demos: Annotated[int, typer.Option(help="demonstrations to record")] = 3,
     starts: Annotated[int, typer.Option(help="new start poses")] = 10,
     seed: int = 0,
+    robot: RobotOpt = "floating",
 ) -> None:
     """The main job on the default task: demonstrations -> execution -> success table."""
     from teachfit.quickstart import run_quickstart
 
-    run_quickstart(out, task, demos, starts, seed, console)
+    run_quickstart(out, task, demos, starts, seed, console, robot_name=robot)
 
 
 @guarded
@@ -78,13 +82,16 @@ def bench_sim(
     task: Annotated[str, typer.Option(help="task name")] = "peg2d",
     steps: Annotated[int, typer.Option(help="steps per measurement")] = 5000,
     repeats: int = 3,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Raw mj_step steps/s vs. steps/s with the controller in the loop, in contact."""
     from teachfit.robot.speed import measure_sim_speed
 
     the_task = load_task(task)
-    s = measure_sim_speed(the_task, steps, repeats)
-    table = Table(title=f"simulation speed on {the_task.name} in contact ({s.contacts} contacts)")
+    s = measure_sim_speed(the_task, steps, repeats, robot=robot)
+    table = Table(
+        title=f"simulation speed, {robot} on {the_task.name} in contact ({s.contacts} contacts)"
+    )
     for col in ("measure", "value", "goal"):
         table.add_column(col, justify="right")
     table.add_row("raw mj_step", f"{s.raw_steps_per_s:,.0f} steps/s", "")

@@ -10,8 +10,9 @@ import typer
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.core.errors import TeachfitError
+from teachfit.execution.batch import episode_rng
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
 
@@ -123,6 +124,7 @@ def run(
     ] = None,
     seed: int = 0,
     plot: Annotated[Path | None, typer.Option(help="figure of the executed paths")] = None,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
@@ -132,7 +134,7 @@ def run(
     from teachfit.execution.search import plan_search, run_search
     from teachfit.metrics.stats import summarize
     from teachfit.models.search_model import SearchModel
-    from teachfit.robot.floating import FloatingToolRobot
+    from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
 
     the_task = load_task(task)
@@ -140,8 +142,8 @@ def run(
     rng = np.random.default_rng(seed)
     demo_start = None
     if demo is not None:
-        from teachfit.demonstrations.dataset import read_demo
         from teachfit.core.geometry import Pose
+        from teachfit.demonstrations.dataset import read_demo
 
         d = read_demo(demo)
         if d.task != the_task.name:
@@ -155,7 +157,7 @@ def run(
             "the hole; without --demo a nominal demonstration start is assumed"
         )
     start_poses = the_task.protocol_starts(protocol, starts, rng, demo_start)
-    robot = FloatingToolRobot(the_task, seed=seed)
+    the_robot = make_robot(robot, the_task, seed=seed)
     fixed = plan_search(model, method, n, rng) if method.startswith("ergodic") else None
     if passes > 1 and method != "tshix":
         raise TeachfitError(f"--passes needs --method tshix, not {method}")
@@ -163,20 +165,19 @@ def run(
     with Progress(console=console, transient=True) as bar:
         job = bar.add_task(f"{method} from {starts} starts", total=starts)
         for i, start in enumerate(start_poses):
-            traj = fixed or plan_search(
-                model, method, n, np.random.default_rng(seed * 1000 + i), passes=passes
-            )
-            r = run_search(robot, the_task, model, start, traj, feedforward=feedforward)
-            outcomes.append(r.outcome)
-            paths.append((r.log.pos, r.outcome.success))
+            traj = fixed or plan_search(model, method, n, episode_rng(seed, i), passes=passes)
+            r = run_search(the_robot, the_task, model, start, traj, feedforward=feedforward)
+            outcomes.append(r.result)
+            paths.append((r.result.log.pos, r.result.success))
             bar.advance(job)
-    s = summarize([o.success for o in outcomes], [o.time_to_insertion for o in outcomes])
+    the_robot.close()
+    s = summarize([o.success for o in outcomes], [o.time_to_success for o in outcomes])
     table = Table(title=f"{method} on {the_task.name} ({protocol}, seed {seed})")
     for col in ("starts", "successes", "rate [95 % CI]", "median time", "reasons"):
         table.add_column(col, justify="right")
     reasons = {}
     for o in outcomes:
-        reasons[o.reason.split(":")[0]] = reasons.get(o.reason.split(":")[0], 0) + 1
+        reasons[o.outcome.value] = reasons.get(o.outcome.value, 0) + 1
     t_med = "n/a" if np.isnan(s.median_time) else f"{s.median_time:.2f} s"
     table.add_row(
         str(s.trials),
@@ -200,13 +201,14 @@ def figures(
     out: Annotated[Path, typer.Option(help="folder for the figures")] = Path("search_figures"),
     n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
     seed: int = 0,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Seed A's figures for a model: samples over p_e for N = 100...500, samples -> itinerary ->
     smoothed trajectory, feed-forward arrows, the 3D trajectory (x, y, rz tasks), and a
     planned vs. executed path from the task's first protocol start."""
     from teachfit.execution.search import plan_search, run_search
     from teachfit.models.search_model import SearchModel
-    from teachfit.robot.floating import FloatingToolRobot
+    from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import get_task
     from teachfit.viz import search_figures as sf
 
@@ -228,10 +230,10 @@ def figures(
         "table1" if task.name == "peg2d" else "table3" if task.name == "socket3d" else "teacher"
     )
     start = task.protocol_starts(protocol, 1, np.random.default_rng(seed))[0]
-    run = run_search(FloatingToolRobot(task, seed=seed), task, model, start, traj)
-    executed = run.log.pos[:, :2] - start.pos[:2]
+    run = run_search(make_robot(robot, task, seed=seed), task, model, start, traj)
+    executed = run.result.log.pos[:, :2] - start.pos[:2]
     fig = sf.planned_vs_executed(traj.states[:, :2], executed)
-    fig.axes[0].set_title(f"from a {protocol} start: {run.outcome.reason}")
+    fig.axes[0].set_title(f"from a {protocol} start: {run.result.outcome.value}")
     written.append(sf.save(fig, out / "planned_vs_executed.png"))
     for path in written:
         console.print(f"figure -> {path}")

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import RobotOpt, console, guarded
 
 skill_app = typer.Typer(
     help="Manipulation skills (seed B): show a skill's graph, run it on a task.",
@@ -94,12 +94,13 @@ def run(
     fps: int = 25,
     width: int = 640,
     height: int = 480,
+    robot: RobotOpt = "floating",
 ) -> None:
     """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
     from teachfit.core.errors import SkillError
+    from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
     from teachfit.skills.library import get_skill
     from teachfit.skills.params import read_params_toml
-    from teachfit.skills.trial import SkillTrial, peg_in_hole_setup
     from teachfit.tasks.registry import load_task
 
     if starts < 1:
@@ -121,7 +122,7 @@ def run(
                 f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
                 "their defaults are used"
             )
-    trial = SkillTrial(setup, controller, seed=seed)
+    trial = SkillTrial(setup, controller, robot=robot, seed=seed)
     est = setup.task2world.inverse().compose(the_task.hole2world)
     console.print(
         f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate off by "
@@ -130,14 +131,14 @@ def run(
     with console.status(f"running {starts} execution(s)"):
         out = trial(learned)
     table = Table(title="executions", title_justify="left")
-    for col in ("#", "outcome", "inserted", "cost (s)", "contact (s)", "end (s)", "nodes"):
+    for col in ("#", "outcome", "detected", "cost (s)", "contact (s)", "end (s)", "nodes"):
         table.add_column(col)
     for i, (tr, ok, cost) in enumerate(zip(out.traces, out.successes, out.costs, strict=True)):
         path = " > ".join(v.node for v in tr.visits)
         table.add_row(
             str(i),
-            "[green]success[/]" if ok else f"[red]{tr.outcome}[/]",
-            str(tr.inserted),
+            "[green]success[/]" if ok else f"[red]{tr.outcome.value}[/]",
+            str(tr.detected),
             f"{cost:.3f}",
             f"{tr.t_first_contact:.2f}",
             f"{tr.t_end:.2f}",

@@ -35,18 +35,18 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from teachfit.control.impedance import (
+    SetpointError,
+    clip_wrench,
+    clipped_twist,
+    critical_damping,
+)
 from teachfit.core.control import (
     AdaptiveLimits,
     AdaptiveParams,
     ImpedanceLimits,
     MetaBounds,
     meta_bounds,
-)
-from teachfit.control.impedance import (
-    SetpointError,
-    clip_wrench,
-    clipped_twist,
-    critical_damping,
 )
 from teachfit.core.errors import ControlError
 from teachfit.core.state import ImpedanceCommand

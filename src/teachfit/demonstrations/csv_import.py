@@ -49,8 +49,8 @@ from typing import Any
 
 import numpy as np
 
-from teachfit.demonstrations.dataset import MIN_SAMPLES, QUAT_NORM_TOL, Demonstration
 from teachfit.core.errors import DatasetError
+from teachfit.demonstrations.dataset import MIN_SAMPLES, QUAT_NORM_TOL, Demonstration
 
 POSITION_KEYS = ("time", "x", "y", "z")
 QUAT_KEYS = ("qw", "qx", "qy", "qz")

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from teachfit.demonstrations.dataset import Demonstration
-from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.core.geometry import Pose
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.demonstrations.dataset import Demonstration
 
 
 def replay_trajectory(

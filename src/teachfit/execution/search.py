@@ -14,11 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.runner import ExecutionConfig, ExecutionLog, Outcome, run_trajectory
-from teachfit.core.setpoints import SetpointTrajectory
-from teachfit.models.search_model import SearchModel
 from teachfit.core.geometry import Pose, quat_from_rz
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.execution.batch import episode_rng
+from teachfit.execution.engine import ExecutionResult
+from teachfit.execution.follow import run_trajectory
+from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
+from teachfit.skills.follow import FollowConfig
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
@@ -62,8 +65,9 @@ def search_setpoints(
 
 @dataclass(frozen=True)
 class SearchRun:
-    outcome: Outcome
-    log: ExecutionLog
+    """One executed search: the engine's result, the planned trajectory, its set-points."""
+
+    result: ExecutionResult
     trajectory: SearchTrajectory
     setpoints: SetpointTrajectory
 
@@ -155,31 +159,33 @@ def run_search(
     traj: SearchTrajectory,
     *,
     feedforward: bool = True,
-    config: ExecutionConfig | None = None,
+    config: FollowConfig | None = None,
 ) -> SearchRun:
-    """Execute one search trajectory from ``start``."""
+    """Execute one search trajectory from ``start`` through the engine."""
     setpoints = search_setpoints(traj, task, start, model if feedforward else None)
-    outcome, log = run_trajectory(robot, task, setpoints, start, config)
-    return SearchRun(outcome, log, traj, setpoints)
+    return SearchRun(run_trajectory(robot, task, setpoints, start, config), traj, setpoints)
 
 
-def run_batch(
+def run_searches(
     robot: Robot,
     task: Task,
     model: SearchModel,
     starts: Sequence[Pose],
-    make_traj: Callable[[int], SearchTrajectory],
+    method: str,
+    n_points: int,
+    seed: int,
     *,
+    passes: int = 1,
     feedforward: bool = True,
-    config: ExecutionConfig | None = None,
+    config: FollowConfig | None = None,
     on_done: Callable[[SearchRun], None] | None = None,
 ) -> list[SearchRun]:
-    """Run ``make_traj(i)`` from each start ``i``; ``on_done`` is called after each run."""
+    """Plan and run a ``method`` search from each start ``i``, planned with
+    :func:`~teachfit.execution.batch.episode_rng` ``(seed, i)``; ``on_done`` after each."""
     runs = []
     for i, start in enumerate(starts):
-        run = run_search(
-            robot, task, model, start, make_traj(i), feedforward=feedforward, config=config
-        )
+        traj = plan_search(model, method, n_points, episode_rng(seed, i), passes=passes)
+        run = run_search(robot, task, model, start, traj, feedforward=feedforward, config=config)
         runs.append(run)
         if on_done is not None:
             on_done(run)

@@ -1,14 +1,7 @@
 """Meta-learning of skill parameters: ask/tell learners, resumable studies, parallel trials."""
 
-from teachfit.learning.base import (
-    Candidate,
-    Finished,
-    Learner,
-    LearningError,
-    ParamDomain,
-    ParamSpace,
-    TrialResult,
-)
+from teachfit.core.params import LearningError, ParamDomain, ParamSpace
+from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
 from teachfit.learning.cmaes import CMAES
 from teachfit.learning.lhs import LatinHypercube

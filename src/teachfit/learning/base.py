@@ -17,13 +17,13 @@ where the learner stood: finished keys are never handed out again.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from teachfit.core.params import LearningError, ParamDomain, ParamSpace
+from teachfit.core.params import LearningError, ParamSpace
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,8 @@ from collections.abc import Sequence
 import optuna
 from optuna.distributions import FloatDistribution
 
-from teachfit.learning.base import Candidate, Finished, LearningError, ParamSpace
+from teachfit.core.params import LearningError, ParamSpace
+from teachfit.learning.base import Candidate, Finished
 
 _CONSTRAINT = "failure"
 

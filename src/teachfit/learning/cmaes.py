@@ -15,7 +15,8 @@ from collections.abc import Sequence
 import cma
 import numpy as np
 
-from teachfit.learning.base import GenerationalLearner, LearningError, ParamSpace
+from teachfit.core.params import LearningError, ParamSpace
+from teachfit.learning.base import GenerationalLearner
 
 
 class CMAES(GenerationalLearner):

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from teachfit.learning.base import LearningError
+from teachfit.core.params import LearningError
 
 
 def best_so_far(costs: Sequence[float]) -> np.ndarray:

@@ -12,7 +12,8 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.stats import qmc
 
-from teachfit.learning.base import Candidate, Finished, LearningError, ParamSpace
+from teachfit.core.params import LearningError, ParamSpace
+from teachfit.learning.base import Candidate, Finished
 
 
 class LatinHypercube:

@@ -7,7 +7,7 @@ worker of :func:`~teachfit.learning.runner.run_study`, a Ray worker, or this one
 scene and robot are built once per process and objective and then reused across trials.
 
 Cost (seed B, Sec. V): the mean over the starts of the learning metric
-(:class:`~teachfit.skills.metric.LearningMetric`): the time from first contact to full
+(:class:`~teachfit.execution.metric.LearningMetric`): the time from first contact to full
 insertion (s) on success, ``t_max + k_d * remaining distance`` on failure. A trial is
 feasible if any start succeeded. ``info`` carries ``success_rate``, ``sim_s`` (simulated robot
 seconds of all executions, recovery included) and ``wall_s``.
@@ -19,7 +19,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from teachfit.learning.base import LearningError, ParamSpace, TrialResult
+from teachfit.core.params import LearningError, ParamSpace
+from teachfit.learning.base import TrialResult
 
 #: distance (m) at which a crashed or diverged trial is penalised: well beyond any region of
 #: interest, so every such trial costs more than every ordinary failure
@@ -46,6 +47,8 @@ class SkillObjective:
         Executions per trial (four in the paper).
     task_overrides : tuple of (name, value)
         Task parameter overrides, e.g. ``(("hole_pos_sigma", 0.001),)`` (SI units).
+    robot : str
+        Robot name in :data:`teachfit.robot.registry.ROBOTS`.
     """
 
     task: str
@@ -54,6 +57,7 @@ class SkillObjective:
     seed: int = 0
     n_starts: int = 4
     task_overrides: tuple[tuple[str, float], ...] = ()
+    robot: str = "floating"
 
     def __post_init__(self) -> None:
         if self.n_starts < 1:
@@ -62,17 +66,17 @@ class SkillObjective:
 
     # ---------------------------------------------------------------------------- set-up
     def trial(self) -> Any:
-        """The :class:`~teachfit.skills.trial.SkillTrial` (built once per process)."""
+        """The :class:`~teachfit.execution.skill_trial.SkillTrial` (built once per process)."""
         found = _CACHE.get(self)
         if found is None:
+            from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
             from teachfit.skills.library import get_skill
-            from teachfit.skills.trial import SkillTrial, peg_in_hole_setup
             from teachfit.tasks.registry import get_task
 
             task = get_task(self.task, **dict(self.task_overrides))
             skill = get_skill(self.skill, self.controller)
             setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
-            found = SkillTrial(setup, self.controller, seed=self.seed)
+            found = SkillTrial(setup, self.controller, robot=self.robot, seed=self.seed)
             _CACHE.clear()  # one experiment per worker at a time: keep memory flat
             _CACHE[self] = found
         return found
@@ -91,6 +95,7 @@ class SkillObjective:
         """JSON-able description stored with a study and compared on resume."""
         return {
             "controller": self.controller,
+            "robot": self.robot,
             "setup_seed": int(self.seed),
             "n_starts": int(self.n_starts),
             "task_overrides": {k: float(v) for k, v in self.task_overrides},
@@ -98,7 +103,7 @@ class SkillObjective:
 
     # ---------------------------------------------------------------------------- trials
     def outcome(self, params: Mapping[str, float] | None) -> Any:
-        """The full :class:`~teachfit.skills.trial.TrialOutcome` (traces with logs)."""
+        """The full :class:`~teachfit.execution.skill_trial.TrialOutcome` (traces with logs)."""
         return self.trial()(params)
 
     def __call__(self, params: Mapping[str, float]) -> TrialResult:
@@ -106,5 +111,9 @@ class SkillObjective:
         tr = self.trial()
         period = float(tr.robot.control_period)
         sim_s = sum(t.steps for t in out.traces) * period
-        res = out.as_result()
-        return TrialResult(res.cost, res.feasible, dict(res.info) | {"sim_s": sim_s})
+        info = {
+            "success_rate": out.success_rate,
+            "wall_s": float(sum(t.wall_s for t in out.traces)),
+            "sim_s": sim_s,
+        }
+        return TrialResult(out.cost, any(out.successes), info)

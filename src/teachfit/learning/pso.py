@@ -20,7 +20,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import qmc
 
-from teachfit.learning.base import GenerationalLearner, LearningError, ParamSpace
+from teachfit.core.params import LearningError, ParamSpace
+from teachfit.learning.base import GenerationalLearner
 
 
 class PSO(GenerationalLearner):

@@ -24,7 +24,8 @@ from collections.abc import Callable
 from types import ModuleType
 from typing import Any
 
-from teachfit.learning.base import Candidate, LearningError, TrialResult
+from teachfit.core.params import LearningError
+from teachfit.learning.base import Candidate, TrialResult
 from teachfit.learning.runner import Objective, RunReport, _Signals, evaluate
 from teachfit.learning.study import Study, TrialRecord
 

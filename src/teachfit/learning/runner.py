@@ -31,7 +31,8 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from typing import Any
 
-from teachfit.learning.base import Candidate, LearningError, TrialResult
+from teachfit.core.params import LearningError
+from teachfit.learning.base import Candidate, TrialResult
 from teachfit.learning.study import Study, TrialRecord
 
 #: what an objective may return: a cost, ``(cost, feasible)`` or a TrialResult

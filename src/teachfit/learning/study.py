@@ -25,14 +25,8 @@ from typing import Any
 import optuna
 from optuna.distributions import FloatDistribution
 
-from teachfit.learning.base import (
-    Candidate,
-    Finished,
-    Learner,
-    LearningError,
-    ParamSpace,
-    TrialResult,
-)
+from teachfit.core.params import LearningError, ParamSpace
+from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
 from teachfit.learning.cmaes import CMAES
 from teachfit.learning.lhs import LatinHypercube

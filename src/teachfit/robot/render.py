@@ -40,6 +40,7 @@ def motion_frames(
     width: int = 640,
     height: int = 480,
     slowdown: float = 1.0,
+    robot: str = "floating",
 ) -> Iterator[np.ndarray]:
     """RGB frames (H, W, 3) of the held part following recorded TCP poses (world frame).
 
@@ -48,6 +49,10 @@ def motion_frames(
     t : (T,) s;  pos : (T, 3) m;  quat : (T, 4) w-x-y-z
     slowdown : play back this many times slower than real time.
     """
+    if robot != "floating":
+        raise RenderError(f"rendering shows the floating tool only, not robot {robot!r}")
+    if not (fps > 0 and width > 0 and height > 0 and slowdown > 0):
+        raise RenderError(f"fps, width, height and slowdown must be > 0: {fps}, {width}x{height}")
     t = np.asarray(t, dtype=float)
     if t.size < 2:
         raise RenderError("need at least two poses to render a motion")

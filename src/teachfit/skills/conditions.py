@@ -265,6 +265,23 @@ class Done(Condition):
 
 
 @dataclass(frozen=True)
+class Detected(Condition):
+    """The task's success detector holds: from what the robot measures (its TCP pose) the
+    part is in the hole (see ``Task.detect_success``)."""
+
+    kind: ClassVar[str] = "detected"
+
+    def compile(self, values: Mapping[str, float]) -> Check:
+        return lambda pc: pc.detected
+
+    def describe(self) -> str:
+        return "task detects success"
+
+    def to_toml(self) -> dict[str, Any]:
+        return {"kind": self.kind}
+
+
+@dataclass(frozen=True)
 class All(Condition):
     """All of ``parts`` hold."""
 
@@ -340,6 +357,7 @@ _LEAVES: dict[str, type[Condition]] = {
         TiltBelow,
         SpeedBelow,
         Done,
+        Detected,
     )
 }
 

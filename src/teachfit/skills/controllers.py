@@ -16,10 +16,14 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from teachfit.control.adaptive import AdaptiveImpedance
-from teachfit.core.control import AdaptiveLimits, AdaptiveParams, meta_bounds
-from teachfit.control.base import Controller
-from teachfit.control.impedance import CartesianImpedance
+from teachfit.core.control import (
+    AdaptiveLimits,
+    AdaptiveParams,
+    AdaptiveSpec,
+    ControllerSpec,
+    FixedGainSpec,
+    meta_bounds,
+)
 from teachfit.core.errors import SkillError
 from teachfit.core.params import ParamDomain
 from teachfit.skills.params import LearnedParam
@@ -57,13 +61,12 @@ def controller_params(kind: str, period: float = 0.001) -> dict[str, LearnedPara
     return out
 
 
-def make_controller(
-    kind: str, values: Mapping[str, float], apparent_mass: np.ndarray, period: float = 0.001
-) -> Controller:
-    """A controller of ``kind``; ``values`` supplies the adaptive meta-parameters (those it
-    lacks, e.g. for a skill that does not learn them, keep :class:`AdaptiveParams`' defaults)."""
+def controller_spec(kind: str, values: Mapping[str, float]) -> ControllerSpec:
+    """The controller settings (data for the robot) of ``kind``; ``values`` supplies the
+    adaptive meta-parameters (those it lacks, e.g. for a skill that does not learn them, keep
+    :class:`AdaptiveParams`' defaults)."""
     if kind == "impedance":
-        return CartesianImpedance(apparent_mass)
+        return FixedGainSpec()
     if kind != "adaptive":
         raise SkillError(f"unknown controller {kind!r}; known: {list(CONTROLLERS)}")
     defaults = AdaptiveParams()
@@ -73,4 +76,4 @@ def make_controller(
         t = float(values.get(f"{meta}_t", d[0]))
         r = float(values.get(f"{meta}_r", d[3]))
         kwargs[meta] = (t,) * 3 + (r,) * 3
-    return AdaptiveImpedance(apparent_mass, AdaptiveParams(**kwargs), period=period)
+    return AdaptiveSpec(params=AdaptiveParams(**kwargs))

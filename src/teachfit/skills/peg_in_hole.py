@@ -30,8 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from teachfit.core.errors import SkillError
-from teachfit.core.params import ParamDomain
 from teachfit.core.geometry import Pose
+from teachfit.core.params import ParamDomain
 from teachfit.skills.conditions import (
     Any_,
     DepthAbove,

@@ -11,10 +11,9 @@ from __future__ import annotations
 
 import math
 
-import mujoco
 import numpy as np
 
-from teachfit.core.geometry import Pose
+from teachfit.core.geometry import Pose, quat_conj_into, quat_mul_into
 from teachfit.core.state import RobotState
 
 
@@ -31,6 +30,8 @@ class Percept:
     p_d, q_d : (3,), (4,) the commanded set-point (m; w-x-y-z), task frame.
     goal : (3,) where the active primitive is heading (NaN when it has no goal).
     done : whether the active primitive finished its own motion (e.g. its profile).
+    detected : whether the task's success detector holds for the measured pose (``False``
+        when the execution has no detector).
     pos, quat : (3,), (4,) TCP pose in the world (m; w-x-y-z).
     """
 
@@ -41,7 +42,7 @@ class Percept:
         self.origin = np.array(task2world.pos)
         self.q_task = np.array(task2world.quat)
         self._q_task_inv = np.zeros(4)
-        mujoco.mju_negQuat(self._q_task_inv, self.q_task)
+        quat_conj_into(self._q_task_inv, self.q_task)
         self.dt = float(dt)
         self.t = 0.0
         self.t_node = 0.0
@@ -56,6 +57,7 @@ class Percept:
         self.q_d = np.array([1.0, 0.0, 0.0, 0.0])
         self.goal = np.full(3, np.nan)
         self.done = False
+        self.detected = False
         self._tmp = np.zeros(3)
 
     def update(self, state: RobotState, t: float) -> None:
@@ -70,7 +72,7 @@ class Percept:
         np.dot(rt, state.ang_vel, out=self.w)
         np.dot(rt, state.wrench[:3], out=self.f[:3])
         np.dot(rt, state.wrench[3:], out=self.f[3:])
-        mujoco.mju_mulQuat(self.q, self._q_task_inv, state.quat)
+        quat_mul_into(self.q, self._q_task_inv, state.quat)
 
     def hold_here(self) -> None:
         """Set the set-point to the measured pose (a primitive starting from where it is)."""
@@ -106,7 +108,7 @@ class Percept:
         """A task-frame pose as world ``(pos (3,), quat (4,))``."""
         pos = self.rot @ p + self.origin
         quat = np.zeros(4)
-        mujoco.mju_mulQuat(quat, self.q_task, q)
+        quat_mul_into(quat, self.q_task, q)
         return pos, quat
 
 
@@ -115,16 +117,21 @@ class MPCommand:
 
     ``twist`` (6,) desired ``[v; w]`` (m/s, rad/s) that moves the set-point over the next
     command period, ``wrench`` (6,) feed-forward ``[f; tau]`` (N, N·m) the robot adds,
-    ``stiffness`` (6,) diagonal Cartesian stiffness (N/m, N·m/rad) along the task axes.
+    ``stiffness`` (6,) diagonal Cartesian stiffness (N/m, N·m/rad) along the task axes, or,
+    with ``full`` set, ``stiffness_full`` (6, 6) (e.g. stiff along a search path and compliant
+    across it). A primitive that sets the set-point itself writes ``pc.p_d``/``pc.q_d``.
     """
 
-    __slots__ = ("twist", "wrench", "stiffness")
+    __slots__ = ("twist", "wrench", "stiffness", "stiffness_full", "full")
 
     def __init__(self) -> None:
         self.twist = np.zeros(6)
         self.wrench = np.zeros(6)
         self.stiffness = np.zeros(6)
+        self.stiffness_full = np.zeros((6, 6))
+        self.full = False
 
     def clear(self) -> None:
         self.twist[:] = 0.0
         self.wrench[:] = 0.0
+        self.full = False

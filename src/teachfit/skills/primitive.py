@@ -25,10 +25,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
-import mujoco
 import numpy as np
 
 from teachfit.core.errors import SkillError
+from teachfit.core.geometry import quat_conj_into, quat_mul_into, quat_to_rotvec_into
 from teachfit.skills.params import Value, ref_name, resolve
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.profile import Trapezoid, synchronized
@@ -113,7 +113,7 @@ def _quat_rz_ry(yaw: float, tilt: float) -> np.ndarray:
     qz = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
     qy = np.array([math.cos(tilt / 2), 0.0, math.sin(tilt / 2), 0.0])
     out = np.zeros(4)
-    mujoco.mju_mulQuat(out, qz, qy)
+    quat_mul_into(out, qz, qy)
     return out
 
 
@@ -226,12 +226,12 @@ class _MoveToRun(PrimitiveRun):
                 shift = np.array(
                     [math.cos(k * self.rz_period / 2), 0, 0, math.sin(k * self.rz_period / 2)]
                 )
-                mujoco.mju_mulQuat(q_goal, shift, self.q_goal_spec)
+                quat_mul_into(q_goal, shift, self.q_goal_spec)
             # rotation vector r (task frame) with exp(r) q_d = q_goal
             dq, inv = np.zeros(4), np.zeros(4)
-            mujoco.mju_negQuat(inv, pc.q_d)
-            mujoco.mju_mulQuat(dq, q_goal, inv)
-            mujoco.mju_quat2Vel(self.rotvec, dq, 1.0)
+            quat_conj_into(inv, pc.q_d)
+            quat_mul_into(dq, q_goal, inv)
+            quat_to_rotvec_into(self.rotvec, dq)
         dist = float(np.linalg.norm(self.dp))
         ang = float(np.linalg.norm(self.rotvec))
         self.profile = synchronized((dist, ang), (self.v, self.w), (self.a, self.dw))

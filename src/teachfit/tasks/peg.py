@@ -9,7 +9,8 @@ Geometry. The hole is bored into the top of a thin-walled boss (a tube, outer di
 ``boss_diameter``) standing ``boss_height`` tall on a base plate (top at ``base_height``),
 centred on the world origin. Nothing surrounds the boss: a peg pushed more than about the wall
 thickness off the axis overhangs the rim, tips and slides off it, and a peg beside the boss
-goes down to the plate (deep below the hole entry, yet not inserted: :meth:`ground_truth_inserted` also
+goes down to the plate (deep below the hole entry, yet not inserted:
+:meth:`ground_truth_inserted` also
 asks for the TCP on the hole axis). The boss wall is ``n_sectors`` convex ring sectors whose
 polygonal hole circumscribes the nominal circle; a solid cylinder fills it below the hole.
 

@@ -18,9 +18,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from teachfit.core.params import ParamSpace  # noqa: E402
+from teachfit.execution.engine import ExecutionResult  # noqa: E402
 from teachfit.learning.curves import Band, best_so_far  # noqa: E402
 from teachfit.learning.study import TrialRecord  # noqa: E402
-from teachfit.skills.executor import ExecutionTrace  # noqa: E402
 
 
 def _save(fig: plt.Figure, path: str | Path) -> Path:
@@ -151,7 +151,7 @@ def plot_param_traces(
     return _save(fig, path)
 
 
-def plot_best_execution(trace: ExecutionTrace, path: str | Path, title: str = "") -> Path:
+def plot_best_execution(trace: ExecutionResult, path: str | Path, title: str = "") -> Path:
     """One execution over time: wrench on the tool (N), TCP position relative to its start
     (mm), orientation (tilt from vertical and yaw, rad); node changes dotted."""
     log = trace.log

@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import FancyBboxPatch  # noqa: E402
 
-from teachfit.skills.executor import ExecutionTrace  # noqa: E402
+from teachfit.execution.engine import ExecutionResult  # noqa: E402
 from teachfit.skills.graph import Skill  # noqa: E402
 
 
@@ -160,7 +160,7 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
     return path
 
 
-def plot_traces(traces: Sequence[ExecutionTrace], path: str | Path) -> Path:
+def plot_traces(traces: Sequence[ExecutionResult], path: str | Path) -> Path:
     """Executions over time: node timeline, contact force and depth (one column each)."""
     path = Path(path)
     k = len(traces)

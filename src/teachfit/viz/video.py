@@ -7,7 +7,6 @@ explains what to set instead of failing deep inside MuJoCo.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -15,7 +14,6 @@ from pathlib import Path
 import imageio.v2 as imageio
 import numpy as np
 
-from teachfit.core.errors import RenderError
 from teachfit.robot.render import motion_frames
 from teachfit.tasks.base import Task
 
@@ -43,6 +41,7 @@ def render_motion(
     width: int = 640,
     height: int = 480,
     slowdown: float = 1.0,
+    robot: str = "floating",
 ) -> Path:
     """Render the held part following recorded TCP poses (world frame) to an mp4.
 
@@ -52,7 +51,7 @@ def render_motion(
     slowdown : play back this many times slower than real time.
     """
     frames = motion_frames(
-        task, t, pos, quat, fps=fps, width=width, height=height, slowdown=slowdown
+        task, t, pos, quat, fps=fps, width=width, height=height, slowdown=slowdown, robot=robot
     )
     with video_writer(out, fps=fps) as writer:
         for frame in frames:

@@ -4,11 +4,11 @@ An experiment fixes the task, the estimated hole pose (taught once, with its err
 start poses (four slightly different ones) in a :class:`SkillSetup`; each trial then runs the
 skill with one set of learned values from every start and reports the mean cost:
 
-    cost = (1 / n) sum_i q_i            (q_i from :class:`~teachfit.skills.metric.LearningMetric`)
+    cost = (1 / n) sum_i q_i        (q_i from :class:`~teachfit.execution.metric.LearningMetric`)
 
-:class:`SkillTrial` keeps one simulated robot across trials (building the MuJoCo model is
-the slow part) and installs a fresh controller per execution, built from the adaptive
-meta-parameters among the learned values.
+:class:`SkillTrial` keeps one robot across trials (building a simulated robot's MuJoCo model
+is the slow part) and hands it fresh controller settings (data) at each reset, built from the
+adaptive meta-parameters among the learned values.
 """
 
 from __future__ import annotations
@@ -18,14 +18,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from teachfit.learning.base import TrialResult
 from teachfit.core.geometry import Pose
-from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
+from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
+from teachfit.execution.metric import LearningMetric
+from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole
-from teachfit.skills.controllers import make_controller
-from teachfit.skills.executor import ExecConfig, ExecutionTrace, execute
+from teachfit.skills.controllers import controller_spec
 from teachfit.skills.graph import Skill
-from teachfit.skills.metric import LearningMetric
 from teachfit.tasks.base import Task
 
 
@@ -64,7 +63,7 @@ class TrialOutcome:
 
     successes: tuple[bool, ...]
     costs: tuple[float, ...]
-    traces: tuple[ExecutionTrace, ...]
+    traces: tuple[ExecutionResult, ...]
 
     @property
     def cost(self) -> float:
@@ -73,17 +72,6 @@ class TrialOutcome:
     @property
     def success_rate(self) -> float:
         return float(np.mean(self.successes))
-
-    def as_result(self) -> TrialResult:
-        """For :mod:`teachfit.learning`: mean cost, feasible if any start succeeded."""
-        return TrialResult(
-            self.cost,
-            any(self.successes),
-            {
-                "success_rate": self.success_rate,
-                "wall_s": float(sum(t.wall_s for t in self.traces)),
-            },
-        )
 
 
 class SkillTrial:
@@ -94,7 +82,8 @@ class SkillTrial:
     setup : the experiment's fixed part.
     controller : ``"adaptive"`` (seed B) or ``"impedance"``.
     metric : defaults to ``LearningMetric(time_limit = the skill's t_max)``.
-    config : executor settings.
+    config : engine settings.
+    robot : name in :data:`~teachfit.robot.registry.ROBOTS`; ``robot_options`` its options.
     seed : the robot's sensor-noise seed.
     """
 
@@ -104,23 +93,21 @@ class SkillTrial:
         controller: str = "adaptive",
         metric: LearningMetric | None = None,
         config: ExecConfig | None = None,
-        robot_params: FloatingToolParams | None = None,
+        robot: str = "floating",
         seed: int = 0,
+        **robot_options: object,
     ) -> None:
         self.setup = setup
         self.controller = controller
         t_max = setup.skill.params.context.get("t_max")
         self.metric = metric or LearningMetric(time_limit=t_max.value if t_max else 5.0)
         self.config = config or ExecConfig()
-        self.robot = FloatingToolRobot(setup.task, params=robot_params, seed=seed)
+        self.robot = make_robot(robot, setup.task, seed=seed, **robot_options)
 
-    def run(self, learned: Mapping[str, float] | None, start: Pose) -> ExecutionTrace:
+    def run(self, learned: Mapping[str, float] | None, start: Pose) -> ExecutionResult:
         """One execution from ``start`` (values validated; defaults fill gaps)."""
         s = self.setup
         values = s.skill.resolve(learned)
-        self.robot.controller = make_controller(
-            self.controller, values, self.robot.params.apparent_mass, self.robot.control_period
-        )
         return execute(
             s.skill,
             self.robot,
@@ -130,6 +117,7 @@ class SkillTrial:
             task=s.task,
             goal2world=s.goal2world,
             config=self.config,
+            controller=controller_spec(self.controller, values),
         )
 
     def __call__(

@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass
 
 from teachfit.core.errors import SkillError
-from teachfit.skills.executor import ExecutionTrace
+from teachfit.execution.engine import ExecutionResult
 
 
 @dataclass(frozen=True)
@@ -36,7 +36,7 @@ class LearningMetric:
         d = remaining if math.isfinite(remaining) else 1.0
         return self.time_limit + self.distance_factor * max(d, 0.0)
 
-    def evaluate(self, trace: ExecutionTrace) -> tuple[bool, float]:
+    def evaluate(self, trace: ExecutionResult) -> tuple[bool, float]:
         """``(success, cost)`` of one execution."""
         if trace.success:
             start = trace.t_first_contact if math.isfinite(trace.t_first_contact) else 0.0

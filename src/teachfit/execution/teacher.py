@@ -25,12 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 from rich.progress import Progress
 
-from teachfit.demonstrations.dataset import Demonstration
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.runner import ExecutionConfig, run_trajectory
-from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.core.geometry import Pose, quat_from_rz
-from teachfit.robot.floating import FloatingToolRobot
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.demonstrations.dataset import Demonstration
+from teachfit.execution.follow import run_trajectory
+from teachfit.robot.registry import make_robot
+from teachfit.skills.follow import FollowConfig
 from teachfit.tasks.base import Task
 
 PATTERNS = ("sweep", "spiral", "zigzag")
@@ -72,11 +73,17 @@ class TeacherStyle:
 class BlindTeacher:
     """Records demonstrations of ``task`` with a simulated blind human (seeded)."""
 
-    def __init__(self, task: Task, style: TeacherStyle | None = None, seed: int = 0) -> None:
+    def __init__(
+        self,
+        task: Task,
+        style: TeacherStyle | None = None,
+        seed: int = 0,
+        robot: str = "floating",
+    ) -> None:
         self.task = task
         self.style = style or TeacherStyle()
         self.rng = np.random.default_rng(seed)
-        self.robot = FloatingToolRobot(task, seed=int(self.rng.integers(2**31)))
+        self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
         self.has_rz = "rz" in task.search_dims
 
     # ------------------------------------------------------------------------ planning
@@ -171,20 +178,21 @@ class BlindTeacher:
         """One attempt. Returns ``(demo, "ok")`` or ``(None, why it was discarded)``."""
         st = self.style
         start = start or self.task.teacher_start(self.rng)
-        cfg = ExecutionConfig(
+        cfg = FollowConfig(
             stiffness_along=st.arm_stiffness,
             stiffness_across=st.arm_stiffness,
             aligned=False,
             push_force=st.push_force,
             settle_time=0.0,
-            log_rate=st.record_rate,
         )
         plan = self.plan(start)
-        outcome, log = run_trajectory(self.robot, self.task, plan, start, cfg)
+        rate = min(st.record_rate, 100.0)
+        outcome = run_trajectory(self.robot, self.task, plan, start, cfg, log_rate=rate)
+        log = outcome.log
         if not outcome.success:
-            return None, f"never reached the hole ({outcome.reason})"
-        if outcome.time_to_insertion < st.min_duration:
-            return None, f"ended at once ({outcome.time_to_insertion:.2f} s)"
+            return None, f"never reached the hole ({outcome.outcome}: {outcome.reason})"
+        if outcome.time_to_success < st.min_duration:
+            return None, f"ended at once ({outcome.time_to_success:.2f} s)"
         demo = Demonstration(
             t=log.t - log.t[0],
             pos=log.pos,
@@ -196,7 +204,7 @@ class BlindTeacher:
             child_frame="tcp",
             meta={
                 "pattern": st.pattern,
-                "time_to_insertion": outcome.time_to_insertion,
+                "time_to_insertion": outcome.time_to_success,
                 "path_length": outcome.path_length,
                 "start": [float(v) for v in (*start.pos, *start.quat)],
             },

@@ -1,0 +1,155 @@
+"""Following a set-point trajectory as a manipulation primitive: search and replay in a graph.
+
+A search trajectory (seed A) or a replayed demonstration is a time-sampled
+:class:`~teachfit.core.setpoints.SetpointTrajectory` of desired poses and feed-forward wrenches.
+:class:`FollowSetpoints` makes it one node of a skill graph: every command tick at node time
+``t`` it sets the set-point to the trajectory's sample ``x_d(t)`` (task frame), commands the
+sample's velocity so that the controller extrapolates between ticks, adds the feed-forward
+wrench and a constant push ``-push_force`` along the task frame's z (into the surface), and
+asks for a stiffness that is high along the direction of motion and low across it (seed A,
+Sec. III-D: the part can fall into a hole it passes over)::
+
+    K_xy = k_across I + (k_along - k_across) u u^T,   u = v_xy / |v_xy|
+
+:func:`follow_skill` wraps a trajectory into a one-node skill whose success is the task's
+success detector and whose error exits are the time budget (trajectory plus ``settle_time``)
+and the force limit, so a search runs through the same engine as every other skill.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from teachfit.control.impedance import aligned_stiffness
+from teachfit.core.errors import SkillError
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.skills.conditions import Any_, Detected, ForceAbove, TimeAbove
+from teachfit.skills.graph import Node, Skill
+from teachfit.skills.params import SkillParams
+from teachfit.skills.percept import MPCommand, Percept
+from teachfit.skills.primitive import Primitive, PrimitiveRun
+
+
+@dataclass(frozen=True)
+class FollowConfig:
+    """How a set-point trajectory is followed (N/m, N·m/rad, N, s).
+
+    ``stiffness_along`` / ``stiffness_across`` act in the x-y plane along / across the
+    direction of the set-point's motion (``aligned=False``: ``stiffness_along`` everywhere);
+    ``push_force`` presses the part onto the surface; ``settle_time`` is how long to wait after
+    the trajectory ends; ``max_force`` (N) ends the execution (force limit); ``anchor``:
+    ``"frame"`` follows the trajectory as given in the task frame, ``"entry"`` translates it
+    so that it starts where the set-point is when the node is entered.
+    """
+
+    stiffness_along: float = 1500.0
+    stiffness_across: float = 150.0
+    stiffness_z: float = 100.0
+    stiffness_rot: tuple[float, float, float] = (40.0, 40.0, 40.0)
+    push_force: float = 6.0
+    aligned: bool = True
+    settle_time: float = 1.0
+    max_force: float = 80.0
+    anchor: str = "frame"
+
+    def __post_init__(self) -> None:
+        for name in (
+            "stiffness_along",
+            "stiffness_across",
+            "stiffness_z",
+            "push_force",
+            "settle_time",
+            "max_force",
+        ):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise SkillError(f"follow: {name} must be >= 0, got {value}")
+        if self.anchor not in ("frame", "entry"):
+            raise SkillError(f"follow: anchor must be 'frame' or 'entry', got {self.anchor!r}")
+
+
+@dataclass(frozen=True)
+class FollowSetpoints(Primitive):
+    """Follow ``trajectory`` (task frame); see the module docstring. Built in code only."""
+
+    trajectory: SetpointTrajectory
+    config: FollowConfig = FollowConfig()
+    kind: ClassVar[str] = "follow_setpoints"
+
+    def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
+        return _FollowRun(self.trajectory, self.config)
+
+    def describe(self) -> str:
+        name = self.trajectory.name or "trajectory"
+        return f"follow {name} ({self.trajectory.duration:.1f} s, push {self.config.push_force} N)"
+
+    def refs(self) -> set[str]:
+        return set()
+
+    def to_toml(self) -> dict[str, Any]:
+        raise SkillError("a follow_setpoints node holds a trajectory and has no TOML form")
+
+
+class _FollowRun(PrimitiveRun):
+    def __init__(self, traj: SetpointTrajectory, cfg: FollowConfig) -> None:
+        self.traj, self.cfg = traj, cfg
+        self.rot_k = np.asarray(cfg.stiffness_rot, dtype=float)
+        self.direction = np.array([1.0, 0.0])
+        self.offset = np.zeros(3)
+        self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
+
+    def enter(self, pc: Percept) -> None:
+        self.direction[:] = (1.0, 0.0)
+        self.offset[:] = pc.p_d - self.traj.pos[0] if self.cfg.anchor == "entry" else 0.0
+        pc.goal[:] = self.traj.pos[-1] + self.offset
+        pc.done = False
+
+    def command(self, pc: Percept, out: MPCommand) -> None:
+        cfg = self.cfg
+        pos, quat, vel, ff = self.traj.sample(pc.t_node)
+        pc.p_d[:] = pos + self.offset
+        pc.q_d[:] = quat
+        if math.hypot(vel[0], vel[1]) > 1e-6:
+            self.direction[:] = vel[:2]
+        out.twist[:3] = vel
+        out.twist[3:] = 0.0
+        out.wrench[:] = ff
+        out.wrench[2] -= cfg.push_force
+        if cfg.aligned:
+            out.stiffness_full[:] = aligned_stiffness(
+                self.direction, cfg.stiffness_along, cfg.stiffness_across, cfg.stiffness_z,
+                self.rot_k,
+            )  # fmt: skip
+            out.full = True
+        else:
+            out.stiffness[:] = self.diag
+        pc.done = pc.t_node >= self.traj.duration
+
+
+def follow_skill(
+    trajectory: SetpointTrajectory, config: FollowConfig | None = None, name: str = "follow"
+) -> Skill:
+    """A one-node skill that follows ``trajectory`` until the task's detector fires.
+
+    Its error exits: the time budget ``duration + settle_time`` and the force limit; the
+    execution engine reports them as ``TIMEOUT`` and ``FORCE_LIMIT``.
+    """
+    cfg = config or FollowConfig()
+    horizon = trajectory.duration + cfg.settle_time
+    error = Any_((TimeAbove(horizon), ForceAbove(cfg.max_force, axis="norm")))
+    node = Node(name, FollowSetpoints(trajectory, cfg), error=error, doc=trajectory.name)
+    return Skill(
+        name=trajectory.name or name,
+        nodes=(node,),
+        transitions=(),
+        start=name,
+        params=SkillParams(),
+        success=Detected(),
+        error=TimeAbove(horizon + 1.0, scope="skill"),
+        frame="the trajectory's frame",
+    )

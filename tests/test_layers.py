@@ -1,0 +1,85 @@
+"""The package layout is the architecture: no package imports one above it, no import loops."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import teachfit
+
+ROOT = Path(teachfit.__file__).parent
+
+#: bottom to top; a package may import only packages of a lower (or its own) layer
+LAYERS: tuple[tuple[str, ...], ...] = (
+    ("core",),
+    ("tasks", "control"),
+    ("robot",),
+    ("demonstrations",),
+    ("models",),
+    ("trajectories", "skills", "plans"),
+    ("capture",),
+    ("execution",),
+    ("learning",),
+    ("metrics",),
+    ("viz",),
+    ("bench",),
+    ("quickstart",),
+    ("cli",),
+)
+RANK = {name: i for i, layer in enumerate(LAYERS) for name in layer}
+
+
+def _imports() -> dict[tuple[str, str], list[str]]:
+    """``(importer, imported) -> [files]`` over every teachfit module (absolute imports)."""
+    edges: dict[tuple[str, str], list[str]] = {}
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT)
+        if rel.name == "__init__.py" and len(rel.parts) == 1:
+            continue  # the top-level package re-exports the public API
+        pkg = rel.parts[0] if len(rel.parts) > 1 else rel.stem
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+                names = [node.module]
+            for name in names:
+                parts = name.split(".")
+                if parts[0] == "teachfit" and len(parts) > 1 and parts[1] != pkg:
+                    edges.setdefault((pkg, parts[1]), []).append(str(rel))
+    return edges
+
+
+def test_every_package_has_a_layer() -> None:
+    pkgs = {p.name for p in ROOT.iterdir() if p.is_dir() and (p / "__init__.py").exists()}
+    pkgs |= {p.stem for p in ROOT.glob("*.py") if p.stem != "__init__"}
+    assert pkgs - set(RANK) == set(), "add new packages to LAYERS"
+
+
+def test_no_package_imports_one_above_it() -> None:
+    upward = {
+        f"{a} -> {b} ({', '.join(sorted(set(files)))})"
+        for (a, b), files in _imports().items()
+        if RANK[b] > RANK[a]
+    }
+    assert not upward
+
+
+def test_no_two_packages_import_each_other() -> None:
+    edges = _imports()
+    loops = sorted(f"{a} <-> {b}" for (a, b) in edges if (b, a) in edges and a < b)
+    assert not loops
+
+
+def test_only_robot_and_scene_building_call_mujoco_math() -> None:
+    """``mju_*`` quaternion/vector math lives in robot/ and the geometry kernel; scene
+    builders (tasks, capture rendering) may use MuJoCo but not its math routines."""
+    allowed = {"robot", "core"}
+    found = []
+    for path in ROOT.rglob("*.py"):
+        rel = path.relative_to(ROOT)
+        if rel.parts[0] in allowed:
+            continue
+        if "mju_" in path.read_text():
+            found.append(str(rel))
+    assert not found
