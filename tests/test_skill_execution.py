@@ -14,7 +14,7 @@ from teachfit.skills.conditions import TimeAbove
 from teachfit.skills.executor import ExecConfig, execute
 from teachfit.skills.metric import LearningMetric
 from teachfit.skills.trial import SkillTrial, peg_in_hole_setup
-from teachfit.tasks.peg2d import Peg2D
+from teachfit.tasks import Peg2D
 
 ORDER = ["approach", "contact", "lateral", "align", "insert"]
 

@@ -31,7 +31,7 @@ class SimSpeed:
 
 def _pressed_robot(task: Task) -> tuple[FloatingToolRobot, ImpedanceCommand]:
     robot = FloatingToolRobot(task)
-    start = task.teacher_start(np.random.default_rng(0))
+    start = task.protocol.teacher_start(np.random.default_rng(0))
     robot.reset(start)
     cmd = ImpedanceCommand(
         pos=start.pos,

@@ -7,11 +7,12 @@ a 25 mm deep hole.
 
 Geometry. The hole is bored into the top of a thin-walled boss (a tube, outer diameter
 ``boss_diameter``) standing ``boss_height`` tall on a base plate (top at ``base_height``),
-centred on the world origin. Nothing surrounds the boss: a peg pushed more than about the wall
-thickness off the axis overhangs the rim, tips and slides off it, and a peg beside the boss
-goes down to the plate (deep below the hole entry, yet not inserted: :meth:`ground_truth_inserted` also
-asks for the TCP on the hole axis). The boss wall is ``n_sectors`` convex ring sectors whose
-polygonal hole circumscribes the nominal circle; a solid cylinder fills it below the hole.
+centred on the world origin (:mod:`teachfit.tasks.scene.round_hole`). Nothing surrounds the
+boss: a peg pushed more than about the wall thickness off the axis overhangs the rim, tips and
+slides off it, and a peg beside the boss goes down to the plate -- deep below the hole entry,
+yet not inserted: :meth:`ground_truth_inserted` asks for the TCP on the hole axis, and
+:meth:`detect_success` for the TCP within :attr:`detection_radius` (the overhang offset) of
+the nominal axis.
 
 Frames. The hole frame (:attr:`hole2world`) is at the centre of the hole entry (the boss top),
 z up. The TCP is the centre of the peg's tip face, the peg's axis +z. The search is in x, y.
@@ -19,22 +20,16 @@ z up. The TCP is the centre of the peg's tip face, the peg's axis +z. The search
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
 from teachfit.core.geometry import Pose
-from teachfit.tasks.base import ContactParams
-from teachfit.tasks.mjcf import SceneXml, chamfered_cylinder, contact_attrs, fmt, ring_sector
-from teachfit.tasks.skill_protocol import (
-    SkillProtocolParams,
-    SkillTask,
-    doc_field,
-)
-
-ALUMINIUM_DENSITY = 2700.0  # kg/m^3
+from teachfit.tasks.geometry.skill import SkillTask
+from teachfit.tasks.params import doc_field
+from teachfit.tasks.protocols.skill import SkillProtocolParams
+from teachfit.tasks.scene.round_hole import BossScene
 
 
 @dataclass(frozen=True)
@@ -42,6 +37,21 @@ class AluminiumPegParams(SkillProtocolParams):
     """Parameters of :class:`AluminiumPeg`; every length in metres."""
 
     task_name: ClassVar[str] = "peg"
+    positive: ClassVar[tuple[str, ...]] = SkillProtocolParams.positive + (
+        "peg_diameter",
+        "clearance",
+        "peg_length",
+        "hole_depth",
+        "boss_diameter",
+        "boss_height",
+        "base_height",
+        "base_half_width",
+        "success_depth",
+    )
+    nonnegative: ClassVar[tuple[str, ...]] = SkillProtocolParams.nonnegative + (
+        "peg_chamfer",
+        "hole_chamfer",
+    )
 
     peg_diameter: float = doc_field("peg diameter (m)", 0.016)
     clearance: float = doc_field("diametral clearance: hole diameter minus peg diameter (m)", 3e-4)
@@ -57,22 +67,8 @@ class AluminiumPegParams(SkillProtocolParams):
     demo_offset: float = doc_field("distance of the blind teacher's start from the hole (m)", 0.003)
     n_sectors: int = doc_field("convex sectors forming the boss wall", 32)
 
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        for key in (
-            "peg_diameter",
-            "clearance",
-            "peg_length",
-            "hole_depth",
-            "boss_diameter",
-            "boss_height",
-            "base_height",
-            "base_half_width",
-            "success_depth",
-        ):
-            self.require(getattr(self, key) > 0, f"{key} must be > 0, got {getattr(self, key)}")
-        for key in ("peg_chamfer", "hole_chamfer"):
-            self.require(getattr(self, key) >= 0, f"{key} must be >= 0, got {getattr(self, key)}")
+    def check(self) -> None:
+        super().check()
         self.require(
             self.clearance < self.peg_diameter / 4,
             f"clearance {self.clearance} must be below a quarter of the peg diameter "
@@ -92,11 +88,7 @@ class AluminiumPegParams(SkillProtocolParams):
             self.hole_depth + 0.002 <= self.boss_height,
             "hole_depth must be at least 2 mm less than boss_height (the hole bottom)",
         )
-        self.require(
-            self.success_depth <= self.hole_depth,
-            f"success_depth {self.success_depth} is deeper than the hole ({self.hole_depth}): "
-            "impossible to succeed",
-        )
+        self.require_reachable(self.success_depth, self.hole_depth, "hole")
         self.require(self.peg_length > self.hole_depth, "peg_length must exceed hole_depth")
         self.require(
             self.base_half_width >= self.boss_diameter / 2 + self.peg_diameter,
@@ -116,6 +108,7 @@ class AluminiumPeg(SkillTask):
     description = "chamfered aluminium peg into a hole with no walls around it; x-y (seed B)"
     search_dims = ("x", "y")
     params_type = AluminiumPegParams
+    scene_type = BossScene
     params: AluminiumPegParams
 
     @property
@@ -131,70 +124,11 @@ class AluminiumPeg(SkillTask):
         return self.params.hole_depth
 
     @property
-    def held_part_length(self) -> float:
-        return self.params.peg_length
-
-    @property
     def overhang_offset(self) -> float:
         """Lateral TCP offset (m) beyond which the peg's tip overhangs the boss rim."""
         return (self.params.boss_diameter - self.params.peg_diameter) / 2
 
-    def add_fixture(self, scene: SceneXml, contact: ContactParams) -> None:
-        p = self.params
-        hole_r = (p.peg_diameter + p.clearance) / 2
-        boss_r = p.boss_diameter / 2
-        top = self.surface_z
-        z_hole = top - p.hole_depth
-        kw = contact_attrs(contact)
-        fixture = ET.SubElement(scene.worldbody, "body", name="fixture")
-        ET.SubElement(
-            fixture,
-            "geom",
-            name="fixture_base",
-            type="box",
-            size=fmt([p.base_half_width, p.base_half_width, p.base_height / 2]),
-            pos=fmt([0, 0, p.base_height / 2]),
-            material="metal",
-            **kw,
-        )
-        core_half = (z_hole - p.base_height) / 2
-        ET.SubElement(
-            fixture,
-            "geom",
-            name="boss_core",
-            type="cylinder",
-            size=fmt([boss_r, core_half]),
-            pos=fmt([0, 0, p.base_height + core_half]),
-            material="metal",
-            **kw,
-        )
-        scene.add_mesh(
-            "boss_sector", ring_sector(hole_r, boss_r, z_hole, top, p.n_sectors, p.hole_chamfer)
-        )
-        for i in range(p.n_sectors):
-            ET.SubElement(
-                fixture,
-                "geom",
-                name=f"hole_wall_{i}",
-                type="mesh",
-                mesh="boss_sector",
-                euler=fmt([0, 0, 2 * np.pi * i / p.n_sectors]),
-                material="metal",
-                **kw,
-            )
-
-    def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
-        p = self.params
-        r = p.peg_diameter / 2
-        scene.add_mesh("alu_peg", chamfered_cylinder(r, p.peg_length, p.peg_chamfer, 48))
-        mass = ALUMINIUM_DENSITY * np.pi * r**2 * p.peg_length
-        ET.SubElement(
-            body,
-            "geom",
-            name="peg",
-            type="mesh",
-            mesh="alu_peg",
-            material="tool",
-            mass=fmt(mass),
-            **contact_attrs(contact),
-        )
+    @property
+    def detection_radius(self) -> float:
+        """Within :attr:`overhang_offset` the whole peg tip is over the boss top."""
+        return self.overhang_offset
