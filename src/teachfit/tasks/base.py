@@ -58,9 +58,10 @@ class Task(ABC):
         """Height of the surface the part slides on before it enters (m, world)."""
 
     @property
-    @abstractmethod
     def hole2world(self) -> Pose:
-        """Ground-truth pose of the hole frame (entry centre, z up) in the world."""
+        """Ground-truth pose of the hole frame (entry centre, z up) in the world; by default on
+        the world z axis, unturned, with the entry at :attr:`surface_z`."""
+        return Pose(np.array([0.0, 0.0, self.surface_z]))
 
     @property
     def success_depth(self) -> float:

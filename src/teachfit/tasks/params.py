@@ -1,22 +1,28 @@
 """Task parameters: a frozen dataclass per task with documented fields and one-line checks.
 
 Every task's parameters derive from :class:`TaskParams`: lengths in metres, angles in radians.
-The sign checks of the fields named in ``positive`` / ``nonnegative`` run first, then the
-relations between fields (:meth:`TaskParams.check`); every failure is a :class:`TaskError`
-whose message starts with the task's name.
+Each field states its description and its bound (:func:`doc_field`); the bounds are checked
+first, in field order, then the relations between fields (:meth:`TaskParams.check`). Every
+failure is a :class:`TaskError` whose message starts with the task's name.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 from teachfit.core.errors import TaskError
 
 
-def doc_field(text: str, default: float | int) -> Any:
-    """A dataclass field with a default and a description for ``teachfit tasks``."""
-    return field(default=default, metadata={"doc": text})
+def doc_field(
+    text: str,
+    default: float | int,
+    above: float | None = None,
+    at_least: float | None = None,
+) -> Any:
+    """A dataclass field with a default, a description for ``teachfit tasks`` and optionally
+    a bound: the value must be ``> above`` or ``>= at_least``."""
+    return field(default=default, metadata={"doc": text, "above": above, "at_least": at_least})
 
 
 @dataclass(frozen=True)
@@ -25,18 +31,15 @@ class TaskParams:
 
     #: task name prefixed to every validation message
     task_name: ClassVar[str] = "task"
-    #: fields that must be > 0
-    positive: ClassVar[tuple[str, ...]] = ()
-    #: fields that must be >= 0
-    nonnegative: ClassVar[tuple[str, ...]] = ()
 
     def __post_init__(self) -> None:
-        for key in self.positive:
-            value = getattr(self, key)
-            self.require(value > 0, f"{key} must be > 0, got {value}")
-        for key in self.nonnegative:
-            value = getattr(self, key)
-            self.require(value >= 0, f"{key} must be >= 0, got {value}")
+        for f in fields(self):
+            value = getattr(self, f.name)
+            above, at_least = f.metadata.get("above"), f.metadata.get("at_least")
+            if above is not None:
+                self.require(value > above, f"{f.name} must be > {above}, got {value}")
+            if at_least is not None:
+                self.require(value >= at_least, f"{f.name} must be >= {at_least}, got {value}")
         self.check()
 
     def check(self) -> None:

@@ -38,36 +38,37 @@ class KeyParams(PrismHoleParams):
     hole_word: ClassVar[str] = "slot"
     face_word: ClassVar[str] = "lock face"
     min_rim: ClassVar[float] = 0.003
-    positive: ClassVar[tuple[str, ...]] = PrismHoleParams.positive + (
-        "blade_width",
-        "blade_thickness",
-        "blade_length",
-        "slot_depth",
-        "bow_width",
-        "bow_thickness",
-        "bow_height",
-    )
-    nonnegative: ClassVar[tuple[str, ...]] = PrismHoleParams.nonnegative + (
-        "blade_chamfer",
-        "slot_chamfer",
-    )
 
-    blade_width: float = doc_field("width of the key blade, along the hole frame's x (m)", 0.007)
-    blade_thickness: float = doc_field("thickness of the blade, along y (m)", 0.002)
-    blade_length: float = doc_field("length of the blade below the bow (m)", 0.030)
-    blade_chamfer: float = doc_field("45-degree chamfer on the blade tip's edges (m)", 0.0005)
-    clearance: float = doc_field("slot size minus blade size, in width and thickness (m)", 0.0003)
-    slot_depth: float = doc_field("depth of the slot below the lock face (m)", 0.020)
-    slot_chamfer: float = doc_field("45-degree chamfer on the slot's entry edges (m)", 0.0008)
-    bow_width: float = doc_field("width of the key bow above the blade (m)", 0.020)
-    bow_thickness: float = doc_field("thickness of the bow (m)", 0.003)
-    bow_height: float = doc_field("height of the bow (m)", 0.015)
-    block_half_width: float = doc_field("half side of the square lock face (m)", 0.020)
-    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.012)
-    start_offset: float = doc_field("lateral offset of the skill starts from the hole (m)", 0.0005)
-    hole_pos_sigma: float = doc_field("std of the taught hole position, per axis (m)", 0.0003)
-    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0087)
-    demo_offset: float = doc_field("distance of the blind teacher's start from the hole (m)", 0.008)
+    blade_width: float = doc_field(
+        "width of the key blade, along the hole frame's x (m)", 0.007, above=0
+    )
+    blade_thickness: float = doc_field("thickness of the blade, along y (m)", 0.002, above=0)
+    blade_length: float = doc_field("length of the blade below the bow (m)", 0.030, above=0)
+    blade_chamfer: float = doc_field(
+        "45-degree chamfer on the blade tip's edges (m)", 0.0005, at_least=0
+    )
+    clearance: float = doc_field(
+        "slot size minus blade size, in width and thickness (m)", 0.0003, above=0
+    )
+    slot_depth: float = doc_field("depth of the slot below the lock face (m)", 0.020, above=0)
+    slot_chamfer: float = doc_field(
+        "45-degree chamfer on the slot's entry edges (m)", 0.0008, at_least=0
+    )
+    bow_width: float = doc_field("width of the key bow above the blade (m)", 0.020, above=0)
+    bow_thickness: float = doc_field("thickness of the bow (m)", 0.003, above=0)
+    bow_height: float = doc_field("height of the bow (m)", 0.015, above=0)
+    block_half_width: float = doc_field("half side of the square lock face (m)", 0.020, above=0)
+    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.012, above=0)
+    start_offset: float = doc_field(
+        "lateral offset of the skill starts from the hole (m)", 0.0005, at_least=0
+    )
+    hole_pos_sigma: float = doc_field(
+        "std of the taught hole position, per axis (m)", 0.0003, at_least=0
+    )
+    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0087, at_least=0)
+    demo_offset: float = doc_field(
+        "distance of the blind teacher's start from the hole (m)", 0.008, above=0
+    )
 
     def check(self) -> None:
         self.require(

@@ -23,9 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-import numpy as np
-
-from teachfit.core.geometry import Pose
+from teachfit.tasks.geometry.round_peg import RoundPegParams
 from teachfit.tasks.geometry.skill import SkillTask
 from teachfit.tasks.params import doc_field
 from teachfit.tasks.protocols.skill import SkillProtocolParams
@@ -33,38 +31,29 @@ from teachfit.tasks.scene.round_hole import BossScene
 
 
 @dataclass(frozen=True)
-class AluminiumPegParams(SkillProtocolParams):
+class AluminiumPegParams(SkillProtocolParams, RoundPegParams):
     """Parameters of :class:`AluminiumPeg`; every length in metres."""
 
     task_name: ClassVar[str] = "peg"
-    positive: ClassVar[tuple[str, ...]] = SkillProtocolParams.positive + (
-        "peg_diameter",
-        "clearance",
-        "peg_length",
-        "hole_depth",
-        "boss_diameter",
-        "boss_height",
-        "base_height",
-        "base_half_width",
-        "success_depth",
-    )
-    nonnegative: ClassVar[tuple[str, ...]] = SkillProtocolParams.nonnegative + (
-        "peg_chamfer",
-        "hole_chamfer",
-    )
 
-    peg_diameter: float = doc_field("peg diameter (m)", 0.016)
-    clearance: float = doc_field("diametral clearance: hole diameter minus peg diameter (m)", 3e-4)
-    peg_chamfer: float = doc_field("45-degree chamfer on the peg tip edge (m)", 0.001)
-    peg_length: float = doc_field("length of the peg below the wrist sensor (m)", 0.060)
-    hole_depth: float = doc_field("depth of the hole below the boss top (m)", 0.025)
-    hole_chamfer: float = doc_field("45-degree chamfer on the hole entry edge (m)", 0.0)
-    boss_diameter: float = doc_field("outer diameter of the boss holding the hole (m)", 0.024)
-    boss_height: float = doc_field("height of the boss above the base plate (m)", 0.040)
-    base_height: float = doc_field("height of the base plate's top (m, world z)", 0.010)
-    base_half_width: float = doc_field("half side of the square base plate (m)", 0.060)
-    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.015)
-    demo_offset: float = doc_field("distance of the blind teacher's start from the hole (m)", 0.003)
+    peg_diameter: float = doc_field("peg diameter (m)", 0.016, above=0)
+    clearance: float = doc_field(
+        "diametral clearance: hole diameter minus peg diameter (m)", 3e-4, above=0
+    )
+    peg_chamfer: float = doc_field("45-degree chamfer on the peg tip edge (m)", 0.001, at_least=0)
+    peg_length: float = doc_field("length of the peg below the wrist sensor (m)", 0.060, above=0)
+    hole_depth: float = doc_field("depth of the hole below the boss top (m)", 0.025, above=0)
+    hole_chamfer: float = doc_field("45-degree chamfer on the hole entry edge (m)", 0.0, at_least=0)
+    boss_diameter: float = doc_field(
+        "outer diameter of the boss holding the hole (m)", 0.024, above=0
+    )
+    boss_height: float = doc_field("height of the boss above the base plate (m)", 0.040, above=0)
+    base_height: float = doc_field("height of the base plate's top (m, world z)", 0.010, above=0)
+    base_half_width: float = doc_field("half side of the square base plate (m)", 0.060, above=0)
+    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.015, above=0)
+    demo_offset: float = doc_field(
+        "distance of the blind teacher's start from the hole (m)", 0.003, above=0
+    )
     n_sectors: int = doc_field("convex sectors forming the boss wall", 32)
 
     def check(self) -> None:
@@ -73,10 +62,6 @@ class AluminiumPegParams(SkillProtocolParams):
             self.clearance < self.peg_diameter / 4,
             f"clearance {self.clearance} must be below a quarter of the peg diameter "
             f"({self.peg_diameter}): that is no tight fit",
-        )
-        self.require(
-            self.peg_chamfer < self.peg_diameter / 2,
-            "peg_chamfer must be smaller than the peg radius",
         )
         wall = (self.boss_diameter - self.peg_diameter - self.clearance) / 2 - self.hole_chamfer
         self.require(
@@ -88,8 +73,6 @@ class AluminiumPegParams(SkillProtocolParams):
             self.hole_depth + 0.002 <= self.boss_height,
             "hole_depth must be at least 2 mm less than boss_height (the hole bottom)",
         )
-        self.require_reachable(self.success_depth, self.hole_depth, "hole")
-        self.require(self.peg_length > self.hole_depth, "peg_length must exceed hole_depth")
         self.require(
             self.base_half_width >= self.boss_diameter / 2 + self.peg_diameter,
             "base_half_width must leave room for the peg beside the boss",
@@ -98,7 +81,7 @@ class AluminiumPegParams(SkillProtocolParams):
             self.demo_offset + self.peg_diameter / 2 <= self.boss_diameter / 2,
             "demo_offset puts the teacher's start (partly) off the boss top",
         )
-        self.require(8 <= self.n_sectors <= 256, "n_sectors must be within [8, 256]")
+        self.check_round_peg()
 
 
 class AluminiumPeg(SkillTask):
@@ -114,10 +97,6 @@ class AluminiumPeg(SkillTask):
     @property
     def surface_z(self) -> float:
         return self.params.base_height + self.params.boss_height
-
-    @property
-    def hole2world(self) -> Pose:
-        return Pose(np.array([0.0, 0.0, self.surface_z]))
 
     @property
     def hole_depth(self) -> float:

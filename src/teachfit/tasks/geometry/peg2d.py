@@ -13,52 +13,43 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-import numpy as np
-
-from teachfit.core.geometry import Pose
 from teachfit.tasks.base import Task
-from teachfit.tasks.params import TaskParams, doc_field
+from teachfit.tasks.geometry.round_peg import RoundPegParams
+from teachfit.tasks.params import doc_field
 from teachfit.tasks.protocols.seed_a import Peg2DProtocol
 from teachfit.tasks.scene.round_hole import Peg2DScene
 
 
 @dataclass(frozen=True)
-class Peg2DParams(TaskParams):
+class Peg2DParams(RoundPegParams):
     """Parameters of :class:`Peg2D`; every length in metres."""
 
     task_name: ClassVar[str] = "peg2d"
-    positive: ClassVar[tuple[str, ...]] = (
-        "peg_diameter",
-        "clearance",
-        "hole_depth",
-        "peg_length",
-        "block_diameter",
-        "block_height",
-        "success_depth",
-        "demo_offset",
-    )
-    nonnegative: ClassVar[tuple[str, ...]] = ("peg_chamfer", "hole_chamfer", "friction")
 
-    peg_diameter: float = doc_field("peg diameter (m)", 0.020)
-    clearance: float = doc_field("diametral clearance: hole diameter minus peg diameter (m)", 5e-4)
-    hole_depth: float = doc_field("depth of the hole below the top surface (m)", 0.020)
-    peg_length: float = doc_field("length of the peg below the wrist sensor (m)", 0.060)
-    peg_chamfer: float = doc_field("45-degree chamfer on the peg tip edge (m)", 0.001)
-    hole_chamfer: float = doc_field("45-degree chamfer on the hole entry edge (m)", 0.0005)
-    block_diameter: float = doc_field("diameter of the cylinder holding the hole (m)", 0.120)
-    block_height: float = doc_field("height of that cylinder's top surface (m)", 0.060)
-    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.010)
-    demo_offset: float = doc_field("distance of the blind teacher's worst-case start (m)", 0.030)
-    friction: float = doc_field("sliding friction coefficient peg/block", 0.3)
+    peg_diameter: float = doc_field("peg diameter (m)", 0.020, above=0)
+    clearance: float = doc_field(
+        "diametral clearance: hole diameter minus peg diameter (m)", 5e-4, above=0
+    )
+    hole_depth: float = doc_field("depth of the hole below the top surface (m)", 0.020, above=0)
+    peg_length: float = doc_field("length of the peg below the wrist sensor (m)", 0.060, above=0)
+    peg_chamfer: float = doc_field("45-degree chamfer on the peg tip edge (m)", 0.001, at_least=0)
+    hole_chamfer: float = doc_field(
+        "45-degree chamfer on the hole entry edge (m)", 0.0005, at_least=0
+    )
+    block_diameter: float = doc_field(
+        "diameter of the cylinder holding the hole (m)", 0.120, above=0
+    )
+    block_height: float = doc_field("height of that cylinder's top surface (m)", 0.060, above=0)
+    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.010, above=0)
+    demo_offset: float = doc_field(
+        "distance of the blind teacher's worst-case start (m)", 0.030, above=0
+    )
+    friction: float = doc_field("sliding friction coefficient peg/block", 0.3, at_least=0)
     n_sectors: int = doc_field("convex sectors forming the hole wall", 32)
 
     def check(self) -> None:
         self.require(
             self.clearance < self.peg_diameter, "clearance must be smaller than the peg diameter"
-        )
-        self.require(
-            self.peg_chamfer < self.peg_diameter / 2,
-            "peg_chamfer must be smaller than the peg radius",
         )
         hole_r = (self.peg_diameter + self.clearance) / 2 + self.hole_chamfer
         self.require(
@@ -69,13 +60,11 @@ class Peg2DParams(TaskParams):
         self.require(
             self.hole_depth < self.block_height, "hole_depth must be smaller than block_height"
         )
-        self.require_reachable(self.success_depth, self.hole_depth, "hole")
-        self.require(self.peg_length > self.hole_depth, "peg_length must exceed hole_depth")
         self.require(
             self.demo_offset + self.peg_diameter / 2 < self.block_diameter / 2,
             "demo_offset puts the teacher's start off the block",
         )
-        self.require(8 <= self.n_sectors <= 256, "n_sectors must be within [8, 256]")
+        self.check_round_peg()
 
 
 class Peg2D(Task):
@@ -92,10 +81,6 @@ class Peg2D(Task):
     @property
     def surface_z(self) -> float:
         return self.params.block_height
-
-    @property
-    def hole2world(self) -> Pose:
-        return Pose(np.array([0.0, 0.0, self.surface_z]))
 
     @property
     def detection_radius(self) -> float:

@@ -34,18 +34,16 @@ class PrismHoleParams(SkillProtocolParams):
     face_word: ClassVar[str] = "block"
     #: least rim (m) the block must leave around the hole
     min_rim: ClassVar[float] = 0.005
-    positive: ClassVar[tuple[str, ...]] = SkillProtocolParams.positive + (
-        "clearance",
-        "block_half_width",
-        "block_height",
-        "success_depth",
-    )
 
-    clearance: float = doc_field("clearance of the part in the hole (m)", 0.0004)
+    clearance: float = doc_field("clearance of the part in the hole (m)", 0.0004, above=0)
     hole_yaw: float = doc_field("yaw of the hole (and block) about world z (rad)", 0.0)
-    block_half_width: float = doc_field("half side of the square block holding the hole (m)", 0.045)
-    block_height: float = doc_field("height of the block's top surface (m, world z)", 0.040)
-    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.010)
+    block_half_width: float = doc_field(
+        "half side of the square block holding the hole (m)", 0.045, above=0
+    )
+    block_height: float = doc_field(
+        "height of the block's top surface (m, world z)", 0.040, above=0
+    )
+    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.010, above=0)
 
     @property
     @abstractmethod

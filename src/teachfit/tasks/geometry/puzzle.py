@@ -30,22 +30,22 @@ class PuzzleParams(PrismHoleParams):
     """Parameters of :class:`Puzzle`; every length in metres, angles in radians."""
 
     task_name: ClassVar[str] = "puzzle"
-    positive: ClassVar[tuple[str, ...]] = PrismHoleParams.positive + (
-        "side_length",
-        "hole_depth",
-        "piece_height",
-    )
-    nonnegative: ClassVar[tuple[str, ...]] = PrismHoleParams.nonnegative + ("hole_chamfer",)
 
-    side_length: float = doc_field("side of the triangular piece (m)", 0.030)
+    side_length: float = doc_field("side of the triangular piece (m)", 0.030, above=0)
     clearance: float = doc_field(
-        "hole's inscribed diameter minus the piece's (m); each edge gap is half", 0.0004
+        "hole's inscribed diameter minus the piece's (m); each edge gap is half", 0.0004, above=0
     )
-    hole_depth: float = doc_field("depth of the hole below the block top (m)", 0.015)
-    hole_chamfer: float = doc_field("45-degree chamfer on the hole edges (m); 0 in the paper", 0.0)
-    piece_height: float = doc_field("height of the piece below the wrist sensor (m)", 0.035)
-    start_yaw: float = doc_field("skill starts draw yaw within +-start_yaw of the hole (rad)", 0.05)
-    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0175)
+    hole_depth: float = doc_field("depth of the hole below the block top (m)", 0.015, above=0)
+    hole_chamfer: float = doc_field(
+        "45-degree chamfer on the hole edges (m); 0 in the paper", 0.0, at_least=0
+    )
+    piece_height: float = doc_field(
+        "height of the piece below the wrist sensor (m)", 0.035, above=0
+    )
+    start_yaw: float = doc_field(
+        "skill starts draw yaw within +-start_yaw of the hole (rad)", 0.05, at_least=0
+    )
+    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0175, at_least=0)
 
     def check(self) -> None:
         self.require(

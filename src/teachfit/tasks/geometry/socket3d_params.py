@@ -18,47 +18,41 @@ class Socket3DParams(TaskParams):
     """Parameters of :class:`~teachfit.tasks.geometry.socket3d.Socket3D`."""
 
     task_name: ClassVar[str] = "socket3d"
-    positive: ClassVar[tuple[str, ...]] = (
-        "pin_diameter",
-        "pin_spacing",
-        "pin_length",
-        "clearance_small",
-        "clearance_large",
-        "hole_depth",
-        "valley_radius",
-        "recess_diameter",
-        "recess_depth",
-        "wall_thickness",
-        "floor_height",
-        "body_diameter",
-        "body_height",
-        "success_depth",
-        "start_rz",
-    )
-    nonnegative: ClassVar[tuple[str, ...]] = ("pin_tip_radius", "valley_depth", "start_wall_gap")
 
-    pin_diameter: float = doc_field("diameter of each pin (m)", 0.004)
-    pin_spacing: float = doc_field("distance between the pin (and hole) axes (m)", 0.019)
-    pin_length: float = doc_field("length of the pins below the plug body (m)", 0.019)
-    pin_tip_radius: float = doc_field("radius of the rounded pin-tip edge (m)", 0.0008)
-    clearance_small: float = doc_field("diametral clearance of the small hole, at -x (m)", 0.0004)
-    clearance_large: float = doc_field("diametral clearance of the large hole, at +x (m)", 0.0008)
-    hole_depth: float = doc_field("depth of the holes below their entry (m)", 0.016)
+    pin_diameter: float = doc_field("diameter of each pin (m)", 0.004, above=0)
+    pin_spacing: float = doc_field("distance between the pin (and hole) axes (m)", 0.019, above=0)
+    pin_length: float = doc_field("length of the pins below the plug body (m)", 0.019, above=0)
+    pin_tip_radius: float = doc_field("radius of the rounded pin-tip edge (m)", 0.0008, at_least=0)
+    clearance_small: float = doc_field(
+        "diametral clearance of the small hole, at -x (m)", 0.0004, above=0
+    )
+    clearance_large: float = doc_field(
+        "diametral clearance of the large hole, at +x (m)", 0.0008, above=0
+    )
+    hole_depth: float = doc_field("depth of the holes below their entry (m)", 0.016, above=0)
     valley_depth: float = doc_field(
-        "depth of the valley from the floor to the hole edge (m)", 0.0025
+        "depth of the valley from the floor to the hole edge (m)", 0.0025, at_least=0
     )
     valley_radius: float = doc_field(
-        "radius around a hole where its valley meets the floor (m)", 0.006
+        "radius around a hole where its valley meets the floor (m)", 0.006, above=0
     )
-    recess_diameter: float = doc_field("inner diameter of the socket recess (m)", 0.044)
-    recess_depth: float = doc_field("height of the recess wall above the floor (m)", 0.022)
-    wall_thickness: float = doc_field("thickness of the recess wall (m)", 0.005)
-    floor_height: float = doc_field("height of the recess floor's flat top (m, world z)", 0.050)
-    body_diameter: float = doc_field("diameter of the round plug body (m)", 0.027)
-    body_height: float = doc_field("height of the plug body above the pins (m)", 0.015)
-    success_depth: float = doc_field("pin insertion past the hole entry that counts (m)", 0.010)
-    start_rz: float = doc_field("starts draw rz uniformly within +-start_rz (rad)", 0.6981317)
-    start_wall_gap: float = doc_field("gap between plug body and wall at teacher starts (m)", 0.001)
+    recess_diameter: float = doc_field("inner diameter of the socket recess (m)", 0.044, above=0)
+    recess_depth: float = doc_field("height of the recess wall above the floor (m)", 0.022, above=0)
+    wall_thickness: float = doc_field("thickness of the recess wall (m)", 0.005, above=0)
+    floor_height: float = doc_field(
+        "height of the recess floor's flat top (m, world z)", 0.050, above=0
+    )
+    body_diameter: float = doc_field("diameter of the round plug body (m)", 0.027, above=0)
+    body_height: float = doc_field("height of the plug body above the pins (m)", 0.015, above=0)
+    success_depth: float = doc_field(
+        "pin insertion past the hole entry that counts (m)", 0.010, above=0
+    )
+    start_rz: float = doc_field(
+        "starts draw rz uniformly within +-start_rz (rad)", 0.6981317, above=0
+    )
+    start_wall_gap: float = doc_field(
+        "gap between plug body and wall at teacher starts (m)", 0.001, at_least=0
+    )
     n_wedges: int = doc_field("convex valley wedges around each hole", 16)
     n_wall_sectors: int = doc_field("convex sectors forming the recess wall", 32)
 

@@ -17,7 +17,7 @@ Frames as in :mod:`teachfit.tasks.base`: world z up, the hole frame at the entry
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -37,22 +37,23 @@ class SkillProtocolParams(TaskParams):
     Lengths in metres, angles in radians. Subclasses add the geometry and may change defaults.
     """
 
-    positive: ClassVar[tuple[str, ...]] = ("approach_height", "demo_offset")
-    nonnegative: ClassVar[tuple[str, ...]] = (
-        "start_offset",
-        "start_yaw",
-        "hole_pos_sigma",
-        "hole_yaw_sigma",
-        "friction",
+    approach_height: float = doc_field(
+        "height of the skill starts above the surface (m)", 0.025, above=0
     )
-
-    approach_height: float = doc_field("height of the skill starts above the surface (m)", 0.025)
-    start_offset: float = doc_field("lateral offset of the skill starts from the hole (m)", 0.002)
-    start_yaw: float = doc_field("skill starts draw yaw within +-start_yaw of the hole (rad)", 0.0)
-    hole_pos_sigma: float = doc_field("std of the taught hole position, per axis (m)", 0.0005)
-    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0)
-    demo_offset: float = doc_field("distance of the blind teacher's start from the hole (m)", 0.02)
-    friction: float = doc_field("sliding friction coefficient part/fixture", 0.3)
+    start_offset: float = doc_field(
+        "lateral offset of the skill starts from the hole (m)", 0.002, at_least=0
+    )
+    start_yaw: float = doc_field(
+        "skill starts draw yaw within +-start_yaw of the hole (rad)", 0.0, at_least=0
+    )
+    hole_pos_sigma: float = doc_field(
+        "std of the taught hole position, per axis (m)", 0.0005, at_least=0
+    )
+    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0, at_least=0)
+    demo_offset: float = doc_field(
+        "distance of the blind teacher's start from the hole (m)", 0.02, above=0
+    )
+    friction: float = doc_field("sliding friction coefficient part/fixture", 0.3, at_least=0)
 
     def check(self) -> None:
         super().check()
