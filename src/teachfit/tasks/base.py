@@ -125,10 +125,8 @@ class Task(ABC):
         cell's drawing says: the TCP is at least :attr:`success_depth` below the nominal entry
         height and within :attr:`detection_radius` of the nominal hole axis."""
         rel = self.nominal_hole2world.inverse().compose(tool2world)
-        return (
-            self.entry_height - float(tool2world.pos[2]) >= self.success_depth
-            and float(np.hypot(rel.pos[0], rel.pos[1])) <= self.detection_radius
-        )
+        deep = self.entry_height - float(tool2world.pos[2]) >= self.success_depth
+        return deep and float(np.hypot(rel.pos[0], rel.pos[1])) <= float(self.detection_radius)
 
     # ------------------------------------------------------------------------------- I/O
     @classmethod
