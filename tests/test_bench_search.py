@@ -53,7 +53,7 @@ def test_parallel_jobs_match_inline_jobs():
 
     overrides, demo, model = _peg_setup(0, 0.0005)
     task = get_task("peg2d", **overrides)
-    starts = task.protocol_starts("table1", 2, np.random.default_rng(3))
+    starts = task.protocol.protocol_starts("table1", 2, np.random.default_rng(3))
     jobs = _jobs("peg2d", overrides, model, starts, "tshix", 30, [1, 2])
     inline = run_jobs(jobs, workers=0)
     pooled = run_jobs(jobs, workers=2)

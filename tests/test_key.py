@@ -12,7 +12,7 @@ from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Key, KeyParams, get_task
-from teachfit.tasks.prism_geometry import beyond_edge_block, rectangle
+from teachfit.tasks.scene.prisms import beyond_edge_block, rectangle
 
 STIFF = [300, 300, 300, 50, 50, 50]
 

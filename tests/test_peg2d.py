@@ -71,13 +71,13 @@ def test_table1_starts_lie_in_a_3cm_circle_halfway():
     task = Peg2D()
     rng = np.random.default_rng(0)
     demo_start = task.contact_pose([0.03, 0.0])
-    starts = task.protocol_starts("table1", 200, rng, demo_start)
+    starts = task.protocol.protocol_starts("table1", 200, rng, demo_start)
     xy = np.array([s.pos[:2] for s in starts])
     centre = np.array([0.015, 0.0])
     assert np.all(np.linalg.norm(xy - centre, axis=1) <= 0.015 + 1e-12)
     assert np.allclose([s.pos[2] for s in starts], task.surface_z)
     with pytest.raises(TaskError):
-        task.protocol_starts("table9", 3, rng)
+        task.protocol.protocol_starts("table9", 3, rng)
 
 
 def test_friction_parameter_reaches_the_scene():

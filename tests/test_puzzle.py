@@ -121,8 +121,8 @@ def test_toml(tmp_path) -> None:
 def test_skill_starts_are_four_deterministic_poses_above_the_hole(name: str) -> None:
     t = get_task(name)
     assert isinstance(t, SkillTask)
-    a = t.skill_starts(np.random.default_rng(7))
-    b = t.protocol_starts("skill", 4, np.random.default_rng(7))
+    a = t.protocol.skill_starts(np.random.default_rng(7))
+    b = t.protocol.protocol_starts("skill", 4, np.random.default_rng(7))
     assert len(a) == 4
     for s, s2 in zip(a, b, strict=True):
         np.testing.assert_array_equal(s.pos, s2.pos)
@@ -134,7 +134,7 @@ def test_skill_starts_are_four_deterministic_poses_above_the_hole(name: str) -> 
     dirs = np.array([np.arctan2(*t.hole2world.inverse().compose(s).pos[1::-1]) for s in a])
     if t.params.start_offset > 0:  # spread evenly: four different starts
         assert len({round(float(d), 6) for d in dirs}) == 4
-    c = t.skill_starts(np.random.default_rng(8))
+    c = t.protocol.skill_starts(np.random.default_rng(8))
     assert not np.allclose(a[0].pos, c[0].pos) or t.params.start_offset == 0
 
 
@@ -142,19 +142,19 @@ def test_skill_starts_are_four_deterministic_poses_above_the_hole(name: str) -> 
 def test_estimated_hole_has_the_taught_error(name: str) -> None:
     t = get_task(name)
     rng = np.random.default_rng(0)
-    est = [t.estimated_hole(rng) for _ in range(400)]
+    est = [t.protocol.estimated_hole(rng) for _ in range(400)]
     dxy = np.array([e.pos[:2] - t.hole2world.pos[:2] for e in est])
     assert np.std(dxy) == pytest.approx(t.params.hole_pos_sigma, rel=0.15)
     assert all(e.pos[2] == pytest.approx(t.surface_z) for e in est)
     yaw = np.array([e.rz - t.hole2world.rz for e in est])
     assert np.std(yaw) == pytest.approx(t.params.hole_yaw_sigma, rel=0.15, abs=1e-12)
-    exact = t.estimated_hole(rng, pos_sigma=0.0, yaw_sigma=0.0)
+    exact = t.protocol.estimated_hole(rng, pos_sigma=0.0, yaw_sigma=0.0)
     np.testing.assert_allclose(exact.pos, t.hole2world.pos)
-    around = t.skill_starts(np.random.default_rng(1), around=est[0])
+    around = t.protocol.skill_starts(np.random.default_rng(1), around=est[0])
     rel = est[0].inverse().compose(around[0])
     assert np.hypot(*rel.pos[:2]) == pytest.approx(t.params.start_offset)
     with pytest.raises(TaskError, match="sigma"):
-        t.estimated_hole(rng, pos_sigma=-1.0)
+        t.protocol.estimated_hole(rng, pos_sigma=-1.0)
 
 
 @pytest.mark.parametrize("name", SEED_B_TASKS)
@@ -163,20 +163,20 @@ def test_starts_are_free_of_the_fixture_and_teacher_starts_on_it(name: str) -> N
     model = mujoco.MjModel.from_xml_string(build_scene(t))
     data = mujoco.MjData(model)
     rng = np.random.default_rng(2)
-    for s in t.protocol_starts("skill", 4, rng):
+    for s in t.protocol.protocol_starts("skill", 4, rng):
         data.qpos[:3], data.qpos[3:7] = s.pos, s.quat
         mujoco.mj_forward(model, data)
         assert data.ncon == 0
-    for s in t.protocol_starts("teacher", 5, rng):
+    for s in t.protocol.protocol_starts("teacher", 5, rng):
         assert s.pos[2] == pytest.approx(t.surface_z)
         assert t.lateral_error(s) == pytest.approx(t.params.demo_offset)
         data.qpos[:3], data.qpos[3:7] = s.pos + [0, 0, 1e-5], s.quat
         mujoco.mj_forward(model, data)
         assert data.ncon == 0
     with pytest.raises(TaskError, match="skill, teacher"):
-        t.protocol_starts("table1", 4, rng)
+        t.protocol.protocol_starts("table1", 4, rng)
     with pytest.raises(TaskError, match="positive"):
-        t.protocol_starts("skill", 0, rng)
+        t.protocol.protocol_starts("skill", 0, rng)
 
 
 @pytest.mark.parametrize("name", SEED_B_TASKS)
@@ -184,12 +184,12 @@ def test_search_pose_and_registry(name: str) -> None:
     t = get_task(name)
     frame = Pose.from_xyz_rz(0.001, 0.0, t.surface_z, 0.3)
     state = np.array([0.001, 0.0, 0.2][: len(t.search_dims)])
-    pose = t.search_pose(state, frame, height=0.001)
+    pose = t.protocol.search_pose(state, frame, height=0.001)
     assert pose.pos[2] == pytest.approx(t.surface_z + 0.001)
     assert pose.rz == pytest.approx(0.5 if t.has_rz else 0.3)
     with pytest.raises(TaskError, match="search states"):
-        t.search_pose(np.zeros(5), frame)
-    assert t.contact.friction == t.params.friction
+        t.protocol.search_pose(np.zeros(5), frame)
+    assert t.scene.contact.friction == t.params.friction
     assert (
         t.success_depth
         < t.hole_depth

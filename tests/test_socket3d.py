@@ -12,7 +12,7 @@ from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Socket3D, Socket3DParams, get_task
-from teachfit.tasks.socket_geometry import valley_wedge
+from teachfit.tasks.scene.socket_pieces import valley_wedge
 
 STIFF = [300, 300, 300, 50, 50, 50]
 
@@ -96,19 +96,19 @@ def test_ground_truth_inserted_needs_both_pins(task: Socket3D) -> None:
 
 def test_search_pose_composes_rz(task: Socket3D) -> None:
     frame = Pose.from_xyz_rz(0.001, 0.002, task.surface_z, 0.3)
-    pose = task.search_pose(np.array([0.001, 0.0, 0.2]), frame, height=0.001)
+    pose = task.protocol.search_pose(np.array([0.001, 0.0, 0.2]), frame, height=0.001)
     assert pose.rz == pytest.approx(0.5)
     np.testing.assert_allclose(
         pose.pos, [0.001 + 0.001 * np.cos(0.3), 0.002 + 0.001 * np.sin(0.3), task.surface_z + 1e-3]
     )
     with pytest.raises(TaskError, match="x, y, rz"):
-        task.search_pose(np.zeros(2), frame)
+        task.protocol.search_pose(np.zeros(2), frame)
 
 
 @pytest.mark.parametrize("protocol", ["teacher", "table3"])
 def test_protocol_starts_inside_recess(task: Socket3D, protocol: str) -> None:
     p = task.params
-    starts = task.protocol_starts(protocol, 15, np.random.default_rng(3))
+    starts = task.protocol.protocol_starts(protocol, 15, np.random.default_rng(3))
     assert len(starts) == 15
     model = mujoco.MjModel.from_xml_string(build_scene(task))
     data = mujoco.MjData(model)
@@ -132,9 +132,9 @@ def test_protocol_starts_inside_recess(task: Socket3D, protocol: str) -> None:
 
 def test_bad_protocol(task: Socket3D) -> None:
     with pytest.raises(TaskError, match="table3"):
-        task.protocol_starts("table1", 3, np.random.default_rng(0))
+        task.protocol.protocol_starts("table1", 3, np.random.default_rng(0))
     with pytest.raises(TaskError, match="positive"):
-        task.protocol_starts("table3", 0, np.random.default_rng(0))
+        task.protocol.protocol_starts("table3", 0, np.random.default_rng(0))
 
 
 def test_flat_wedges_tile_the_square_minus_the_hole() -> None:

@@ -68,7 +68,7 @@ def run_quickstart(
     demo = demos[0]
     rng = np.random.default_rng(seed + 1)
     demo_start = Pose(demo.pos[0], demo.quat[0])
-    starts = task.protocol_starts("table1", n_starts, rng, demo_start)
+    starts = task.protocol.protocol_starts("table1", n_starts, rng, demo_start)
     robot = make_robot(robot_name, task, seed=seed)
     model = SearchModel.fit([demo], task.name)
     model_file = model.save(out / "search.model")

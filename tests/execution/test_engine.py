@@ -15,7 +15,7 @@ from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.skills import peg_in_hole
 from teachfit.skills.conditions import TimeAbove
-from teachfit.tasks.peg2d import Peg2D
+from teachfit.tasks import Peg2D
 
 ORDER = ["approach", "contact", "lateral", "align", "insert"]
 

@@ -128,7 +128,7 @@ def table1(
     overrides, demo, model = _peg_setup(seed, clearance)
     task = get_task("peg2d", **overrides)
     rng = np.random.default_rng(seed + 1)
-    starts = task.protocol_starts("table1", n_starts, rng, Pose(demo.pos[0], demo.quat[0]))
+    starts = task.protocol.protocol_starts("table1", n_starts, rng, Pose(demo.pos[0], demo.quat[0]))
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
     tshix = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds)
     iid = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds, sampling="random")
@@ -160,7 +160,7 @@ def table2(
     """
     overrides, demo, model = _peg_setup(seed, clearance)
     task = get_task("peg2d", **overrides)
-    start = task.protocol_starts(
+    start = task.protocol.protocol_starts(
         "table2", 1, np.random.default_rng(seed), Pose(demo.pos[0], demo.quat[0])
     )[0]
     starts = [start] * n_traj
@@ -222,7 +222,7 @@ def table3(
     one = SearchModel.fit(demos[:1], task.name)
     two = SearchModel.fit(demos, task.name)
     two_diag = SearchModel.fit(demos, task.name, covariance="diag")
-    starts = task.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
+    starts = task.protocol.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
     t1 = _jobs("socket3d", {}, one, starts, "tshix", n_points, seeds)
     t2 = _jobs("socket3d", {}, two, starts, "tshix", n_points, seeds)

@@ -156,7 +156,7 @@ def run(
             "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
             "the hole; without --demo a nominal demonstration start is assumed"
         )
-    start_poses = the_task.protocol_starts(protocol, starts, rng, demo_start)
+    start_poses = the_task.protocol.protocol_starts(protocol, starts, rng, demo_start)
     the_robot = make_robot(robot, the_task, seed=seed)
     fixed = plan_search(model, method, n, rng) if method.startswith("ergodic") else None
     if passes > 1 and method != "tshix":
@@ -229,7 +229,7 @@ def figures(
     protocol = (
         "table1" if task.name == "peg2d" else "table3" if task.name == "socket3d" else "teacher"
     )
-    start = task.protocol_starts(protocol, 1, np.random.default_rng(seed))[0]
+    start = task.protocol.protocol_starts(protocol, 1, np.random.default_rng(seed))[0]
     run = run_search(make_robot(robot, task, seed=seed), task, model, start, traj)
     executed = run.result.log.pos[:, :2] - start.pos[:2]
     fig = sf.planned_vs_executed(traj.states[:, :2], executed)

@@ -177,7 +177,7 @@ class BlindTeacher:
     def demonstrate(self, start: Pose | None = None) -> tuple[Demonstration | None, str]:
         """One attempt. Returns ``(demo, "ok")`` or ``(None, why it was discarded)``."""
         st = self.style
-        start = start or self.task.teacher_start(self.rng)
+        start = start or self.task.protocol.teacher_start(self.rng)
         cfg = FollowConfig(
             stiffness_along=st.arm_stiffness,
             stiffness_across=st.arm_stiffness,

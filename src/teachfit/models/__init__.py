@@ -3,7 +3,6 @@
 from teachfit.models.dynamics import DynamicsModel, fit_dynamics
 from teachfit.models.exploration import ExplorationDistribution, fit_exploration
 from teachfit.models.search_data import (
-    TASK_DIMS,
     DemoArrays,
     SearchData,
     dims_for_task,
@@ -12,7 +11,6 @@ from teachfit.models.search_data import (
 from teachfit.models.search_model import SearchModel
 
 __all__ = [
-    "TASK_DIMS",
     "DemoArrays",
     "DynamicsModel",
     "ExplorationDistribution",

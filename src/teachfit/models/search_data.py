@@ -1,10 +1,11 @@
 """Demonstrations -> search states and (step, action wrench) pairs, in the search frame.
 
 The *search state* ``s`` of a demonstration sample is its pose relative to the first pose of
-that demonstration, restricted to the search degrees of freedom of the task:
+that demonstration, restricted to the search degrees of freedom of the task (its
+``search_dims``, :func:`teachfit.tasks.registry.search_dims_of`), e.g.:
 
-* ``peg2d``:   ``s = (x, y)``            (m)
-* ``socket3d``: ``s = (x, y, rz)``       (m, m, rad; ``rz`` = rotation about z, unwrapped)
+* ``peg2d``, ``peg``:   ``s = (x, y)``                 (m)
+* ``socket3d``, ``puzzle``, ``key``: ``s = (x, y, rz)``  (m, m, rad; ``rz`` about z, unwrapped)
 
 The *action* is the wrench the teacher applied, i.e. minus the wrench the environment exerted on
 the tool, restricted to the same DOFs: ``a = -(fx, fy)`` (N) or ``a = -(fx, fy, tz)`` (N, N m).
@@ -23,19 +24,19 @@ from typing import Any
 
 import numpy as np
 
-from teachfit.core.errors import ModelError
+from teachfit.core.errors import ModelError, TaskError
+from teachfit.tasks.registry import search_dims_of
 
-TASK_DIMS: dict[str, tuple[str, ...]] = {"peg2d": ("x", "y"), "socket3d": ("x", "y", "rz")}
 _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rx": 3, "ry": 4, "rz": 5}
 _POS_INDEX = {"x": 0, "y": 1, "z": 2}
 
 
 def dims_for_task(task: str) -> tuple[str, ...]:
-    """Search DOFs of a task: ``("x", "y")`` for peg2d, ``("x", "y", "rz")`` for socket3d."""
+    """Search DOFs of the built-in task ``task`` (its ``search_dims``); ModelError if unknown."""
     try:
-        return TASK_DIMS[task]
-    except KeyError:
-        raise ModelError(f"unknown task {task!r}; known: {sorted(TASK_DIMS)}") from None
+        return search_dims_of(task)
+    except TaskError as exc:
+        raise ModelError(str(exc)) from None
 
 
 def validate_dims(dims: Sequence[str]) -> tuple[str, ...]:

@@ -20,8 +20,8 @@ from teachfit.core.control import ControllerSpec, FixedGainSpec
 from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
-from teachfit.tasks.base import ContactParams, Task
-from teachfit.tasks.mjcf import SceneXml, fmt
+from teachfit.tasks.base import Task
+from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
 
 
 @dataclass(frozen=True)
@@ -61,7 +61,7 @@ class FloatingToolParams:
 def build_scene(task: Task, params: FloatingToolParams | None = None) -> str:
     """MJCF of ``task``'s cell with a floating tool holding the task's part."""
     params = params or FloatingToolParams()
-    contact = getattr(task, "contact", None) or params.contact
+    contact = getattr(task.scene, "contact", None) or params.contact
     scene = SceneXml(model=f"teachfit-{task.name}", timestep=params.timestep)
     scene.option.set("noslip_iterations", "0")
     ET.SubElement(
@@ -80,8 +80,8 @@ def build_scene(task: Task, params: FloatingToolParams | None = None) -> str:
         contype="0",
         conaffinity="0",
     )
-    task.add_fixture(scene, contact)
-    length = task.held_part_length
+    task.scene.add_fixture(scene, contact)
+    length = task.scene.held_part_length
     start = task.contact_pose([0.05, 0.0]).translated([0, 0, 0.02])
     tool = ET.SubElement(scene.worldbody, "body", name="tool", pos=fmt(start.pos), gravcomp="1")
     ET.SubElement(tool, "freejoint", name="tool_free")
@@ -106,7 +106,7 @@ def build_scene(task: Task, params: FloatingToolParams | None = None) -> str:
         mass="0",
     )
     part = ET.SubElement(tool, "body", name="held_part", gravcomp="1")
-    task.add_held_part(part, scene, contact)
+    task.scene.add_held_part(part, scene, contact)
     ET.SubElement(part, "site", name="ft_site", pos=fmt([0, 0, length]), size="0.003")
     ET.SubElement(scene.sensor, "force", name="ft_force", site="ft_site")
     ET.SubElement(scene.sensor, "torque", name="ft_torque", site="ft_site")

@@ -34,7 +34,7 @@ def _pressed_robot(task: Task, name: str) -> tuple[object, ImpedanceCommand]:
     robot = make_robot(name, task)
     if not (hasattr(robot, "model") and hasattr(robot, "data")):
         raise TeachfitError(f"robot {name!r} is not simulated in MuJoCo: no simulation speed")
-    start = task.teacher_start(np.random.default_rng(0))
+    start = task.protocol.teacher_start(np.random.default_rng(0))
     robot.reset(start)
     cmd = ImpedanceCommand(
         pos=start.pos,

@@ -220,7 +220,7 @@ HOLE_ERROR = (0.0007, 0.0002, 0.02)
 def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
     """The task's ``estimated_hole(rng)`` if it has one, else the true hole pose with Gaussian
     error :data:`HOLE_ERROR` (yaw error only for parts whose yaw matters)."""
-    est = getattr(task, "estimated_hole", None)
+    est = getattr(task.protocol, "estimated_hole", None)
     if callable(est):
         pose = est(rng)
         if not isinstance(pose, Pose):
@@ -262,10 +262,10 @@ def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:
     (``skill_starts(rng)``, four, or its ``"skill"`` protocol for other ``n``) if it has them,
     else 25 mm above the surface at +-4 mm around the true hole (corners of a square, 1 mm
     jitter), yaw jitter +-0.05 rad where the yaw matters."""
-    own = getattr(task, "skill_starts", None)
+    own = getattr(task.protocol, "skill_starts", None)
     if callable(own):
         starts = list(own(rng))
-        return starts if len(starts) == n else task.protocol_starts("skill", n, rng)
+        return starts if len(starts) == n else task.protocol.protocol_starts("skill", n, rng)
     hole = task.hole2world
     yaw_matters = "rz" in getattr(task, "search_dims", ()) or getattr(task, "rz_period", 0) > 0
     out = []

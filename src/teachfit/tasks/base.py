@@ -1,56 +1,55 @@
-"""What every simulated assembly task provides.
+"""What every simulated assembly task is: parameters, geometry and the success test.
 
-A task is a frozen parameter dataclass (lengths in metres) plus the scene it generates. The
+A task is a frozen parameter dataclass (lengths in metres) plus the cell it describes. The
 world frame has z up; the fixture's top surface is at ``surface_z``; the *hole frame* sits at
 the centre of the (first) hole on that surface, z up. The *tool centre point* (TCP) is the
 lowest point of the held part on its axis (peg tip, pin-tip midpoint), so a TCP at
 ``hole2world`` means the part is aligned and just touching the entry.
+
+A :class:`Task` holds its geometry and success test itself (concern of the subclasses in
+:mod:`teachfit.tasks.geometry`) and reaches the two other concerns through attributes:
+:attr:`Task.scene` (MuJoCo bodies, :mod:`teachfit.tasks.scene`) and :attr:`Task.protocol`
+(search poses and the papers' start poses, :mod:`teachfit.tasks.protocols`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import tomllib
-import xml.etree.ElementTree as ET
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, ClassVar, Self
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
-from teachfit.tasks.mjcf import SceneXml
 
-
-@dataclasses.dataclass(frozen=True)
-class ContactParams:
-    """Contact model shared by the fixture and the held part.
-
-    ``solref``/``solimp`` make contacts stiff enough for sub-millimetre clearances at a 1 ms
-    step (MuJoCo needs ``solref[0] >= 2 * timestep``). ``friction`` is the sliding coefficient.
-    """
-
-    friction: float = 0.3
-    solref: tuple[float, float] = (0.002, 1.0)
-    solimp: tuple[float, float, float] = (0.95, 0.99, 0.0005)
-    margin: float = 0.0
+if TYPE_CHECKING:
+    from teachfit.tasks.protocols.base import Protocol
+    from teachfit.tasks.scene.builder import SceneBuilder
 
 
 class Task(ABC):
-    """A tight-fit assembly cell: fixture geometry, held part, ground truth and protocols."""
+    """A tight-fit assembly cell: geometry and success test; scene and protocols attached."""
 
     name: ClassVar[str]
     description: ClassVar[str]
     #: names of the searched degrees of freedom, e.g. ("x", "y") or ("x", "y", "rz")
     search_dims: ClassVar[tuple[str, ...]]
     params_type: ClassVar[type]
+    scene_type: ClassVar[type[SceneBuilder]]
+    protocol_type: ClassVar[type[Protocol]]
 
     def __init__(self, params: Any | None = None) -> None:
         self.params = self.params_type() if params is None else params
         if not isinstance(self.params, self.params_type):
             raise TaskError(f"{self.name} needs {self.params_type.__name__}, got {params!r}")
+        #: the cell's MuJoCo bodies (fixture and held part)
+        self.scene: SceneBuilder = self.scene_type(self)
+        #: the cell's search poses and start protocols
+        self.protocol: Protocol = self.protocol_type(self)
 
     # ----------------------------------------------------------------------------- geometry
     @property
@@ -59,29 +58,31 @@ class Task(ABC):
         """Height of the surface the part slides on before it enters (m, world)."""
 
     @property
-    @abstractmethod
     def hole2world(self) -> Pose:
-        """Ground-truth pose of the hole frame (entry centre, z up) in the world."""
+        """Ground-truth pose of the hole frame (entry centre, z up) in the world; by default on
+        the world z axis, unturned, with the entry at :attr:`surface_z`."""
+        return Pose(np.array([0.0, 0.0, self.surface_z]))
 
     @property
-    @abstractmethod
     def success_depth(self) -> float:
         """Depth below the entry (m) the TCP must pass for the insertion to count."""
-
-    @abstractmethod
-    def add_fixture(self, scene: SceneXml, contact: ContactParams) -> None:
-        """Add the fixed parts (with the hole) to ``scene.worldbody``."""
-
-    @abstractmethod
-    def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
-        """Add the held part's geoms to ``body`` whose frame is the TCP (part axis along +z)."""
+        return float(self.params.success_depth)
 
     @property
-    @abstractmethod
-    def held_part_length(self) -> float:
-        """Height of the held part above the TCP (m): where the wrist F/T sensor sits."""
+    def capture_radius(self) -> float:
+        """Lateral TCP offset (m) beyond which the part cannot be inside the hole: the
+        clearance plus 0.1 mm of soft-contact give."""
+        return float(self.params.clearance) + 1e-4
 
-    # ----------------------------------------------------------------------- ground truth
+    @property
+    def has_rz(self) -> bool:
+        """Whether the yaw about z is searched (and must match the hole's)."""
+        return "rz" in self.search_dims
+
+    def contact_pose(self, xy: np.ndarray, rz: float = 0.0) -> Pose:
+        """TCP pose resting on the surface at world ``xy`` (m) with yaw ``rz`` (rad)."""
+        return Pose.from_xyz_rz(float(xy[0]), float(xy[1]), self.surface_z, rz)
+
     def insertion_depth(self, tool2world: Pose) -> float:
         """How far the TCP is below the hole entry along the hole axis (m, positive inside)."""
         rel = self.hole2world.inverse().compose(tool2world)
@@ -92,6 +93,7 @@ class Task(ABC):
         rel = self.hole2world.inverse().compose(tool2world)
         return float(np.hypot(rel.pos[0], rel.pos[1]))
 
+    # ------------------------------------------------------------------------ success test
     def ground_truth_inserted(self, tool2world: Pose) -> bool:
         """Simulator ground truth (benchmarks only): the TCP is deeper than
         :attr:`success_depth` below the *true* hole entry and on the true hole axis."""
@@ -101,45 +103,30 @@ class Task(ABC):
         )
 
     @property
+    def nominal_hole2world(self) -> Pose:
+        """The hole frame as the cell's drawing gives it (world); the simulated cell is built
+        exactly to its drawing, so this is :attr:`hole2world`."""
+        return self.hole2world
+
+    @property
     def entry_height(self) -> float:
         """Nominal height of the hole entry (m, world z): what the cell's drawing says."""
-        return float(self.hole2world.pos[2])
+        return float(self.nominal_hole2world.pos[2])
+
+    @property
+    @abstractmethod
+    def detection_radius(self) -> float:
+        """Lateral TCP distance (m) from the nominal hole axis within which the held part
+        stands wholly over the fixture's top, whose only opening is the hole: there, a TCP
+        below the entry is in the hole. Beyond it the part may go down beside the fixture."""
 
     def detect_success(self, tool2world: Pose) -> bool:
-        """The success detector, from what a robot measures: its TCP is at least
-        :attr:`success_depth` below the nominal entry height. Nothing but a hole lets the part
-        that low, so no knowledge of where the hole is is needed."""
-        return self.entry_height - float(tool2world.pos[2]) >= self.success_depth
-
-    @property
-    def contact(self) -> ContactParams:
-        """Contact model of this cell; a ``friction`` task parameter sets the coefficient."""
-        friction = getattr(self.params, "friction", None)
-        return ContactParams() if friction is None else ContactParams(friction=float(friction))
-
-    @property
-    def capture_radius(self) -> float:
-        """Lateral TCP offset (m) beyond which the part cannot be inside the hole."""
-        return 0.005
-
-    # --------------------------------------------------------------------------- protocols
-    @abstractmethod
-    def search_pose(self, state: np.ndarray, search2world: Pose, height: float = 0.0) -> Pose:
-        """Tool pose for a search state (``search_dims``) given the search frame."""
-
-    def contact_pose(self, xy: np.ndarray, rz: float = 0.0) -> Pose:
-        """TCP pose resting on the surface at world ``xy`` with yaw ``rz``."""
-        return Pose.from_xyz_rz(float(xy[0]), float(xy[1]), self.surface_z, rz)
-
-    @abstractmethod
-    def teacher_start(self, rng: np.random.Generator) -> Pose:
-        """A worst-case start for a blind demonstration (on the surface, off the hole)."""
-
-    @abstractmethod
-    def protocol_starts(
-        self, protocol: str, n: int, rng: np.random.Generator, demo_start: Pose | None = None
-    ) -> list[Pose]:
-        """Start poses for a paper protocol (``"table1"``, ``"table3"``, ...)."""
+        """The success detector, from what a robot measures (its TCP pose, world) and what the
+        cell's drawing says: the TCP is at least :attr:`success_depth` below the nominal entry
+        height and within :attr:`detection_radius` of the nominal hole axis."""
+        rel = self.nominal_hole2world.inverse().compose(tool2world)
+        deep = self.entry_height - float(tool2world.pos[2]) >= self.success_depth
+        return deep and float(np.hypot(rel.pos[0], rel.pos[1])) <= float(self.detection_radius)
 
     # ------------------------------------------------------------------------------- I/O
     @classmethod

@@ -1,4 +1,4 @@
-"""Built-in tasks by name, and loading a task from a name or a TOML file."""
+"""Built-in tasks by name, their search dimensions, and loading a task from a name or a file."""
 
 from __future__ import annotations
 
@@ -6,15 +6,23 @@ from pathlib import Path
 
 from teachfit.core.errors import TaskError
 from teachfit.tasks.base import Task
-from teachfit.tasks.key import Key
-from teachfit.tasks.peg import AluminiumPeg
-from teachfit.tasks.peg2d import Peg2D
-from teachfit.tasks.puzzle import Puzzle
-from teachfit.tasks.socket3d import Socket3D
+from teachfit.tasks.geometry.key import Key
+from teachfit.tasks.geometry.peg import AluminiumPeg
+from teachfit.tasks.geometry.peg2d import Peg2D
+from teachfit.tasks.geometry.puzzle import Puzzle
+from teachfit.tasks.geometry.socket3d import Socket3D
 
 TASKS: dict[str, type[Task]] = {
     cls.name: cls for cls in (Peg2D, Socket3D, Puzzle, Key, AluminiumPeg)
 }
+
+
+def search_dims_of(name: str) -> tuple[str, ...]:
+    """Searched degrees of freedom of the built-in task ``name``, e.g. ``("x", "y", "rz")``."""
+    try:
+        return TASKS[name].search_dims
+    except KeyError:
+        raise TaskError(f"unknown task {name!r}; built-in tasks: {sorted(TASKS)}") from None
 
 
 def get_task(name: str, **overrides: object) -> Task:

@@ -1,20 +1,31 @@
-"""Small builders for MuJoCo MJCF scenes made of convex pieces.
+"""Small builders for MuJoCo MJCF scenes made of convex pieces, and the contact model.
 
 MuJoCo collides every mesh as its convex hull, so a part with a hole is assembled from many
 convex pieces. The builders here return vertex arrays of such pieces; :class:`SceneXml` collects
-assets, bodies and geoms into an MJCF document (``xml.etree`` keeps the output valid XML).
+assets, bodies and geoms into an MJCF document (``xml.etree`` keeps the output valid XML);
+:class:`ContactParams` and :func:`contact_attrs` give every geom the same contact model.
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from teachfit.tasks.base import ContactParams
+
+@dataclass(frozen=True)
+class ContactParams:
+    """Contact model shared by the fixture and the held part.
+
+    ``solref``/``solimp`` make contacts stiff enough for sub-millimetre clearances at a 1 ms
+    step (MuJoCo needs ``solref[0] >= 2 * timestep``). ``friction`` is the sliding coefficient.
+    """
+
+    friction: float = 0.3
+    solref: tuple[float, float] = (0.002, 1.0)
+    solimp: tuple[float, float, float] = (0.95, 0.99, 0.0005)
+    margin: float = 0.0
 
 
 def fmt(values: np.ndarray | list[float] | tuple[float, ...] | float) -> str:

@@ -40,7 +40,7 @@ def valley_wedge(
     The wedge lies between the rays at ``angle0 < angle1`` (rad, about ``centre``, spanning less
     than pi) and inside the square of half-width ``half_width`` centred on the hole. Its inner
     boundary is the chord perpendicular to the bisector at distance ``r_hole`` from the centre
-    (as :func:`~teachfit.tasks.mjcf.ring_sector` does), so ``K`` wedges leave a polygonal hole
+    (as :func:`~teachfit.tasks.scene.mjcf.ring_sector` does), so ``K`` wedges leave a polygonal hole
     that is never narrower than the circle of radius ``r_hole``.
 
     The top surface, with ``d`` the distance from the centre measured along the bisector, is

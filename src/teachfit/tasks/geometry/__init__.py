@@ -1,0 +1,1 @@
+"""Task geometry and success tests: each cell's parameters, hole frame and ground truth."""

@@ -1,0 +1,131 @@
+"""``key``: a flat key blade into a narrow chamfered slot (seed B).
+
+Seed B's second task: a key whose tip and keyhole are chamfered, which makes the first entry
+easy; the hole is so small that the paper applied no deliberate start deviation. The paper's
+numbers are lost in the extracted text, so the defaults are plausible ones: a 7 mm x 2 mm
+blade 30 mm long with 0.5 mm tip chamfers, a slot 0.3 mm wider in both directions, 20 mm deep,
+with 0.8 mm entry chamfers, in a 40 mm square lock face.
+
+Geometry (:mod:`teachfit.tasks.geometry.prism_hole`). The slot is a rectangle
+``blade_width + clearance`` (along the hole frame's x) by ``blade_thickness + clearance``
+(along y) with a 45-degree chamfer of ``slot_chamfer`` along each entry edge. The held part is
+the blade (its tip chamfered by ``blade_chamfer`` on all four edges) under a wider bow that
+stays above the lock face.
+
+Frames. The hole frame (:attr:`hole2world`) is the centre of the slot at the lock face (the
+top of its chamfers), z up, turned by ``hole_yaw``. The TCP is the centre of the blade's tip
+face, the blade's width along its x. The blade is 2-fold symmetric: :attr:`rz_period` is pi.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from teachfit.tasks.geometry.prism_hole import PrismHoleParams, PrismHoleTask
+from teachfit.tasks.params import doc_field
+from teachfit.tasks.scene.prism_hole import KeyScene
+
+
+@dataclass(frozen=True)
+class KeyParams(PrismHoleParams):
+    """Parameters of :class:`Key`; every length in metres, angles in radians."""
+
+    task_name: ClassVar[str] = "key"
+    depth_field: ClassVar[str] = "slot_depth"
+    hole_word: ClassVar[str] = "slot"
+    face_word: ClassVar[str] = "lock face"
+    min_rim: ClassVar[float] = 0.003
+
+    blade_width: float = doc_field(
+        "width of the key blade, along the hole frame's x (m)", 0.007, above=0
+    )
+    blade_thickness: float = doc_field("thickness of the blade, along y (m)", 0.002, above=0)
+    blade_length: float = doc_field("length of the blade below the bow (m)", 0.030, above=0)
+    blade_chamfer: float = doc_field(
+        "45-degree chamfer on the blade tip's edges (m)", 0.0005, at_least=0
+    )
+    clearance: float = doc_field(
+        "slot size minus blade size, in width and thickness (m)", 0.0003, above=0
+    )
+    slot_depth: float = doc_field("depth of the slot below the lock face (m)", 0.020, above=0)
+    slot_chamfer: float = doc_field(
+        "45-degree chamfer on the slot's entry edges (m)", 0.0008, at_least=0
+    )
+    bow_width: float = doc_field("width of the key bow above the blade (m)", 0.020, above=0)
+    bow_thickness: float = doc_field("thickness of the bow (m)", 0.003, above=0)
+    bow_height: float = doc_field("height of the bow (m)", 0.015, above=0)
+    block_half_width: float = doc_field("half side of the square lock face (m)", 0.020, above=0)
+    success_depth: float = doc_field("insertion depth that counts as success (m)", 0.012, above=0)
+    start_offset: float = doc_field(
+        "lateral offset of the skill starts from the hole (m)", 0.0005, at_least=0
+    )
+    hole_pos_sigma: float = doc_field(
+        "std of the taught hole position, per axis (m)", 0.0003, at_least=0
+    )
+    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0087, at_least=0)
+    demo_offset: float = doc_field(
+        "distance of the blind teacher's start from the hole (m)", 0.008, above=0
+    )
+
+    def check(self) -> None:
+        self.require(
+            self.blade_thickness < self.blade_width,
+            "blade_thickness must be smaller than blade_width (a flat blade)",
+        )
+        self.require(
+            self.clearance < self.blade_thickness,
+            f"clearance {self.clearance} must be smaller than blade_thickness "
+            f"({self.blade_thickness}): that is no tight fit",
+        )
+        self.require(
+            self.blade_chamfer < self.blade_thickness / 2,
+            "blade_chamfer must be smaller than half the blade thickness",
+        )
+        super().check()
+        self.require(
+            self.slot_chamfer < self.slot_depth, "slot_chamfer must be smaller than slot_depth"
+        )
+        self.require(
+            self.blade_length >= self.slot_depth + 0.001,
+            "blade_length must exceed slot_depth by >= 1 mm (the bow stays above the lock face)",
+        )
+        self.require(
+            self.bow_width >= self.blade_width and self.bow_thickness >= self.blade_thickness,
+            "the bow must be at least as wide and thick as the blade",
+        )
+
+    @property
+    def hole_reach(self) -> float:
+        """Half width of the slot's entry along x, chamfer included (m)."""
+        return (self.blade_width + self.clearance) / 2 + self.slot_chamfer
+
+    @property
+    def part_radius(self) -> float:
+        """Distance of the blade tip's corners from its centre (m)."""
+        return float(np.hypot(self.blade_width, self.blade_thickness)) / 2
+
+
+class Key(PrismHoleTask):
+    """Flat key blade into a narrow chamfered slot; search in x, y and rz."""
+
+    name = "key"
+    description = "flat key blade into a narrow chamfered slot; search x-y-rz (seed B)"
+    params_type = KeyParams
+    scene_type = KeyScene
+    params: KeyParams
+    #: the blade is 2-fold symmetric: it inserts at rz and rz + pi (rad)
+    rz_period: ClassVar[float] = float(np.pi)
+
+    @property
+    def yaw_lever(self) -> float:
+        p = self.params
+        return p.blade_width + p.blade_thickness
+
+    @property
+    def slot_half_size(self) -> tuple[float, float]:
+        """Half width (x) and half thickness (y) of the slot below its chamfers (m)."""
+        p = self.params
+        return (p.blade_width + p.clearance) / 2, (p.blade_thickness + p.clearance) / 2

@@ -1,0 +1,1 @@
+"""Experiment protocols: each cell's search poses and the papers' start poses."""

@@ -1,0 +1,117 @@
+"""Scenes of the prism-hole cells: ``puzzle`` (a triangle) and ``key`` (a slot).
+
+Both cut a convex polygonal hole into a square block (half side ``block_half_width``, top at
+``block_height``, world z) turned by ``hole_yaw`` about world z. The hole is built from one
+convex piece per hole edge, the part of the block beyond that edge's line
+(:func:`~teachfit.tasks.scene.prisms.beyond_edge_block`, optionally chamfered), plus a box
+below the hole's bottom. The held part is a prism whose bottom-face centre is the TCP. Lengths
+in metres, angles in radians, the fixture's body frame is the hole frame at the block's foot.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from abc import abstractmethod
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from teachfit.tasks.scene.builder import SceneBuilder, add_geom, add_mesh_geom, fixture_body
+from teachfit.tasks.scene.mjcf import ContactParams, SceneXml
+from teachfit.tasks.scene.prisms import (
+    beyond_edge_block,
+    chamfered_prism,
+    edge_normals,
+    rectangle,
+    regular_polygon,
+)
+
+if TYPE_CHECKING:
+    from teachfit.tasks.geometry.key import Key
+    from teachfit.tasks.geometry.prism_hole import PrismHoleTask
+    from teachfit.tasks.geometry.puzzle import Puzzle
+
+#: edge normals of the puzzle's triangle at 60, 180, 300 degrees: a vertex on +x
+TRIANGLE_PHASE = np.pi / 3
+
+
+class PrismHoleScene(SceneBuilder):
+    """A block with a convex polygonal hole of :meth:`hole_edges`; subclasses add the part."""
+
+    task: PrismHoleTask
+
+    @abstractmethod
+    def hole_edges(self) -> list[tuple[str, np.ndarray, float]]:
+        """``(geom name, outward unit normal (2,), distance from the hole centre (m))`` per edge
+        of the hole, in the hole frame."""
+
+    @property
+    @abstractmethod
+    def hole_chamfer(self) -> float:
+        """45-degree chamfer along the hole's entry edges (m)."""
+
+    def add_fixture(self, scene: SceneXml, contact: ContactParams) -> None:
+        p = self.task.params
+        top = p.block_height
+        z_bot = top - self.task.hole_depth
+        block = fixture_body(scene, p.hole_yaw)
+        half = [p.block_half_width, p.block_half_width, z_bot / 2]
+        add_geom(block, "fixture_base", contact, type="box", size=half, pos=[0, 0, z_bot / 2])
+        outline = rectangle(p.block_half_width, p.block_half_width)
+        for name, normal, offset in self.hole_edges():
+            verts = beyond_edge_block(outline, normal, offset, z_bot, top, self.hole_chamfer)
+            add_mesh_geom(block, scene, name, verts, contact)
+
+
+class PuzzleScene(PrismHoleScene):
+    """``puzzle``: an equilateral triangular hole, no chamfer by default; a triangular piece."""
+
+    task: Puzzle
+
+    @property
+    def held_part_length(self) -> float:
+        return self.task.params.piece_height
+
+    @property
+    def hole_chamfer(self) -> float:
+        return self.task.params.hole_chamfer
+
+    def hole_edges(self) -> list[tuple[str, np.ndarray, float]]:
+        inradius = self.task.params.hole_inradius
+        normals = edge_normals(3, TRIANGLE_PHASE)
+        return [(f"hole_wall_{i}", n, inradius) for i, n in enumerate(normals)]
+
+    def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
+        p = self.task.params
+        tri = regular_polygon(3, p.piece_inradius, TRIANGLE_PHASE)
+        piece = chamfered_prism(tri, p.piece_height)
+        add_mesh_geom(body, scene, "puzzle_piece", piece, contact, "tool", mass="0.05")
+
+
+class KeyScene(PrismHoleScene):
+    """``key``: a rectangular chamfered slot; a chamfered flat blade under a wider bow."""
+
+    task: Key
+
+    @property
+    def held_part_length(self) -> float:
+        return self.task.params.blade_length + self.task.params.bow_height
+
+    @property
+    def hole_chamfer(self) -> float:
+        return self.task.params.slot_chamfer
+
+    def hole_edges(self) -> list[tuple[str, np.ndarray, float]]:
+        hx, hy = self.task.slot_half_size
+        sides = {"east": (1.0, 0.0, hx), "west": (-1.0, 0.0, hx)}
+        sides |= {"north": (0.0, 1.0, hy), "south": (0.0, -1.0, hy)}
+        return [(f"slot_wall_{s}", np.array([a, b]), d) for s, (a, b, d) in sides.items()]
+
+    def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
+        p = self.task.params
+        blade = rectangle(p.blade_width / 2, p.blade_thickness / 2)
+        verts = chamfered_prism(blade, p.blade_length, p.blade_chamfer)
+        add_mesh_geom(body, scene, "key_blade", verts, contact, "tool", mass="0.005")
+        bow = [p.bow_width / 2, p.bow_thickness / 2, p.bow_height / 2]
+        pos = [0, 0, p.blade_length + p.bow_height / 2]
+        add_geom(body, "key_bow", contact, "tool", type="box", size=bow, pos=pos, mass="0.01")
