@@ -15,7 +15,13 @@ from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.library import SKILLS, get_skill
 from teachfit.skills.loader import load_skill, skill_to_toml
 from teachfit.skills.metric import LearningMetric
-from teachfit.skills.params import ContextParam, LearnedParam, SkillParams, read_params_toml
+from teachfit.skills.params import (
+    ContextParam,
+    LearnedParam,
+    SkillParams,
+    read_params_toml,
+    write_params_toml,
+)
 from teachfit.skills.trial import SkillSetup, SkillTrial, TrialOutcome, peg_in_hole_setup
 
 __all__ = [
@@ -38,5 +44,6 @@ __all__ = [
     "load_skill",
     "peg_in_hole_setup",
     "read_params_toml",
+    "write_params_toml",
     "skill_to_toml",
 ]
