@@ -24,7 +24,7 @@ def _gl_context_error() -> str | None:
     return None
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def needs_gl() -> None:
     """Skip (with the reason) a test that renders with MuJoCo when no GL context exists."""
     error = _gl_context_error()
