@@ -25,8 +25,8 @@ from scipy.spatial.transform import Rotation
 from teachfit.capture.markers import Marker, MarkerSet, marker_image, write_markers
 from teachfit.capture.rig import Camera, Rig, write_rig
 from teachfit.capture.scene import Carrier, Quad, camera_K, look_at, scene_xml
-from teachfit.demonstrations.dataset import Demonstration, write_dataset
 from teachfit.core.errors import CaptureError, RenderError
+from teachfit.demonstrations.dataset import Demonstration, write_dataset
 from teachfit.plans.parts import Assembly, build_assembly, pose_from_xyz_rpy
 from teachfit.plans.synth import synth_demo
 

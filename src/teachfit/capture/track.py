@@ -21,8 +21,8 @@ from teachfit.capture.fuse import FusionConfig, fuse_part, relative_pose
 from teachfit.capture.markers import MarkerSet
 from teachfit.capture.rig import Rig
 from teachfit.capture.temporal import FilterConfig, PoseFilter
-from teachfit.demonstrations.dataset import Demonstration
 from teachfit.core.errors import CaptureError
+from teachfit.demonstrations.dataset import Demonstration
 
 __all__ = ["STATUS", "Track", "TrackConfig", "Tracker", "track_frames"]
 

@@ -14,8 +14,8 @@ import numpy as np
 from scipy.signal import butter, sosfiltfilt
 from scipy.spatial.transform import Rotation
 
-from teachfit.demonstrations.dataset import Demonstration
 from teachfit.core.errors import TaskError
+from teachfit.demonstrations.dataset import Demonstration
 from teachfit.plans.collision import CollisionChecker
 from teachfit.plans.parts import Assembly
 

@@ -7,7 +7,6 @@ explains what to set instead of failing deep inside MuJoCo.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -15,7 +14,6 @@ from pathlib import Path
 import imageio.v2 as imageio
 import numpy as np
 
-from teachfit.core.errors import RenderError
 from teachfit.robot.render import motion_frames
 from teachfit.tasks.base import Task
 
