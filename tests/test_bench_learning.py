@@ -65,33 +65,15 @@ def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
     read_png(path, min_px=300)
 
 
+def _bench(*args: str) -> object:
+    return CliRunner().invoke(app, ["bench", "learning", "--tasks", "key", "--no-target", *args])
+
+
 def test_bench_learning_cli_and_best_execution_figure(tmp_path: Path) -> None:
     md, fig = tmp_path / "bench.md", tmp_path / "curves.png"
-    res = CliRunner().invoke(
-        app,
-        [
-            "bench",
-            "learning",
-            "--tasks",
-            "key",
-            "--methods",
-            "lhs",
-            "--experiments",
-            "2",
-            "--trials",
-            "3",
-            "--starts",
-            "1",
-            "--workers",
-            "0",
-            "--no-target",
-            "--speedup-trials",
-            "0",
-            "--plot",
-            str(fig),
-            "--markdown",
-            str(md),
-        ],
+    res = _bench(
+        *("--methods", "lhs", "--experiments", "2", "--trials", "3", "--starts", "1"),
+        *("--workers", "0", "--speedup-trials", "0", "--plot", str(fig), "--markdown", str(md)),
     )
     assert res.exit_code == 0, res.output
     # the table written is the library's for the same settings, but for the wall-time columns
@@ -100,22 +82,7 @@ def test_bench_learning_cli_and_best_execution_figure(tmp_path: Path) -> None:
     want = next(ln for ln in expected.splitlines() if ln.startswith("| key | lhs |"))
     assert row.split(" | ")[:7] == want.split(" | ")[:7]
     read_png(fig, min_px=300)
-    res = CliRunner().invoke(
-        app,
-        [
-            "bench",
-            "learning",
-            "--tasks",
-            "key",
-            "--methods",
-            "sgd",
-            "--experiments",
-            "1",
-            "--trials",
-            "2",
-            "--no-target",
-        ],
-    )
+    res = _bench("--methods", "sgd", "--experiments", "1", "--trials", "2")
     assert res.exit_code == 2 and "unknown method(s) ['sgd']" in res.output
     obj = SkillObjective("key", n_starts=1)
     trace = obj.outcome(None).traces[0]

@@ -40,6 +40,13 @@ def _videos(clip, n=3):
     return [clip[f"video{i}"] for i in range(n)]
 
 
+def _capture_markers(clip, markers: Path, out: Path, *extra: str) -> object:
+    """``teachfit capture markers`` on the clip's three videos and rig."""
+    videos = ["--video", *map(str, _videos(clip)), "--rig", str(clip["rig"])]
+    args = ["capture", "markers", *videos, "--markers", str(markers), "--out", str(out)]
+    return CliRunner().invoke(app, [*args, *extra])
+
+
 def test_synth_writes_consistent_files(clip):
     rig, truth = read_rig(clip["rig"]), read_demo(clip["truth"])
     assert len(rig) == 3 and rig.cameras[0].width == 640
@@ -51,24 +58,14 @@ def test_synth_writes_consistent_files(clip):
 
 def test_three_cameras_track_accurately_and_plan(clip, tmp_path):
     out = tmp_path / "demo.h5"
-    res = CliRunner().invoke(
-        app,
-        [
-            "capture",
-            "markers",
-            "--video",
-            *map(str, _videos(clip)),
-            "--rig",
-            str(clip["rig"]),
-            "--markers",
-            str(clip["markers"]),
-            "--out",
-            str(out),
-            "--truth",
-            str(clip["truth"]),
-            "--plot",
-            str(tmp_path / "track.png"),
-        ],
+    res = _capture_markers(
+        clip,
+        clip["markers"],
+        out,
+        "--truth",
+        str(clip["truth"]),
+        "--plot",
+        str(tmp_path / "track.png"),
     )
     assert res.exit_code == 0, res.output
     read_png(tmp_path / "track.png", min_px=300)
@@ -205,21 +202,7 @@ def test_bad_inputs_raise_clear_errors(clip, tmp_path):
     with pytest.raises(CaptureError, match="no marker of part 'G'.*DICT_5X5_50"):
         track_frames(VideoSet(_videos(clip), rig), rig, other)
     path = write_markers(other, tmp_path / "m.toml")
-    res = CliRunner().invoke(
-        app,
-        [
-            "capture",
-            "markers",
-            "--video",
-            *map(str, _videos(clip)),
-            "--rig",
-            str(clip["rig"]),
-            "--markers",
-            str(path),
-            "--out",
-            str(tmp_path / "x.h5"),
-        ],
-    )
+    res = _capture_markers(clip, path, tmp_path / "x.h5")
     assert res.exit_code == 2 and "no marker of part" in res.output
 
 

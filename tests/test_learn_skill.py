@@ -27,6 +27,19 @@ def cli(*args: object) -> object:
     return runner.invoke(app, ["learn", "skill", *[str(a) for a in args]])
 
 
+def _puzzle_study(db: Path, obj: SkillObjective) -> Study:
+    """The stored CMA-ES puzzle study of ``QUICK`` (resumed, not run)."""
+    return Study(
+        db,
+        task="puzzle",
+        skill="peg-in-hole",
+        space=obj.space,
+        method="cmaes",
+        penalty=obj.penalty,
+        context=obj.context(),
+    )
+
+
 def test_skill_objective_runs_in_worker_processes_and_stores_sim_time(tmp_path: Path) -> None:
     obj = SkillObjective("puzzle", seed=1, n_starts=1)
     assert pickle.loads(pickle.dumps(obj)) == obj
@@ -77,16 +90,7 @@ def test_learn_resume_mismatch_and_best_params_file(tmp_path: Path) -> None:
     read_png(tmp_path / "c.png", min_px=200)
     read_png(tmp_path / "t.png", min_px=200)
     obj = SkillObjective("puzzle", n_starts=1)
-    stored = Study(
-        db,
-        task="puzzle",
-        skill="peg-in-hole",
-        space=obj.space,
-        method="cmaes",
-        penalty=obj.penalty,
-        context=obj.context(),
-        resume=True,
-    ).best()
+    stored = _puzzle_study(db, obj).best()
     assert f"best: trial {stored.number + 1}, cost {stored.cost:.3f} s" in res.output
     # the parameter file holds exactly the best trial's values, and reads back as the skill's
     params = read_params_toml(best, obj.trial().setup.skill.params)
@@ -96,20 +100,7 @@ def test_learn_resume_mismatch_and_best_params_file(tmp_path: Path) -> None:
     assert res.exit_code == 2 and "already has 5 trials" in res.output and "--resume" in res.output
     res = cli(*QUICK, "--trials", 7, "--study", db, "--workers", 0, "--resume")
     assert res.exit_code == 0 and "5 trial(s) restored" in res.output
-    assert (
-        len(
-            Study(
-                db,
-                task="puzzle",
-                skill="peg-in-hole",
-                space=obj.space,
-                method="cmaes",
-                penalty=obj.penalty,
-                context=obj.context(),
-            ).trials()
-        )
-        == 7
-    )
+    assert len(_puzzle_study(db, obj).trials()) == 7
     res = cli(
         "--task",
         "key",
