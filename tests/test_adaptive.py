@@ -12,11 +12,10 @@ from teachfit.control.adaptive import (
     meta_bounds,
 )
 from teachfit.control.base import Controller
-from teachfit.control.impedance import CartesianImpedance
 from teachfit.core.control import AdaptiveSpec, FixedGainSpec, ImpedanceLimits
 from teachfit.core.errors import ControlError
-from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.tasks import get_task
 
 MASS = np.array([1.0, 1.0, 1.0, 0.004, 0.004, 0.004])

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from teachfit.core.errors import DatasetError
 from teachfit.demonstrations import dataset as ds
 from teachfit.demonstrations.dataset import (
     Demonstration,
@@ -19,7 +20,6 @@ from teachfit.demonstrations.dataset import (
     read_demo,
     write_dataset,
 )
-from teachfit.core.errors import DatasetError
 
 
 def make_demo(

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from teachfit.core.errors import SimulationDiverged
-from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.robot.interface import Robot
 from teachfit.tasks import get_task
 

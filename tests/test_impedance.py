@@ -9,8 +9,8 @@ from teachfit.control.impedance import (
 )
 from teachfit.core.errors import ControlError
 from teachfit.core.geometry import quat_from_rz
-from teachfit.robot.floating import FloatingToolRobot
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks import get_task
 
 

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from teachfit.core.errors import TaskError
-from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Peg2D, Peg2DParams, get_task, load_task
 
 

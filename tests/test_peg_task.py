@@ -9,8 +9,8 @@ from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose, rotation_to_wxyz
-from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import AluminiumPeg, AluminiumPegParams, get_task
 
 

@@ -8,8 +8,8 @@ import pytest
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
-from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Puzzle, PuzzleParams, SkillTask, get_task, load_task
 
 STIFF = [300, 300, 300, 50, 50, 50]

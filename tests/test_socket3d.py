@@ -9,8 +9,8 @@ from scipy.spatial import ConvexHull
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
-from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Socket3D, Socket3DParams, get_task
 from teachfit.tasks.socket_geometry import valley_wedge
 

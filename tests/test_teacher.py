@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from teachfit.demonstrations.teacher import BlindTeacher, TeacherStyle
 from teachfit.core.errors import TeachfitError
+from teachfit.demonstrations.teacher import BlindTeacher, TeacherStyle
 from teachfit.tasks import get_task
 
 
