@@ -113,9 +113,10 @@ def test_short_line_and_blank_lines(tmp_path: Path) -> None:
 
 
 def test_too_few_samples(tmp_path: Path) -> None:
+    one_row = write(tmp_path, "time,x,y,z\n0,0,0,0\n")
     with pytest.raises(DatasetError, match="1 data rows, need at least 2") as info:
-        import_csv(write(tmp_path, "time,x,y,z\n0,0,0,0\n"), BASIC, task="a")
-    assert info.value.path is not None
+        import_csv(one_row, BASIC, task="a")
+    assert info.value.path == str(one_row)
     with pytest.raises(DatasetError, match="header") as info:
         import_csv(write(tmp_path, "", "empty.csv"), BASIC, task="a")
     assert info.value.row == 1
