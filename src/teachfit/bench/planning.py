@@ -110,9 +110,9 @@ class PlanningBenchConfig:
 class CheckCost:
     """Wall time (us) of one collision check of a task, and of the same-run baseline.
 
-    ``contact_us``: at the goal pose (the parts touch, coal's narrow phase works hardest);
-    ``free_us``: at the start pose. ``baseline_us``: one quaternion-to-matrix conversion by
-    scipy (``Rotation.from_quat(q).as_matrix()``), timed in the same run, so that the ratios
+    ``contact_us``: at the goal pose (the parts a clearance apart: coal's narrow phase works
+    hardest); ``free_us``: at the start pose. ``baseline_us``: one quaternion-to-matrix
+    conversion by scipy (``Rotation.from_quat(q).as_matrix()``), timed in the same run, so that the ratios
     compare across machines. Each figure is the fastest of ``repeats`` loops of ``n`` calls.
     """
 
@@ -326,7 +326,7 @@ def report_notes(results: Sequence[TaskBench]) -> list[str]:
     for r in results:
         c = r.check
         lines.append(
-            f"{r.task}: collision check {c.contact_us:.1f} us per call at the goal (contact), "
+            f"{r.task}: collision check {c.contact_us:.1f} us per call at the goal (near contact), "
             f"{c.free_us:.1f} us at the start = {c.contact_us / c.baseline_us:.2f}x and "
             f"{c.free_us / c.baseline_us:.2f}x one scipy quaternion-to-matrix conversion "
             f"({c.baseline_us:.1f} us, same run; fastest of 3 x {c.n} calls)"
