@@ -112,8 +112,9 @@ class CheckCost:
 
     ``contact_us``: at the goal pose (the parts a clearance apart: coal's narrow phase works
     hardest); ``free_us``: at the start pose. ``baseline_us``: one quaternion-to-matrix
-    conversion by scipy (``Rotation.from_quat(q).as_matrix()``), timed in the same run, so that the ratios
-    compare across machines. Each figure is the fastest of ``repeats`` loops of ``n`` calls.
+    conversion by scipy (``Rotation.from_quat(q).as_matrix()``), timed in the same run, so
+    that the ratios compare across machines. Each figure is the fastest of ``repeats`` loops
+    of ``n`` calls.
     """
 
     contact_us: float
