@@ -17,8 +17,8 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/teachfit quickstart --out out/quickstart
 
-test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+# `make test` lints first (ruff check and ruff format --check), then runs the tests
+test: lint
 	$(BIN)/python -m pytest -n 2 --durations=10
 
 lint: $(STAMP)

@@ -19,7 +19,7 @@ def test_table1_protocol_runs_every_method_on_the_same_starts():
         assert r.ours.trials == 2
         assert 0.0 <= r.ours.low <= r.ours.rate <= r.ours.high <= 1.0
         assert r.paper == PAPER_TABLE1[r.method.split("-")[0]]
-        assert r.plan_ms > 0 and r.length > 0 and np.isfinite(r.ergodic)
+        assert r.length > 0 and np.isfinite(r.ergodic)  # plan_ms: a benchmark figure
     # the ergodic trajectory is planned as long as the mean TSHIX pass (x-y, 2D: same metric)
     assert abs(rows[2].length - rows[0].length) < 0.1 * rows[0].length
 
@@ -30,7 +30,12 @@ def test_table2_and_ablation_rows_line_up_with_the_paper():
     assert [r.method for r in abl] == ["N=20 no-ff"]
     assert all(r.ours.trials == 2 for r in rows + abl)
     assert rows[1].length > rows[0].length  # more samples, longer tour
-    assert PAPER_TABLE2[300] == (17, 20) and PAPER_ABLATION[400] == (13, 20)
+    # each row stands beside the paper's figure for its N (none for these small N)
+    assert [r.paper for r in rows] == [PAPER_TABLE2.get(20), PAPER_TABLE2.get(40)]
+    assert abl[0].paper == PAPER_ABLATION.get(20)
+    # the transcribed paper: without feed-forward fewer successes at every N, same trials
+    for n, (ok, trials) in PAPER_ABLATION.items():
+        assert ok < PAPER_TABLE2[n][0] and trials == PAPER_TABLE2[n][1], n
 
 
 def test_table3_runs_six_methods_on_socket3d():

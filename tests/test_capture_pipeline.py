@@ -1,5 +1,8 @@
 """Rendered clips end to end: synth -> track -> demonstration -> plan; occlusion, outliers,
-bad input; ChArUco calibration of the synthetic rig. Small (640x480, ~11 frames), seeded."""
+bad input; ChArUco calibration of the synthetic rig. Small (640x480, ~11 frames), seeded.
+
+Every test here works on clips rendered with MuJoCo, so each is skipped (with the reason) where
+no OpenGL context exists; the capture code without rendering is tested in test_capture_*.py."""
 
 from __future__ import annotations
 
@@ -9,6 +12,7 @@ from pathlib import Path
 import imageio.v2 as imageio
 import numpy as np
 import pytest
+from media_checks import read_png
 from typer.testing import CliRunner
 
 from teachfit.bench.capture import pose_errors
@@ -28,12 +32,19 @@ CFG = SynthConfig(resolutions=((640, 480),) * 3, distance=0.35, stride=15, noise
 
 
 @pytest.fixture(scope="module")
-def clip(tmp_path_factory) -> dict[str, Path]:
+def clip(tmp_path_factory, needs_gl) -> dict[str, Path]:
     return write_synth_capture(tmp_path_factory.mktemp("synth"), seed=3, cfg=CFG)
 
 
 def _videos(clip, n=3):
     return [clip[f"video{i}"] for i in range(n)]
+
+
+def _capture_markers(clip, markers: Path, out: Path, *extra: str) -> object:
+    """``teachfit capture markers`` on the clip's three videos and rig."""
+    videos = ["--video", *map(str, _videos(clip)), "--rig", str(clip["rig"])]
+    args = ["capture", "markers", *videos, "--markers", str(markers), "--out", str(out)]
+    return CliRunner().invoke(app, [*args, *extra])
 
 
 def test_synth_writes_consistent_files(clip):
@@ -47,33 +58,26 @@ def test_synth_writes_consistent_files(clip):
 
 def test_three_cameras_track_accurately_and_plan(clip, tmp_path):
     out = tmp_path / "demo.h5"
-    res = CliRunner().invoke(
-        app,
-        [
-            "capture",
-            "markers",
-            "--video",
-            *map(str, _videos(clip)),
-            "--rig",
-            str(clip["rig"]),
-            "--markers",
-            str(clip["markers"]),
-            "--out",
-            str(out),
-            "--truth",
-            str(clip["truth"]),
-            "--plot",
-            str(tmp_path / "track.png"),
-        ],
+    res = _capture_markers(
+        clip,
+        clip["markers"],
+        out,
+        "--truth",
+        str(clip["truth"]),
+        "--plot",
+        str(tmp_path / "track.png"),
     )
     assert res.exit_code == 0, res.output
-    assert "error vs truth" in res.output and (tmp_path / "track.png").stat().st_size > 10_000
+    read_png(tmp_path / "track.png", min_px=300)
     demo, truth = read_demo(out), read_demo(clip["truth"])
     assert demo.source == "captured" and demo.frame == "G" and demo.child_frame == "L"
     assert demo.n_samples == truth.n_samples  # every frame trustworthy in this clean clip
     err = 1e3 * np.linalg.norm(demo.pos - truth.pos, axis=1)
     assert np.median(err) < 0.5 and err.max() < 2.0
-    res = CliRunner().invoke(app, ["plan", "--demo", f"{out}:0", "--te", "0.2", "--seed", "1"])
+    printed = " ".join(res.output.split())
+    assert f"error vs truth: median {np.median(err):.3f} mm" in printed
+    args = ["plan", "--demo", f"{out}:0", "--max-checks", "2000", "--seed", "1"]
+    res = CliRunner().invoke(app, args)  # a budget in checks: the outcome is the seed's alone
     assert res.exit_code == 0 and "success" in res.output, res.output
 
 
@@ -198,25 +202,11 @@ def test_bad_inputs_raise_clear_errors(clip, tmp_path):
     with pytest.raises(CaptureError, match="no marker of part 'G'.*DICT_5X5_50"):
         track_frames(VideoSet(_videos(clip), rig), rig, other)
     path = write_markers(other, tmp_path / "m.toml")
-    res = CliRunner().invoke(
-        app,
-        [
-            "capture",
-            "markers",
-            "--video",
-            *map(str, _videos(clip)),
-            "--rig",
-            str(clip["rig"]),
-            "--markers",
-            str(path),
-            "--out",
-            str(tmp_path / "x.h5"),
-        ],
-    )
+    res = _capture_markers(clip, path, tmp_path / "x.h5")
     assert res.exit_code == 2 and "no marker of part" in res.output
 
 
-def test_charuco_calibration_recovers_the_rig(tmp_path):
+def test_charuco_calibration_recovers_the_rig(tmp_path, needs_gl):
     spec = CharucoSpec()
     cfg = SynthConfig(resolutions=((640, 480),) * 2)
     truth = write_charuco_shots(tmp_path / "calib", spec, cfg, shots=12, seed=0)

@@ -1,7 +1,5 @@
 """Mesh-mesh collision and distance with coal."""
 
-import time
-
 import numpy as np
 import pytest
 import trimesh
@@ -41,14 +39,17 @@ def test_xyzq_hot_path_matches_matrix_query(lgroove):
         assert checker.collides_xyzq(*pos, w, x, y, z) == checker.collides(T)
 
 
-def test_a_check_is_cheap(lgroove):
+def test_every_collision_check_is_counted(lgroove):
+    # the planner reports n_checks as its work (and budgets attempts in it); the time per check
+    # is a benchmark figure (`teachfit bench planning`), not a test
     asm, checker = lgroove
     x, y, z = asm.goal[:3, 3]
-    t0 = time.perf_counter()
-    for _ in range(2000):
+    before = checker.n_checks
+    for _ in range(7):
         checker.collides_xyzq(x, y, z, 1.0, 0.0, 0.0, 0.0)
-    per_check = (time.perf_counter() - t0) / 2000
-    assert per_check < 200e-6  # ~10-20 us here; generous for a loaded CI machine
+    checker.collides(asm.start)
+    checker.distance(asm.start)  # a distance query is not a collision check
+    assert checker.n_checks - before == 8
 
 
 def test_degenerate_meshes_raise(lgroove):

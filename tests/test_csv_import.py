@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -114,9 +113,10 @@ def test_short_line_and_blank_lines(tmp_path: Path) -> None:
 
 
 def test_too_few_samples(tmp_path: Path) -> None:
+    one_row = write(tmp_path, "time,x,y,z\n0,0,0,0\n")
     with pytest.raises(DatasetError, match="1 data rows, need at least 2") as info:
-        import_csv(write(tmp_path, "time,x,y,z\n0,0,0,0\n"), BASIC, task="a")
-    assert info.value.path is not None
+        import_csv(one_row, BASIC, task="a")
+    assert info.value.path == str(one_row)
     with pytest.raises(DatasetError, match="header") as info:
         import_csv(write(tmp_path, "", "empty.csv"), BASIC, task="a")
     assert info.value.row == 1
@@ -146,7 +146,8 @@ def test_toml_errors(tmp_path: Path) -> None:
         ColumnMap.from_toml(write(tmp_path, "x = [", "broken.toml"))
 
 
-def test_ten_thousand_rows_fast(tmp_path: Path) -> None:
+def test_ten_thousand_rows_round_trip(tmp_path: Path) -> None:
+    # the import speed is a benchmark figure (benchmarks/csv_import_speed.py), not a test
     rng = np.random.default_rng(0)
     n = 10_000
     t = 1.7e9 + np.arange(n) * 0.001
@@ -156,9 +157,10 @@ def test_ten_thousand_rows_fast(tmp_path: Path) -> None:
     header = ",".join(HEADER[:14])
     path = tmp_path / "big.csv"
     np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.9f")
-    start = time.perf_counter()
     demo = import_csv(path, ColumnMap.from_toml(COLUMNS), task="a")
-    elapsed = time.perf_counter() - start
     assert demo.n_samples == n
-    np.testing.assert_allclose(demo.t[-1], (n - 1) * 0.001, atol=1e-9)
-    assert elapsed < 1.5, elapsed  # typically ~0.1 s; generous for a loaded machine
+    np.testing.assert_allclose(demo.t, np.arange(n) * 0.001, atol=1e-6)
+    np.testing.assert_allclose(demo.pos, table[:, 1:4], atol=1e-9)
+    # the same rotation row by row (a quaternion and its negation are one rotation)
+    np.testing.assert_allclose(np.abs(np.sum(demo.quat * table[:, 4:8], axis=1)), 1.0, atol=1e-6)
+    np.testing.assert_allclose(demo.wrench, -table[:, 8:14], atol=1e-9)  # wrench_sign = -1

@@ -1,54 +1,62 @@
 """CLI of demonstration-guided planning (typer app of teachfit.cli.plan_cmd)."""
 
+import re
+
 import numpy as np
-from rich.console import Console
+from media_checks import read_png, read_video
 from typer.testing import CliRunner
 
-from teachfit.cli.plan_cmd import app, bench_planning
-from teachfit.plans import build_assembly
+from teachfit.bench.planning import PlanningBenchConfig, report_table, run_planning_bench
+from teachfit.cli.plan_cmd import app
+from teachfit.demonstrations.dataset import read_demo
+from teachfit.plans import MotionPlanner, PlannerConfig, build_assembly, matrix_to_state
 from teachfit.viz.plan_video import render_path_video
 
 runner = CliRunner()
 
 
-def test_parts_show_prints_dimensions_and_plots(tmp_path):
+def _flat(text: str) -> str:
+    return " ".join(text.split())
+
+
+def test_parts_show_prints_the_library_dimensions_and_plots(tmp_path):
     png = tmp_path / "parts.png"
     result = runner.invoke(app, ["parts", "show", "l-groove", "--plot", str(png)])
     assert result.exit_code == 0, result.output
-    assert "opening_length" in result.output and "70.0" in result.output
-    assert png.stat().st_size > 1000
+    asm = build_assembly("l-groove")
+    lines = result.output.splitlines()
+    for key, value in asm.dimensions.items():
+        assert any(key in ln and f"{1e3 * value:.1f}" in ln for ln in lines), key
+    assert f"moving part: {len(asm.moving.faces)} triangles" in result.output
+    img = read_png(png, min_px=300)
+    assert img.shape[1] > 2 * img.shape[0]  # three panels side by side
     bad = runner.invoke(app, ["parts", "show", "peg"])
     assert bad.exit_code == 2 and "unknown task" in bad.output
 
 
-def test_synth_then_plan_with_demo_writes_figures(tmp_path):
+def test_plan_saves_the_path_the_library_plans(tmp_path):
     h5 = tmp_path / "l_demo.h5"
     result = runner.invoke(
         app, ["demo", "synth", "--task", "l-groove", "--seed", "3", "--out", str(h5)]
     )
     assert result.exit_code == 0, result.output
     strip, keys, npy = tmp_path / "strip.png", tmp_path / "keys.png", tmp_path / "path.npy"
-    result = runner.invoke(
-        app,
-        [
-            "plan",
-            "--task",
-            "l-groove",
-            "--demo",
-            str(h5),
-            "--strip",
-            str(strip),
-            "--keyposes",
-            str(keys),
-            "--save",
-            str(npy),
-        ],
-    )
+    args = ["plan", "--task", "l-groove", "--demo", str(h5), "--max-checks", "1000"]
+    args += ["--seed", "2", "--strip", str(strip), "--keyposes", str(keys), "--save", str(npy)]
+    result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
-    assert "success" in result.output
-    assert strip.stat().st_size > 1000 and keys.stat().st_size > 1000
-    path = np.load(npy)
-    assert path.shape[1] == 7 and len(path) >= 2
+    # the same query through the library: the very same path and figures
+    asm = build_assembly("l-groove")
+    mp = MotionPlanner(asm, PlannerConfig(max_checks=1000))
+    expected = mp.plan(read_demo(f"{h5}:0"), seed=2)
+    assert expected.success
+    assert np.array_equal(np.load(npy), expected.path)
+    out = _flat(result.output)
+    assert f"key poses used {expected.used_key_poses}/{expected.candidates}" in out
+    assert f"{expected.collision_checks} collision checks" in out
+    panels = read_png(strip, min_px=150)
+    assert panels.shape[1] > 3 * panels.shape[0]  # six poses side by side
+    read_png(keys, min_px=200)
     # a demonstration of other parts is refused with a clear message
     wrong = runner.invoke(app, ["plan", "--task", "tenon", "--demo", f"{h5}:0"])
     assert wrong.exit_code == 2 and "l-groove" in wrong.output
@@ -57,26 +65,44 @@ def test_synth_then_plan_with_demo_writes_figures(tmp_path):
 def test_plan_needs_exactly_one_of_demo_and_no_demo():
     result = runner.invoke(app, ["plan", "--task", "tenon"])
     assert result.exit_code == 2
-    result = runner.invoke(app, ["plan", "--task", "tenon", "--no-demo", "--te", "0.02"])
-    assert result.exit_code == 1 and "failure" in result.output
+    assert "give exactly one of --demo FILE and --no-demo" in result.output
+    args = ["plan", "--task", "tenon", "--no-demo", "--max-checks", "300"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 1, result.output
+    assert "failure: no path within 300 collision checks per attempt" in _flat(result.output)
 
 
-def test_video_is_written(tmp_path):
+def test_video_shows_the_part_moving(tmp_path):
     asm = build_assembly("tenon")
-    from teachfit.plans import matrix_to_state
-
     path = np.stack([matrix_to_state(asm.start), matrix_to_state(asm.goal)])
     out = render_path_video(asm, path, tmp_path / "p.mp4", frames=3, size_px=160)
-    assert out.stat().st_size > 500
+    frames = read_video(out)
+    assert frames.shape == (3, 160, 160, 3)
+    moved = np.abs(frames[0].astype(int) - frames[-1].astype(int)).max(axis=2) > 40
+    assert moved.mean() > 0.005  # the moving part is elsewhere in the last frame
 
 
-def test_bench_planning_prints_and_appends(tmp_path):
+def test_bench_planning_prints_and_appends_what_the_library_computes(tmp_path):
     md = tmp_path / "BENCHMARKS.md"
-    console = Console(record=True, width=160)
-    results = bench_planning(
-        ["tenon"], 1, no_demo_seeds=1, no_demo_budget=0.05, write=True, benchmarks=md, out=console
+    args = ["bench", "planning", "--tasks", "tenon", "--seeds", "2", "--max-checks", "1000"]
+    args += ["--no-demo-seeds", "1", "--no-demo-budget", "0.05", "--write"]
+    result = runner.invoke(app, [*args, "--benchmarks", str(md)])
+    assert result.exit_code == 0, result.output
+    cfg = PlanningBenchConfig(
+        tasks=("tenon",), seeds=2, max_checks=1000, no_demo_seeds=1, no_demo_budget=0.05
     )
-    assert results[0].demo.n == 1 and results[0].no_demo.n == 1
-    text = console.export_text()
-    assert "speed-up" in text and "paper" in text
-    assert "| tenon | demo |" in md.read_text()
+    guided = report_table(run_planning_bench(cfg))[0]
+    text = md.read_text()
+    assert f"`{cfg.command()}`" in text
+    row = next(ln for ln in text.splitlines() if ln.startswith("| tenon | demo |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    # runs, poses available, used and success do not depend on the machine's speed
+    assert cells[:5] == guided[:5] and cells[8] == guided[8]
+    assert guided[8].startswith("100 %") and "budget 1000 checks/attempt" in guided[8]
+    assert any(ln.startswith("| tenon | no-demo | 1 |") for ln in text.splitlines())
+    out = _flat(result.output)
+    assert "tenon: speed-up with demonstration" in out and "tenon: speed-up" in text
+    check = re.search(r"tenon: collision check ([0-9.]+) us per call", out)
+    assert check is not None and float(check.group(1)) > 0
+    bad = runner.invoke(app, ["bench", "planning", "--tasks", "peg"])
+    assert bad.exit_code == 2 and "unknown or no task(s) ['peg']" in bad.output

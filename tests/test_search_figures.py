@@ -1,5 +1,6 @@
 import numpy as np
 import pytest
+from media_checks import read_png
 
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.tshix import TshixPlanner
@@ -31,6 +32,8 @@ def test_all_figures_render(tmp_path, expl3):
     }
     for name, fig in figs.items():
         p = sf.save(fig, tmp_path / f"{name}.png", dpi=40)
-        assert p.stat().st_size > 1000
+        w, h = fig.get_size_inches() * 40
+        img = read_png(p, min_px=60)
+        assert abs(img.shape[1] - w) <= 1 and abs(img.shape[0] - h) <= 1, (name, img.shape)
     with pytest.raises(ValueError):
         sf.trajectory_3d(tr)

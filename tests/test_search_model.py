@@ -91,9 +91,10 @@ def test_no_wrench_gives_zero_feedforward_and_bad_demo_raises():
 
 
 def test_with_demonstration_type():
-    ds = pytest.importorskip("teachfit.demonstrations.dataset")
+    from teachfit.demonstrations.dataset import Demonstration  # a failed import fails here
+
     d = make_demo(0)
-    demo = ds.Demonstration(
+    demo = Demonstration(
         t=d.t, pos=d.pos, quat=d.quat, wrench=d.wrench, task="peg2d", source="synthetic"
     )
     m = SearchModel.fit([demo], "peg2d")

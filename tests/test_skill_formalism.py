@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+import os
 import tomllib
 from pathlib import Path
 
@@ -24,7 +25,13 @@ from teachfit.skills.conditions import (
 )
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.loader import load_skill, skill_from_dict, skill_to_toml
-from teachfit.skills.params import ContextParam, LearnedParam, SkillParams, read_params_toml
+from teachfit.skills.params import (
+    ContextParam,
+    LearnedParam,
+    SkillParams,
+    read_params_toml,
+    write_params_toml,
+)
 from teachfit.skills.percept import Percept
 from teachfit.skills.primitive import Move, MoveTo
 from teachfit.skills.profile import Trapezoid, synchronized
@@ -225,6 +232,36 @@ def test_params_file_errors_are_clear(tmp_path):
     text.write_text('force = "strong"\n')
     with pytest.raises(SkillError, match="must be numbers"):
         read_params_toml(text, sk.params)
+
+
+def test_written_params_read_back_exactly(tmp_path):
+    sk = peg_in_hole.build("impedance")
+    values = {"force": 12.345678901234567, "tilt": 0.05, "a_t": 0.001 / 3.0}
+    path = write_params_toml(tmp_path / "out" / "best.toml", values, "best of cmaes\ntrial 4")
+    text = path.read_text()
+    assert text.startswith("# best of cmaes\n# trial 4\n[params]\n")
+    back = read_params_toml(path, sk.params)
+    assert {k: back[k] for k in values} == values  # floats round-trip to the last bit
+    assert [p.name for p in path.parent.iterdir()] == ["best.toml"]  # no temporary left
+    assert path.stat().st_mode & 0o777 == 0o644
+
+
+def test_a_failed_params_write_keeps_the_old_file_and_no_temporary(tmp_path, monkeypatch):
+    path = write_params_toml(tmp_path / "best.toml", {"force": 5.0})
+    old = path.read_text()
+
+    def broken_replace(src, dst):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", broken_replace)
+    with pytest.raises(SkillError, match=r"cannot write parameter file .*best.toml.*No space"):
+        write_params_toml(path, {"force": 6.0})
+    assert path.read_text() == old
+    assert [p.name for p in tmp_path.iterdir()] == ["best.toml"]
+    for bad, match in (({"force": math.nan}, "finite"), ({"for ce": 1.0}, "identifiers")):
+        with pytest.raises(SkillError, match=match):
+            write_params_toml(tmp_path / "other.toml", bad)
+    assert not (tmp_path / "other.toml").exists()
 
 
 # ------------------------------------------------------------------------------------ TOML

@@ -21,7 +21,6 @@ Marker file (TOML, ``format = "teachfit-markers"``, ``version = 1``)::
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +28,7 @@ import cv2
 import numpy as np
 
 from teachfit.capture.geometry import checked_transform, toml_matrix
+from teachfit.capture.tomlfile import read_versioned_toml, write_versioned_toml
 from teachfit.core.errors import CaptureError
 
 __all__ = [
@@ -140,15 +140,7 @@ class MarkerSet:
 
 def read_markers(path: str | Path) -> MarkerSet:
     """Read and validate a marker TOML file; problems raise :class:`CaptureError`."""
-    path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise CaptureError(f"marker file {path}: cannot read ({exc.strerror or exc})") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise CaptureError(f"marker file {path}: invalid TOML ({exc})") from exc
-    if doc.get("format") != FORMAT or doc.get("version") != VERSION:
-        raise CaptureError(f"marker file {path}: expected format = {FORMAT!r}, version = 1")
+    doc = read_versioned_toml(path, "marker", FORMAT, VERSION)
     try:
         markers = []
         for i, entry in enumerate(doc.get("marker", [])):
@@ -169,8 +161,6 @@ def read_markers(path: str | Path) -> MarkerSet:
 def write_markers(markers: MarkerSet, path: str | Path) -> Path:
     """Write a marker set as TOML (by hand: tomllib only reads)."""
     lines = [
-        f'format = "{FORMAT}"',
-        f"version = {VERSION}",
         f'dictionary = "{markers.dictionary}"',
         f'reference = "{markers.reference}"',
         f'moving = "{markers.moving}"',
@@ -185,10 +175,7 @@ def write_markers(markers: MarkerSet, path: str | Path) -> Path:
             f"marker2part = {toml_matrix(m.marker2part)}",
             "",
         ]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(lines))
-    return path
+    return write_versioned_toml(path, FORMAT, VERSION, lines)
 
 
 def marker_image(dictionary: str, marker_id: int, px: int, margin: float = 0.25) -> np.ndarray:

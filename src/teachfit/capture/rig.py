@@ -17,7 +17,6 @@ Camera frames follow OpenCV: x right, y down, z along the optical axis.
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from teachfit.capture.geometry import checked_transform, invert, toml_matrix
+from teachfit.capture.tomlfile import read_versioned_toml, write_versioned_toml
 from teachfit.core.errors import CaptureError
 
 __all__ = ["Camera", "Rig", "read_rig", "write_rig"]
@@ -124,18 +124,7 @@ class Rig:
 
 def read_rig(path: str | Path) -> Rig:
     """Read and validate a rig TOML file; every problem is a :class:`CaptureError` naming it."""
-    path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise CaptureError(f"rig file {path}: cannot read ({exc.strerror or exc})") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise CaptureError(f"rig file {path}: invalid TOML ({exc})") from exc
-    if doc.get("format") != FORMAT or doc.get("version") != VERSION:
-        raise CaptureError(
-            f"rig file {path}: expected format = {FORMAT!r}, version = {VERSION}, got "
-            f"{doc.get('format')!r}, {doc.get('version')!r}"
-        )
+    doc = read_versioned_toml(path, "rig", FORMAT, VERSION)
     cams = []
     for i, entry in enumerate(doc.get("camera", [])):
         missing = {"name", "width", "height", "K", "dist", "cam2rig"} - set(entry)
@@ -153,7 +142,7 @@ def read_rig(path: str | Path) -> Rig:
 
 def write_rig(rig: Rig, path: str | Path) -> Path:
     """Write ``rig`` as TOML (by hand: the standard library's tomllib only reads)."""
-    lines = [f'format = "{FORMAT}"', f"version = {VERSION}", ""]
+    lines = [""]
     for cam in rig.cameras:
         lines += [
             "[[camera]]",
@@ -165,7 +154,4 @@ def write_rig(rig: Rig, path: str | Path) -> Path:
             f"cam2rig = {toml_matrix(cam.cam2rig)}",
             "",
         ]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(lines))
-    return path
+    return write_versioned_toml(path, FORMAT, VERSION, lines)

@@ -9,10 +9,10 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
+from teachfit.cli.progress import progress_bar
 from teachfit.core.errors import CaptureError
 
 __all__ = ["bench_capture_cmd", "capture_app"]
@@ -20,17 +20,6 @@ __all__ = ["bench_capture_cmd", "capture_app"]
 capture_app = typer.Typer(
     help="Demonstrations captured from video (multi-camera ArUco tracking).", no_args_is_help=True
 )
-
-
-def _progress() -> Progress:
-    return Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-    )
 
 
 def _pair(text: str, what: str) -> tuple[int, int]:
@@ -114,7 +103,7 @@ def markers(
         VideoSet(videos, the_rig) if videos else CameraSet(camera or [], the_rig, max_frames=frames)
     )
     cfg = TrackConfig(filter=None) if no_filter else TrackConfig()
-    with _progress() as bar:
+    with progress_bar() as bar:
         job = bar.add_task("tracking", total=source.n_frames or None)
         track = track_frames(
             source, the_rig, the_markers, cfg, progress=lambda d: bar.update(job, completed=d)
@@ -191,7 +180,7 @@ def synth(
         stride=stride,
         max_frames=max_frames,
     )
-    with _progress() as bar:
+    with progress_bar() as bar:
         job = bar.add_task("rendering", total=None)
         paths = write_synth_capture(
             out,
@@ -233,7 +222,7 @@ def bench_capture_cmd(
     cfg = _synth_config(
         3, ["1920x1080"], noise=noise, blur=blur, lighting=lighting, stride=stride, crf=crf
     )
-    with tempfile.TemporaryDirectory() as tmp, _progress() as bar:
+    with tempfile.TemporaryDirectory() as tmp, progress_bar() as bar:
         jobs: dict[str, int] = {}
 
         def tick(label: str, done: int, total: int) -> None:

@@ -7,10 +7,10 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.progress import progress_bar
 from teachfit.core.params import LearningError
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
@@ -28,26 +28,6 @@ def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
         if not sep or not name.strip():
             raise LearningError(f"--task-param wants NAME=VALUE with a number, got {item!r}")
     return tuple(out)
-
-
-def _bar() -> Progress:
-    return Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-    )
-
-
-def write_params_toml(path: Path, params: dict[str, float], header: str) -> Path:
-    """Learned values as a TOML ``[params]`` table (readable by ``skill run --params``)."""
-    lines = [f"# {line}" for line in header.splitlines()] + ["[params]"]
-    lines += [f"{name} = {float(v)!r}" for name, v in params.items()]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(lines) + "\n")
-    return path
 
 
 @guarded
@@ -131,7 +111,7 @@ def learn_skill(
             f"{trials}[/]: nothing to run; raise --trials to continue"
         )
     best = [math.inf]
-    with _bar() as bar:
+    with progress_bar() as bar:
         job = bar.add_task(f"{method} {task}", total=trials, completed=min(st.n_finished, trials))
 
         def progress(rec: object) -> None:
@@ -195,6 +175,8 @@ def _report_best(
         table.add_row(name, f"{v:.4g}", f"{d.low:.4g}", f"{d.high:.4g}")
     console.print(table)
     if out is not None:
+        from teachfit.skills.params import write_params_toml
+
         head = f"best of {title}: cost {best.cost:.4f} s, trial {best.number + 1}"
         console.print(f"parameters -> {write_params_toml(out, best.params, head)}")
     if plot is not None:
@@ -243,7 +225,7 @@ def bench_learning(
     task_list = [t for t in tasks.split(",") if t]
     method_list = [m for m in methods.split(",") if m]
     total = len(task_list) * len(method_list) * experiments * trials
-    with _bar() as bar:
+    with progress_bar() as bar:
         job = bar.add_task("learning", total=total)
         res = bl.run_learning_bench(
             task_list,

@@ -2,28 +2,25 @@
 
 ``app`` holds all four (``app parts show``, ``app demo synth``, ``app plan``,
 ``app bench planning``); the main CLI can mount the pieces it needs: ``parts_app``,
-:func:`demo_synth`, :func:`plan`, :func:`bench_planning_cmd` (or call :func:`bench_planning`).
+:func:`demo_synth`, :func:`plan`, :func:`bench_planning_cmd`. Every command reports a
+:class:`~teachfit.core.errors.TeachfitError` as one line (:func:`~teachfit.cli.common.guarded`).
 """
 
 from __future__ import annotations
 
-import shlex
-import sys
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from teachfit.core.errors import TeachfitError
+from teachfit.cli.common import console, guarded
+from teachfit.cli.progress import progress_bar
+from teachfit.core.errors import PlanningError, TeachfitError
 
 __all__ = [
     "app",
     "bench_app",
-    "bench_planning",
     "bench_planning_cmd",
     "demo_app",
     "demo_synth",
@@ -40,15 +37,9 @@ app.add_typer(parts_app, name="parts")
 app.add_typer(demo_app, name="demo")
 app.add_typer(bench_app, name="bench")
 
-console = Console()
-
-
-def _fail(exc: Exception) -> typer.Exit:
-    console.print(f"[red]error:[/red] {exc}")
-    return typer.Exit(code=2)
-
 
 @parts_app.command("show")
+@guarded
 def parts_show(
     task: Annotated[str, typer.Argument(help="l-groove or tenon")],
     plot: Annotated[Path | None, typer.Option(help="write a figure of the parts (png)")] = None,
@@ -56,10 +47,7 @@ def parts_show(
     """Print the parts' dimensions, start and goal poses; optionally plot them."""
     from teachfit.plans.parts import build_assembly
 
-    try:
-        asm = build_assembly(task)
-    except TeachfitError as exc:
-        raise _fail(exc) from exc
+    asm = build_assembly(task)
     table = Table(title=f"{task} dimensions")
     table.add_column("dimension")
     table.add_column("mm", justify="right")
@@ -77,6 +65,7 @@ def parts_show(
 
 
 @demo_app.command("synth")
+@guarded
 def demo_synth(
     out: Annotated[Path, typer.Option(help="HDF5 file to write")],
     task: Annotated[str, typer.Option(help="l-groove or tenon")] = "l-groove",
@@ -91,12 +80,9 @@ def demo_synth(
     from teachfit.plans.parts import build_assembly
     from teachfit.plans.synth import synth_demo
 
-    try:
-        asm = build_assembly(task)
-        demos = [synth_demo(asm, seed + i) for i in range(count)]
-        write_dataset(out, demos, overwrite=overwrite)
-    except TeachfitError as exc:
-        raise _fail(exc) from exc
+    asm = build_assembly(task)
+    demos = [synth_demo(asm, seed + i) for i in range(count)]
+    write_dataset(out, demos, overwrite=overwrite)
     for demo in demos:
         console.print(
             f"{demo.name}: {len(demo.t)} poses over {demo.t[-1]:.1f} s, "
@@ -117,6 +103,7 @@ def _load_demo(spec: str) -> object:
 
 
 @app.command("plan")
+@guarded
 def plan(
     task: Annotated[str, typer.Option(help="l-groove or tenon")] = "l-groove",
     demo: Annotated[
@@ -124,8 +111,12 @@ def plan(
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
     te: Annotated[float, typer.Option(help="budget per attempt (s)")] = 0.02,
+    max_checks: Annotated[
+        int | None,
+        typer.Option(help="budget per attempt in collision checks instead of --te (repeatable)"),
+    ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
-    seed: Annotated[int, typer.Option(help="seed of the key-pose repair")] = 0,
+    seed: Annotated[int, typer.Option(help="seed of the key-pose repair and of OMPL")] = 0,
     render: Annotated[Path | None, typer.Option(help="write an mp4 of the path")] = None,
     strip: Annotated[
         Path | None, typer.Option(help="write the path as a strip of poses (png)")
@@ -142,13 +133,10 @@ def plan(
     from teachfit.plans.planner import MotionPlanner, PlannerConfig
 
     if (demo is None) == (not no_demo):
-        raise _fail(ValueError("give exactly one of --demo FILE and --no-demo"))
-    try:
-        asm = build_assembly(task)
-        mp = MotionPlanner(asm, PlannerConfig(planner=planner, te=te))
-        result = mp.plan(None if no_demo else _load_demo(demo), seed=seed)
-    except TeachfitError as exc:
-        raise _fail(exc) from exc
+        raise PlanningError("give exactly one of --demo FILE and --no-demo")
+    asm = build_assembly(task)
+    mp = MotionPlanner(asm, PlannerConfig(planner=planner, te=te, max_checks=max_checks))
+    result = mp.plan(None if no_demo else _load_demo(demo), seed=seed)
     status = "[green]success[/green]" if result.success else "[red]failure[/red]"
     console.print(
         f"{status}: {result.message}; planning {result.time_s:.3f} s "
@@ -174,121 +162,55 @@ def plan(
     if render is not None:
         from teachfit.viz.plan_video import render_path_video
 
-        try:
-            render_path_video(asm, mp.densify(result.path, 0.002), render)
-        except TeachfitError as exc:
-            raise _fail(exc) from exc
+        render_path_video(asm, mp.densify(result.path, 0.002), render)
         console.print(f"wrote {render}")
 
 
-def bench_planning(
-    tasks: Sequence[str],
-    seeds: int,
-    *,
-    te: float = 0.01,
-    planner: str = "RRTConnect",
-    no_demo_seeds: int = 5,
-    no_demo_budget: float = 30.0,
-    write: bool = False,
-    benchmarks: str | Path = "BENCHMARKS.md",
-    out: Console | None = None,
-) -> list:
-    """Run the Table I protocol with a progress bar, print the table, optionally append it.
-
-    Returns the list of :class:`teachfit.bench.planning.TaskBench`.
-    """
-    from teachfit.bench.planning import append_markdown, run_planning_bench, to_markdown
-
-    out = out or console
-    total = len(tasks) * (seeds + min(no_demo_seeds, seeds))
-    columns = (
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeElapsedColumn(),
-    )
-    with Progress(*columns, console=out, transient=True) as bar:
-        job = bar.add_task("planning", total=total)
-
-        def tick(label: str, _done: int) -> None:
-            bar.update(job, advance=1, description=label)
-
-        results = run_planning_bench(
-            tasks,
-            seeds,
-            te=te,
-            planner=planner,
-            no_demo_seeds=no_demo_seeds,
-            no_demo_budget=no_demo_budget,
-            progress=tick,
-        )
-    table = Table(title="Planning with demonstrated key poses (Table I protocol)")
-    for col in (
-        "task",
-        "planner",
-        "runs",
-        "poses avail.",
-        "used",
-        "median s",
-        "p90 s",
-        "success",
-        "paper used",
-        "paper s",
-    ):
-        table.add_column(col)
-    for r in results:
-        modes = [r.demo] + ([r.no_demo] if r.no_demo is not None else [])
-        for s in modes:
-            demo_row = s.mode == "demo"
-            table.add_row(
-                r.task,
-                s.mode,
-                str(s.n),
-                str(s.candidates) if demo_row else "-",
-                f"{s.used_min}-{s.used_max}" if demo_row else "-",
-                f"{s.time_median:.3f}",
-                f"{s.time_p90:.3f}",
-                f"{100 * s.success_rate:.0f} %",
-                f"{r.paper_used[0]}-{r.paper_used[1]} of {r.paper_candidates}" if demo_row else "",
-                f"{r.paper_time[0]}-{r.paper_time[1]}" if demo_row else "",
-            )
-    out.print(table)
-    for r in results:
-        if r.speedup is not None:
-            bound = ">= " if r.speedup_is_bound else ""
-            out.print(
-                f"{r.task}: speed-up with demonstration {bound}{r.speedup:.0f}x "
-                f"(median over {r.no_demo.n} seeds, no-demo budget {r.no_demo.budget_s:g} s)"
-            )
-    if write:
-        command = "teachfit bench planning " + shlex.join(sys.argv[3:]) if sys.argv else ""
-        path = append_markdown(to_markdown(results, command=command.strip()), benchmarks)
-        out.print(f"appended to {path}")
-    return results
-
-
 @bench_app.command("planning")
+@guarded
 def bench_planning_cmd(
     tasks: Annotated[str, typer.Option(help="comma-separated task names")] = "l-groove,tenon",
     seeds: Annotated[int, typer.Option(min=1, help="seeds per task")] = 50,
     te: Annotated[float, typer.Option(help="budget per attempt (s) with demonstration")] = 0.01,
+    max_checks: Annotated[
+        int | None,
+        typer.Option(help="budget per attempt with demonstration in collision checks, not --te"),
+    ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
     no_demo_seeds: Annotated[int, typer.Option(min=0, help="seeds run without demonstration")] = 5,
     no_demo_budget: Annotated[float, typer.Option(help="budget (s) without demonstration")] = 30.0,
     write: Annotated[
-        bool, typer.Option("--write", help="append the table to BENCHMARKS.md")
+        bool, typer.Option("--write", help="append the table to --benchmarks")
     ] = False,
+    benchmarks: Annotated[Path, typer.Option(help="markdown file --write appends to")] = Path(
+        "BENCHMARKS.md"
+    ),
 ) -> None:
     """Table I of the paper over many seeds, with and without demonstration."""
-    try:
-        bench_planning(
-            [t.strip() for t in tasks.split(",") if t.strip()],
-            seeds,
-            te=te,
-            planner=planner,
-            no_demo_seeds=no_demo_seeds,
-            no_demo_budget=no_demo_budget,
-            write=write,
+    from teachfit.bench import planning as bp
+
+    cfg = bp.PlanningBenchConfig(
+        tasks=tuple(t.strip() for t in tasks.split(",") if t.strip()),
+        seeds=seeds,
+        te=te,
+        max_checks=max_checks,
+        planner=planner,
+        no_demo_seeds=no_demo_seeds,
+        no_demo_budget=no_demo_budget,
+    )
+    with progress_bar() as bar:
+        job = bar.add_task("planning", total=cfg.n_runs)
+        results = bp.run_planning_bench(
+            cfg, progress=lambda label, _done: bar.update(job, advance=1, description=label)
         )
-    except TeachfitError as exc:
-        raise _fail(exc) from exc
+    table = Table(title="Planning with demonstrated key poses (Table I protocol)")
+    for col in bp.TABLE_COLUMNS:
+        table.add_column(col)
+    for row in bp.report_table(results):
+        table.add_row(*row)
+    console.print(table)
+    for line in bp.report_notes(results):
+        console.print(line)
+    if write:
+        path = bp.append_markdown(bp.to_markdown(results, command=cfg.command()), benchmarks)
+        console.print(f"appended to {path}")

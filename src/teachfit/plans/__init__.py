@@ -22,6 +22,7 @@ from teachfit.plans.planner import (
     PlannerConfig,
     PlanResult,
     matrix_to_state,
+    seed_ompl,
 )
 from teachfit.plans.synth import nominal_keyframes, synth_demo
 
@@ -45,5 +46,6 @@ __all__ = [
     "pose_parameters",
     "pose_to_matrix",
     "rank_key_poses",
+    "seed_ompl",
     "synth_demo",
 ]

@@ -123,14 +123,15 @@ class CollisionChecker:
         """Collision test for ``L2G`` given as position (m) and quaternion w-x-y-z (hot path)."""
         self._L2G.setRotation(quat_to_matrix(w, qx, qy, qz))
         self._L2G.setTranslation(np.array((x, y, z)))
-        self._cres.clear()
-        self.n_checks += 1
-        self._collide(self._L2G, self._G, self._creq, self._cres)
-        return self._cres.isCollision()
+        return self._check()
 
     def collides(self, L2G: np.ndarray) -> bool:
         """Collision test for a (4, 4) pose ``L2G`` of the moving part in ``G``."""
         self._set(L2G)
+        return self._check()
+
+    def _check(self) -> bool:
+        """Collision test at the pose already set; counted in ``n_checks``."""
         self._cres.clear()
         self.n_checks += 1
         self._collide(self._L2G, self._G, self._creq, self._cres)

@@ -7,6 +7,12 @@ tries the straight motion, and solved segments are reused by later attempts. A k
 collision is replaced by the nearest collision-free pose sampled around it. The final path is
 shortcut and smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
 
+Every query seeds OMPL's global RNG from its ``seed`` (:func:`seed_ompl`), so the samplers of
+the planners and of the path simplifier it creates draw the same numbers whatever ran before in
+the process (worker processes included). With a budget in collision checks
+(``PlannerConfig.max_checks``) instead of seconds, a query's result is a function of its
+inputs and seed alone, whatever the machine's speed or load.
+
 States are ``(7,)`` arrays ``[x, y, z, qw, qx, qy, qz]``: ``L2G`` in m and a unit quaternion.
 """
 
@@ -27,7 +33,14 @@ from teachfit.plans.collision import CollisionChecker, pose_to_matrix
 from teachfit.plans.keyposes import KeyPoses, rank_key_poses
 from teachfit.plans.parts import Assembly
 
-__all__ = ["PLANNERS", "MotionPlanner", "PlanResult", "PlannerConfig", "matrix_to_state"]
+__all__ = [
+    "PLANNERS",
+    "MotionPlanner",
+    "PlanResult",
+    "PlannerConfig",
+    "matrix_to_state",
+    "seed_ompl",
+]
 
 ou.setLogLevel(ou.LogLevel.LOG_ERROR)
 
@@ -41,6 +54,30 @@ PLANNERS: dict[str, Callable[[ob.SpaceInformation], ob.Planner]] = {
     "PRM": og.PRM,
 }
 """OMPL geometric planners selectable by name."""
+
+
+def seed_ompl(seed: int) -> None:
+    """Seed OMPL's global RNG: every OMPL sampler created afterwards draws from ``seed``.
+
+    OMPL derives the seed of each new random generator (a planner's sampler, a path simplifier)
+    from this global one; reseeding after the first draw in a process works (ompl 2.0) but logs
+    an error, which is silenced here. OMPL ignores a seed of 0, so ``seed`` maps to ``seed + 1``.
+
+    Raises
+    ------
+    PlanningError
+        ``seed`` is not an integer in ``[0, 2**32 - 2]``.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise PlanningError(f"seed must be an integer, got {seed!r}")
+    if not 0 <= int(seed) <= 2**32 - 2:
+        raise PlanningError(f"seed must be in [0, 2**32 - 2], got {seed}")
+    level = ou.getLogLevel()
+    ou.setLogLevel(ou.LogLevel.LOG_NONE)
+    try:
+        ou.RNG.setSeed(int(seed) + 1)
+    finally:
+        ou.setLogLevel(level)
 
 
 def matrix_to_state(T: np.ndarray) -> np.ndarray:
@@ -61,6 +98,9 @@ class PlannerConfig:
         Time budget (s) of one attempt; when exceeded the next key pose is inserted. The paper
         used 5 s with Panda3D's collision checks in Python; t_e is in effect a budget of
         samples, and our coal checks are orders of magnitude faster, so the default is 0.02 s.
+    max_checks : int or None
+        Budget of one attempt in collision checks instead of ``te`` seconds (``te`` is then
+        ignored): the result of a query no longer depends on the machine's speed or load.
     resolution : float
         Longest motion (m; rotations count as the motion of the part's farthest vertex) that
         OMPL checks without an intermediate state.
@@ -89,12 +129,15 @@ class PlannerConfig:
     repair_samples: int = 64
     first_key_poses: int = 0
     key_region: float | None = None
+    max_checks: int | None = None
 
     def __post_init__(self) -> None:
         if self.planner not in PLANNERS:
             raise PlanningError(f"unknown planner {self.planner!r}; known: {', '.join(PLANNERS)}")
         if not self.te > 0 or not self.resolution > 0 or not self.verify_resolution > 0:
             raise PlanningError("te, resolution and verify_resolution must be > 0")
+        if self.max_checks is not None and self.max_checks < 1:
+            raise PlanningError(f"max_checks must be >= 1 or None, got {self.max_checks}")
         if (
             self.smooth_steps < 0
             or self.repair_samples < 1
@@ -259,18 +302,25 @@ class MotionPlanner:
         return None
 
     # -- segments -----------------------------------------------------------------------------
-    def _plan_segment(self, a: np.ndarray, b: np.ndarray, budget: float) -> np.ndarray | None:
+    def _plan_segment(
+        self, a: np.ndarray, b: np.ndarray, budget: float, by_checks: bool
+    ) -> np.ndarray | None:
+        """Path from ``a`` to ``b`` within ``budget`` (collision checks or seconds), or None."""
         sa, sb = self._to_ompl(a), self._to_ompl(b)
         if self.si.checkMotion(sa, sb):
             return np.stack([a, b])
-        if budget <= 1e-3:
+        if budget < (1.0 if by_checks else 1e-3):
             return None
         ss = og.SimpleSetup(self.si)
         # ompl 2.0.1 crashes if SimpleSetup.setup() runs before start and goal are set; solve()
         # calls setup() itself, so set them first and never call setup() explicitly.
         ss.setStartAndGoalStates(sa, sb)
         ss.setPlanner(PLANNERS[self.config.planner](self.si))
-        ss.solve(float(budget))
+        if by_checks:
+            checker, limit = self.checker, self.checker.n_checks + int(budget)
+            ss.solve(ob.PlannerTerminationCondition(lambda: checker.n_checks >= limit))
+        else:
+            ss.solve(float(budget))
         if not ss.haveExactSolutionPath():
             return None
         path = ss.getSolutionPath()
@@ -278,7 +328,12 @@ class MotionPlanner:
 
     # -- public -------------------------------------------------------------------------------
     def plan(
-        self, demo: object | None = None, *, te: float | None = None, seed: int = 0
+        self,
+        demo: object | None = None,
+        *,
+        te: float | None = None,
+        max_checks: int | None = None,
+        seed: int = 0,
     ) -> PlanResult:
         """Plan from start to goal, inserting ranked key poses of ``demo`` as needed.
 
@@ -289,19 +344,28 @@ class MotionPlanner:
             plans without one (a single attempt of ``te`` seconds).
         te : float, optional
             Budget (s) per attempt; defaults to ``config.te``.
+        max_checks : int, optional
+            Budget per attempt in collision checks instead of seconds; defaults to
+            ``config.max_checks`` (None: the budget is ``te``).
         seed : int
-            Seed of the key-pose repair sampling (OMPL's own sampler is seeded per process).
+            Seed of the key-pose repair sampling and of OMPL's samplers (:func:`seed_ompl`).
 
         Raises
         ------
         PlanningError
-            Demonstration of another task, or with fewer than two poses.
+            Demonstration of another task, or with fewer than two poses; a bad budget or seed.
         """
         t0 = time.perf_counter()
         checks0 = self.checker.n_checks
         te = self.config.te if te is None else float(te)
         if not te > 0:
             raise PlanningError(f"te must be > 0 s, got {te!r}")
+        checks = self.config.max_checks if max_checks is None else max_checks
+        if checks is not None and checks < 1:
+            raise PlanningError(f"max_checks must be >= 1, got {checks!r}")
+        by_checks = checks is not None
+        budget_of_attempt = float(checks) if by_checks else te
+        seed_ompl(seed)
         rng = np.random.default_rng(seed)
         keys: KeyPoses | None = None
         if demo is not None:
@@ -319,16 +383,17 @@ class MotionPlanner:
             ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
             states = {-1: self.start, n_cand: self.goal} | {i: repaired[i] for i in ids[1:-1]}
             attempts += 1
-            ta = time.perf_counter()
+            ta, ca = time.perf_counter(), self.checker.n_checks
             pieces = []
             for a, b in zip(ids[:-1], ids[1:], strict=True):
                 if (a, b) in solved:
                     pieces.append(solved[(a, b)])
                     continue
-                budget = te - (time.perf_counter() - ta)
+                spent = self.checker.n_checks - ca if by_checks else time.perf_counter() - ta
+                budget = budget_of_attempt - spent
                 if failed.get((a, b), -1.0) * 1.5 >= budget:
-                    break  # failed before with as much time: insert another key pose
-                seg = self._plan_segment(states[a], states[b], budget)
+                    break  # failed before with as much budget: insert another key pose
+                seg = self._plan_segment(states[a], states[b], budget, by_checks)
                 if seg is None:
                     failed[(a, b)] = budget
                     break
@@ -358,6 +423,7 @@ class MotionPlanner:
                     message="ok" if path is not None else "path failed dense verification",
                     key_poses=keys,
                 )
+        per_attempt = f"{checks} collision checks" if by_checks else f"te={te} s"
         return PlanResult(
             success=False,
             path=np.empty((0, 7)),
@@ -369,7 +435,7 @@ class MotionPlanner:
             replaced_key_poses=sum(1 for v in repaired.values() if v is None),
             collision_checks=self.checker.n_checks - checks0,
             planner=self.config.planner,
-            message=f"no path within te={te} s per attempt after {attempts} attempt(s)",
+            message=f"no path within {per_attempt} per attempt after {attempts} attempt(s)",
             key_poses=keys,
         )
 

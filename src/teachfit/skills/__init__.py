@@ -5,7 +5,13 @@ from teachfit.skills.follow import FollowConfig, FollowSetpoints, follow_skill
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.library import SKILLS, get_skill
 from teachfit.skills.loader import load_skill, skill_to_toml
-from teachfit.skills.params import ContextParam, LearnedParam, SkillParams, read_params_toml
+from teachfit.skills.params import (
+    ContextParam,
+    LearnedParam,
+    SkillParams,
+    read_params_toml,
+    write_params_toml,
+)
 
 __all__ = [
     "SKILLS",
@@ -21,5 +27,6 @@ __all__ = [
     "get_skill",
     "load_skill",
     "read_params_toml",
+    "write_params_toml",
     "skill_to_toml",
 ]

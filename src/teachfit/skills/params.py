@@ -14,6 +14,8 @@ per execution, never in the control loop.
 from __future__ import annotations
 
 import math
+import os
+import tempfile
 import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -177,3 +179,44 @@ def read_params_toml(
         return params.check_learned(data, users)
     except SkillError as exc:
         raise SkillError(f"{path}: {exc}") from exc
+
+
+def write_params_toml(path: str | Path, params: Mapping[str, float], header: str = "") -> Path:
+    """Learned values as a TOML ``[params]`` table that :func:`read_params_toml` reads back.
+
+    ``header`` becomes ``#`` comment lines. The file is written atomically: to a temporary file
+    in the same folder, then moved onto ``path`` (``os.replace``), so a reader sees the old file
+    or the new one, never half of one; on failure the temporary file is removed.
+
+    Raises
+    ------
+    SkillError
+        A name that is not an identifier, a value that is not a finite number, or the file
+        cannot be written.
+    """
+    path = Path(path)
+    lines = [f"# {line}" for line in header.splitlines()] + ["[params]"]
+    for name, v in params.items():
+        if not name.isidentifier():
+            raise SkillError(f"parameter names must be identifiers, got {name!r}")
+        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            raise SkillError(f"parameter {name!r} must be a finite number, got {v!r}")
+        lines.append(f"{name} = {float(v)!r}")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise SkillError(f"cannot write parameter file {path}: {exc}") from exc
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            os.fchmod(fh.fileno(), 0o644)  # mkstemp creates 0600; a parameter file is shared
+            fh.write("\n".join(lines) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException as exc:
+        Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise SkillError(f"cannot write parameter file {path}: {exc}") from exc
+        raise
+    return path
