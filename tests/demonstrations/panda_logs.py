@@ -6,6 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from rosbags.rosbag1 import Writer as Writer1
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.typesys import Stores, get_typestore
 
 RATE = 20.0
 FIELDS = ("x", "y", "z", "qx", "qy", "qz", "qw", "fx", "fy", "fz", "tx", "ty", "tz")
@@ -18,8 +22,14 @@ def tool_down_quat(yaw: np.ndarray) -> np.ndarray:
     return np.stack([zeros, np.cos(half), np.sin(half), zeros], axis=1)
 
 
-def _phase(seconds: float, rng: np.random.Generator, start: np.ndarray, end: np.ndarray,
-           contact: bool, yaw: tuple[float, float]) -> dict[str, np.ndarray]:  # fmt: skip
+def _phase(
+    seconds: float,
+    rng: np.random.Generator,
+    start: np.ndarray,
+    end: np.ndarray,
+    contact: bool,
+    yaw: tuple[float, float],
+) -> dict[str, np.ndarray]:
     n = int(round(seconds * RATE))
     s = np.linspace(0.0, 1.0, n, endpoint=False)[:, None]
     pos = start + (end - start) * s
@@ -85,8 +95,7 @@ def write_log(
         cols.insert(0, ((epoch + log["t"]) * time_factor)[:, None])
         header.insert(0, time_column)
         fmt.insert(0, "%.3f")
-    np.savetxt(path, np.hstack(cols), fmt=fmt, delimiter=",", header=",".join(header),
-               comments="")  # fmt: skip
+    np.savetxt(path, np.hstack(cols), fmt=fmt, delimiter=",", header=",".join(header), comments="")
     return path
 
 
@@ -106,3 +115,87 @@ def write_map(path: Path, *, time: str | None = "t_ms", **options: object) -> Pa
     lines += [f'{k} = "{k}"' for k in ("fx", "fy", "fz", "tx", "ty", "tz")]
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+EPOCH_NS = 1_718_023_402_000_000_000
+POSE, WRENCH, TF = (
+    "geometry_msgs/msg/PoseStamped",
+    "geometry_msgs/msg/WrenchStamped",
+    ("tf2_msgs/msg/TFMessage"),
+)
+
+
+def _header(ts, ns: int, frame: str, ros1: bool):
+    stamp = ts.types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+    header = ts.types["std_msgs/msg/Header"]
+    return (
+        header(seq=0, stamp=stamp, frame_id=frame) if ros1 else header(stamp=stamp, frame_id=frame)
+    )
+
+
+def _pose_msg(ts, kind: str, ns: int, pos, quat, ros1: bool, frame: str = "panda_link0"):
+    t = ts.types
+    w, x, y, z = quat
+    if kind == POSE:
+        pose = t["geometry_msgs/msg/Pose"](
+            position=t["geometry_msgs/msg/Point"](x=pos[0], y=pos[1], z=pos[2]),
+            orientation=t["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
+        )
+        return t[POSE](header=_header(ts, ns, frame, ros1), pose=pose)
+    transforms = []
+    for child, offset in (("panda_hand_tcp", 0.0), ("camera", 1.0)):
+        transform = t["geometry_msgs/msg/Transform"](
+            translation=t["geometry_msgs/msg/Vector3"](x=pos[0] + offset, y=pos[1], z=pos[2]),
+            rotation=t["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
+        )
+        transforms.append(
+            t["geometry_msgs/msg/TransformStamped"](
+                header=_header(ts, ns, frame, ros1), child_frame_id=child, transform=transform
+            )
+        )
+    return t[TF](transforms=transforms)
+
+
+def _wrench_msg(ts, ns: int, wrench, ros1: bool, frame: str):
+    t = ts.types
+    vec = t["geometry_msgs/msg/Vector3"]
+    body = t["geometry_msgs/msg/Wrench"](force=vec(*wrench[:3]), torque=vec(*wrench[3:]))
+    return t[WRENCH](header=_header(ts, ns, frame, ros1), wrench=body)
+
+
+def write_bag(
+    path: Path,
+    storage: str = "ros1",
+    pose_kind: str = POSE,
+    wrench_frame: str = "panda_link0",
+    wrench_sign: float = 1.0,
+) -> dict[str, np.ndarray]:
+    """A 25 s search at 20 Hz: poses at the log's stamps, wrenches at 50 Hz offset by 3 ms.
+
+    Returns the generated log (``t`` s, ``pos``, ``quat``, ``wrench`` at the pose stamps).
+    """
+    log = panda_log("search")
+    ros1 = storage == "ros1"
+    ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+    w_t = np.arange(0.003, log["t"][-1] + 0.1, 0.02)
+    w_values = np.column_stack([np.interp(w_t, log["t"], log["wrench"][:, k]) for k in range(6)])
+    if ros1:
+        writer = Writer1(path)
+    else:
+        plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+        writer = Writer2(path, version=9, storage_plugin=plugin)
+    serialize = ts.serialize_ros1 if ros1 else ts.serialize_cdr
+    with writer:
+        pose_conn = writer.add_connection("/tcp_pose", pose_kind, typestore=ts)
+        wrench_conn = writer.add_connection("/ft_sensor", WRENCH, typestore=ts)
+        events = [(int(round(t * 1e9)), 0, i) for i, t in enumerate(log["t"])]
+        events += [(int(round(t * 1e9)), 1, i) for i, t in enumerate(w_t)]
+        for ns, kind, i in sorted(events):
+            stamp = EPOCH_NS + ns
+            if kind == 0:
+                msg = _pose_msg(ts, pose_kind, stamp, log["pos"][i], log["quat"][i], ros1)
+                writer.write(pose_conn, stamp + 1_000_000, serialize(msg, pose_kind))
+            else:
+                msg = _wrench_msg(ts, stamp, wrench_sign * w_values[i], ros1, wrench_frame)
+                writer.write(wrench_conn, stamp + 1_000_000, serialize(msg, WRENCH))
+    return log

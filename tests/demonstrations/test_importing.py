@@ -111,8 +111,9 @@ def test_base_frame_is_transformed_or_noted(make_log) -> None:
     # 180 deg about z: x and y flip, then the offset; forces rotate the same way
     np.testing.assert_allclose(demo.pos[0], [-0.45 - 0.45, 0.10 + 0.10, 0.30 - 0.20], atol=1e-6)
     np.testing.assert_allclose(demo.wrench[:, :3], log.wrench[:, :3] * [-1, -1, 1], atol=1e-12)
-    anchored = build_demos(log, task="peg2d", name="run", options=ImportOptions(FrameTransform(
-        first_pose=True)))  # fmt: skip
+    anchored = build_demos(
+        log, task="peg2d", name="run", options=ImportOptions(FrameTransform(first_pose=True))
+    )
     (demo,) = anchored.demos
     assert demo.frame == "panda_link0_start"
     np.testing.assert_allclose(demo.pos[0], 0.0, atol=1e-15)
