@@ -150,9 +150,16 @@ def build_demos(log: RawLog, *, task: str, name: str, options: ImportOptions) ->
             meta.update(segment=k, segment_start_s=float(piece.t[0]), segmented_by=seg.mode)
         try:
             demo = Demonstration(
-                t=t, pos=pos, quat=quat, wrench=wrench, task=task, source="imported",
-                frame=frame, name=label, meta=meta,
-            )  # fmt: skip
+                t=t,
+                pos=pos,
+                quat=quat,
+                wrench=wrench,
+                task=task,
+                source="imported",
+                frame=frame,
+                name=label,
+                meta=meta,
+            )
         except DatasetError as exc:  # not expected after the reader's checks
             raise DatasetError(f"{context}{exc}", path=log.path) from exc
         demos.append(demo)
