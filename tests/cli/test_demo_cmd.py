@@ -183,3 +183,22 @@ def test_export_round_trip(tmp_path: Path) -> None:
     assert res.exit_code == 2 and shows(res, "index 7 out of range: the file holds 2 demos")
     res = invoke("demo", "export", f"{h5}:0", "--out", out)
     assert res.exit_code == 2 and shows(res, "file exists")
+
+
+def test_transform_option_and_options_for_the_other_kind(tmp_path: Path) -> None:
+    res, *_, out = import_log(
+        tmp_path, "search", None, None, "--transform", "world:0,0,-0.2,1,0,0,0"
+    )
+    assert res.exit_code == 0, res.output
+    assert not shows(res, "not the simulation world")
+    (demo,) = read_dataset(out)
+    assert demo.frame == "world" and demo.meta["source2frame"] == [0, 0, -0.2, 1, 0, 0, 0]
+    assert demo.pos[0, 2] == pytest.approx(0.10, abs=1e-6)
+    res, *_ = import_log(tmp_path, "search", None, None, "--transform", "world:0,0")
+    assert_refused(res, tmp_path / "none.h5", "'FRAME:x,y,z,qw,qx,qy,qz'")
+    res, *_ = import_log(tmp_path, "search", None, None, "--pose-topic", "/tcp_pose")
+    assert_refused(res, tmp_path / "none.h5", "--pose-topic is for ROS bags")
+    bag = tmp_path / "run.bag"
+    write_bag(bag)
+    res = invoke("demo", "import", bag, "--pose-topic", "/tcp_pose", "--rate", 20, "--out", out)
+    assert_refused(res, tmp_path / "none.h5", "drop --rate")

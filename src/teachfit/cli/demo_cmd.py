@@ -109,10 +109,24 @@ def import_(
     if is_bag(log):
         if pose_topic is None:
             raise TeachfitError(f"{log} is a bag: give --pose-topic (and --wrench-topic)")
+        if rate is not None:
+            raise TeachfitError(f"{log} is a bag: its header stamps give the time, drop --rate")
         raw = read_bag(
             log, pose_topic, wrench_topic, wrench_sign=wrench_sign, child_frame=child_frame
         )
     else:
+        bag_only = {
+            "--pose-topic": pose_topic,
+            "--wrench-topic": wrench_topic,
+            "--child-frame": child_frame,
+            "--wrench-sign": None if wrench_sign == 1 else 1,
+        }
+        given = [option for option, value in bag_only.items() if value is not None]
+        if given:
+            raise TeachfitError(
+                f"{given[0]} is for ROS bags; {log} is read as CSV with the map {columns}"
+                + (" (set wrench_sign there)" if given[0] == "--wrench-sign" else "")
+            )
         the_map = ColumnMap.from_toml(columns, rate_hz=rate)
         frame = frame or the_map.transform
         raw = read_csv_log(log, the_map)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import csv
 import io
 from collections import Counter
+from dataclasses import replace
 from decimal import Decimal, InvalidOperation
 from functools import partial
 from pathlib import Path
@@ -250,7 +251,7 @@ def import_csv(
         The log: one header line, then one sample per line.
     columns : ColumnMap
         Which columns to read, their units and conventions; its ``transform`` is applied unless
-        ``options`` gives one.
+        ``options`` gives another.
     task : str
         Task name stored in the demonstration.
     name : str, optional
@@ -271,6 +272,8 @@ def import_csv(
         For unreadable input (see :func:`read_csv_log`) or a failed plausibility check.
     """
     log = read_csv_log(csv_path, columns)
-    options = options or ImportOptions(transform=columns.transform)
+    options = options or ImportOptions()
+    if options.transform is None:
+        options = replace(options, transform=columns.transform)
     result = build_demos(log, task=task, name=name or Path(csv_path).stem, options=options)
     return result.demos[0]

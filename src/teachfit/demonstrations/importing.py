@@ -8,8 +8,9 @@ piece is re-anchored at its first pose if asked, re-timed to start at t = 0 and 
 
 Each demonstration's ``meta`` records where it came from: ``source_file``, ``source_format``,
 ``source_frame``, ``source2frame`` (pose of the log frame in the stored frame, ``[x, y, z, qw,
-qx, qy, qz]``), ``time_offset_s`` (first time stamp, s), ``source_rows`` (first and last row)
-and, for a piece of a segmented log, ``segment`` and ``segment_start_s``.
+qx, qy, qz]``), ``time_offset_s`` (first time stamp, s), ``source_rows`` (first and last CSV
+row or bag message) and, for a piece of a segmented log, ``segment``, ``segment_start_s`` and
+``segmented_by``.
 """
 
 from __future__ import annotations
@@ -124,7 +125,7 @@ def build_demos(log: RawLog, *, task: str, name: str, options: ImportOptions) ->
         context = (
             ""
             if seg is None
-            else f"demonstration {label} (rows {piece.rows[0]}-{piece.rows[-1]}): "
+            else f"demonstration {label} ({log.row_word} {piece.rows[0]}-{piece.rows[-1]}): "
         )
         pos, quat, wrench, frame, pose = (
             piece.pos,

@@ -91,7 +91,7 @@ def check_orientation(log: RawLog, limits: Limits) -> Finding | None:
     if steps.size and steps.max() > limits.max_step_rad:
         i = int(np.argmax(steps))
         message = (
-            f"the orientation jumps by {math.degrees(steps[i]):.0f} deg between rows "
+            f"the orientation jumps by {math.degrees(steps[i]):.0f} deg between {log.row_word} "
             f"{log.rows[i]} and {log.rows[i + 1]}"
         )
         return Finding("orientation", message, f"check the quaternion columns and {order}")

@@ -72,11 +72,17 @@ class RawLog:
         """Number of samples T."""
         return int(self.t.shape[0])
 
+    @property
+    def row_word(self) -> str:
+        """What :attr:`rows` count, for messages: CSV "rows" or bag "messages"."""
+        return "messages" if str(self.meta.get("source_format", "")).startswith("ros") else "rows"
+
     def hint(self, key: str, value: object) -> str:
         """How the user changes setting ``key`` to ``value`` for this log."""
         if self.fix_in is not None:
             return f"set {key} = {value} in {self.fix_in}"
-        return f"pass --{key.replace('_', '-')} {value}"
+        option = {"rate_hz": "rate"}.get(key, key).replace("_", "-")
+        return f"pass --{option} {value}"
 
     def sliced(self, start: int, stop: int) -> RawLog:
         """Samples ``start:stop`` (time not re-zeroed)."""
