@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from panda_logs import panda_log, tool_down_quat
@@ -45,14 +47,12 @@ def test_a_good_log_passes_every_check() -> None:
 
 def test_rate_suggests_the_scale_that_fits() -> None:
     log = panda_log("search")
-    ns = raw(t=log["t"] * 1e9)  # stamps in ns read as s
-    ns = RawLog(**{**ns.__dict__, "time_step_units": 0.05 * 1e9})
+    ns = replace(raw(t=log["t"] * 1e9), time_step_units=0.05 * 1e9)  # ns read as s
     finding = check_rate(ns, Limits())
     assert finding is not None and "if it is in ns, set time_scale = 1e-09 in map.toml" in (
         finding.fix
     )
-    cli = raw(fix_in=None, t=log["t"] * 1e3)
-    cli = RawLog(**{**cli.__dict__, "time_step_units": None})
+    cli = replace(raw(fix_in=None, t=log["t"] * 1e3), time_step_units=None)  # --rate 0.02
     assert "pass --rate <Hz>" in check_rate(cli, Limits()).fix
 
 

@@ -59,7 +59,7 @@ def test_windows_and_markers() -> None:
 def test_bad_settings_and_missing_data() -> None:
     with pytest.raises(DatasetError, match="segment by one of"):
         Segmenter("time")
-    with pytest.raises(DatasetError, match="must not exceed force_on_n") as info:
+    with pytest.raises(DatasetError, match="must not exceed the start force") as info:
         Segmenter("contact", force_on_n=2.0, force_off_n=3.0)
     assert info.value.column == "force_off_n"
     with pytest.raises(DatasetError, match="needs a wrench") as info:

@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.markup import escape
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
-from teachfit.demonstrations.column_map import ColumnMap
+from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
 from teachfit.demonstrations.dataset import (
     append_dataset,
@@ -26,9 +27,10 @@ from teachfit.demonstrations.plausibility import CHECKS
 from teachfit.demonstrations.rosbag_import import is_bag, read_bag
 from teachfit.demonstrations.segment import Segmenter
 from teachfit.demonstrations.teacher import PATTERNS, BlindTeacher, TeacherStyle
-from teachfit.errors import TeachfitError
+from teachfit.errors import DatasetError, TeachfitError
 from teachfit.tasks.registry import load_task
 
+T = TypeVar("T")
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)
 
 
@@ -55,6 +57,17 @@ def record(
         f"recorded {len(demos)} demonstration(s) of [bold]{the_task.name}[/] -> {out}"
         + (f" (discarded {len(discarded)}: {'; '.join(discarded)})" if discarded else "")
     )
+
+
+def _option(flag: str, build: Callable[..., T], *args: Any) -> T:
+    """``build(*args)``, its DatasetError reported against the command-line ``flag``."""
+    try:
+        return build(*args)
+    except DatasetError as exc:
+        option = {"force_off_n": "--force-off", "force_on_n": "--force-threshold"}.get(
+            exc.column or "", flag
+        )
+        raise TeachfitError(f"{option}: {bare(exc)}") from exc
 
 
 @app.command("import")
@@ -101,11 +114,11 @@ def import_(
     ] = None,
     accept_implausible: Annotated[bool, typer.Option(help="accept every failed check")] = False,
 ) -> None:
-    """Import a real robot log as demonstrations, appending to ``--out``."""
+    """Import a real robot log (CSV or ROS bag) as demonstrations, appending to --out."""
     load_task(task)
     if out.is_dir():
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
-    frame = None if transform is None else FrameTransform.parse(transform)
+    frame = None if transform is None else _option("--transform", FrameTransform.parse, transform)
     if is_bag(log):
         if pose_topic is None:
             raise TeachfitError(f"{log} is a bag: give --pose-topic (and --wrench-topic)")
@@ -132,8 +145,15 @@ def import_(
         raw = read_csv_log(log, the_map)
     segmenter = None
     if segment is not None:
-        segmenter = Segmenter(
-            segment, window, force_threshold, force_off, min_duration, marker_value
+        segmenter = _option(
+            "--segment",
+            Segmenter,
+            segment,
+            window,
+            force_threshold,
+            force_off,
+            min_duration,
+            marker_value,
         )
     accepted = frozenset(accept or ()) | ({"all"} if accept_implausible else set())
     options = ImportOptions(transform=frame, accept=accepted, segmenter=segmenter)

@@ -127,13 +127,8 @@ def build_demos(log: RawLog, *, task: str, name: str, options: ImportOptions) ->
             if seg is None
             else f"demonstration {label} ({log.row_word} {piece.rows[0]}-{piece.rows[-1]}): "
         )
-        pos, quat, wrench, frame, pose = (
-            piece.pos,
-            piece.quat,
-            piece.wrench,
-            piece.frame,
-            source2frame,
-        )
+        pos, quat, wrench = piece.pos, piece.quat, piece.wrench
+        frame, pose = piece.frame, source2frame
         if options.transform is not None and options.transform.first_pose:
             pos, quat, wrench, origin = options.transform.apply(pos, quat, wrench)
             frame = options.transform.target(piece.frame)
@@ -165,9 +160,9 @@ def build_demos(log: RawLog, *, task: str, name: str, options: ImportOptions) ->
             raise DatasetError(f"{context}{exc}", path=log.path) from exc
         demos.append(demo)
         force = None if wrench is None else float(np.linalg.norm(wrench[:, :3], axis=1).max())
-        extent = np.ptp(pos[:, :2], axis=0) * 1e3
+        ex, ey = (float(v) for v in np.ptp(pos[:, :2], axis=0) * 1e3)
         pieces.append(
-            Piece(label, float(piece.t[0]), demo.duration, demo.n_samples, tuple(extent), force)
+            Piece(label, float(piece.t[0]), demo.duration, demo.n_samples, (ex, ey), force)
         )
     if demos[0].frame != "world":
         notes.append(

@@ -58,7 +58,7 @@ class Segmenter:
                 raise DatasetError(f"must be positive, got {value!r}", column=label)
         if off > self.force_on_n:
             raise DatasetError(
-                f"must not exceed force_on_n ({self.force_on_n} N), got {off} N",
+                f"the end force must not exceed the start force ({self.force_on_n} N), got {off} N",
                 column="force_off_n",
             )
         if not (math.isfinite(self.min_duration_s) and self.min_duration_s >= 0):
