@@ -118,11 +118,10 @@ def write_map(path: Path, *, time: str | None = "t_ms", **options: object) -> Pa
 
 
 EPOCH_NS = 1_718_023_402_000_000_000
-POSE, WRENCH, TF = (
-    "geometry_msgs/msg/PoseStamped",
-    "geometry_msgs/msg/WrenchStamped",
-    ("tf2_msgs/msg/TFMessage"),
-)
+POSE = "geometry_msgs/msg/PoseStamped"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+TF = "tf2_msgs/msg/TFMessage"
+TRANSFORM = "geometry_msgs/msg/TransformStamped"
 
 
 def _header(ts, ns: int, frame: str, ros1: bool):
@@ -134,6 +133,8 @@ def _header(ts, ns: int, frame: str, ros1: bool):
 
 
 def _pose_msg(ts, kind: str, ns: int, pos, quat, ros1: bool, frame: str = "panda_link0"):
+    """A PoseStamped, a TransformStamped (to panda_hand_tcp) or a TFMessage (to panda_hand_tcp
+    and, 1 m away, camera) for one pose."""
     t = ts.types
     w, x, y, z = quat
     if kind == POSE:
@@ -153,7 +154,7 @@ def _pose_msg(ts, kind: str, ns: int, pos, quat, ros1: bool, frame: str = "panda
                 header=_header(ts, ns, frame, ros1), child_frame_id=child, transform=transform
             )
         )
-    return t[TF](transforms=transforms)
+    return transforms[0] if kind == TRANSFORM else t[TF](transforms=transforms)
 
 
 def _wrench_msg(ts, ns: int, wrench, ros1: bool, frame: str):

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from panda_logs import TF, write_bag
+from panda_logs import TF, TRANSFORM, write_bag
 
 from teachfit.demonstrations.importing import ImportOptions, build_demos
 from teachfit.demonstrations.rosbag_import import is_bag, read_bag
@@ -43,6 +43,13 @@ def test_mcap_file_and_tf_topic(tmp_path: Path) -> None:
     log = read_bag(mcap, "/tcp_pose", child_frame="panda_hand_tcp")
     assert log.wrench is None and log.n_samples == truth["t"].size
     np.testing.assert_allclose(log.pos, truth["pos"], atol=1e-12)
+
+
+def test_transform_stamped_topic(tmp_path: Path) -> None:
+    truth = write_bag(tmp_path / "run.bag", pose_kind=TRANSFORM)
+    log = read_bag(tmp_path / "run.bag", "/tcp_pose", "/ft_sensor")
+    assert log.frame == "panda_link0" and log.n_samples == truth["t"].size - 1
+    np.testing.assert_allclose(log.quat, truth["quat"][1:], atol=1e-12)
 
 
 def test_wrench_in_the_sensor_frame_is_rotated(tmp_path: Path) -> None:
