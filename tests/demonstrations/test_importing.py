@@ -93,9 +93,7 @@ def test_robot_wrench_stored_as_the_environments(make_log) -> None:
 def test_example_map_sign_on_an_environment_wrench_log(make_log) -> None:
     csv, cmap = make_log("search", cmap={"wrench_sign": -1})
     message = refused(csv, cmap)
-    assert f"the environment exerts, already: flip wrench_sign, set wrench_sign = 1 in {cmap}" in (
-        message
-    )
+    assert f"-1 negates it: flip wrench_sign, set wrench_sign = 1 in {cmap}" in (message)
 
 
 def test_base_frame_is_transformed_or_noted(make_log) -> None:

@@ -132,8 +132,13 @@ def check_wrench_sign(log: RawLog, limits: Limits) -> Finding | None:
         f"(median fz = {fz:+.1f} N in {log.frame!r}); pressing down, the environment pushes the "
         "tool up (+z)"
     )
-    what = "the robot applies" if sign == 1 else "the environment exerts, already"
-    fix = f"the log holds the wrench {what}: flip wrench_sign, " + log.hint("wrench_sign", -sign)
+    what = (
+        "the log holds the wrench the robot applies"
+        if sign == 1
+        else "the log already holds the wrench the environment exerts, and wrench_sign = -1 "
+        "negates it"
+    )
+    fix = f"{what}: flip wrench_sign, " + log.hint("wrench_sign", -sign)
     return Finding("wrench_sign", message, fix)
 
 
