@@ -1,25 +1,36 @@
-"""``teachfit demo ...``: record, import and show demonstrations."""
+"""``teachfit demo ...``: record, import, export and show demonstrations."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any, TypeVar
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from teachfit.cli.common import RobotOpt, console, guarded
-from teachfit.core.errors import TeachfitError
-from teachfit.demonstrations.csv_import import ColumnMap, import_csv
+from teachfit.core.errors import DatasetError, TeachfitError
+from teachfit.demonstrations.column_map import ColumnMap, bare
+from teachfit.demonstrations.csv_import import read_csv_log
 from teachfit.demonstrations.dataset import (
     append_dataset,
     dataset_summary,
     read_dataset,
+    read_demo,
     write_dataset,
 )
+from teachfit.demonstrations.export import export_csv
+from teachfit.demonstrations.frames import FrameTransform
+from teachfit.demonstrations.importing import ImportOptions, build_demos
+from teachfit.demonstrations.plausibility import CHECKS
+from teachfit.demonstrations.rosbag_import import is_bag, read_bag
+from teachfit.demonstrations.segment import Segmenter
 from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
 from teachfit.tasks.registry import load_task
 
+T = TypeVar("T")
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)
 
 
@@ -49,22 +60,154 @@ def record(
     )
 
 
+def _option(flag: str, build: Callable[..., T], *args: Any) -> T:
+    """``build(*args)``, its DatasetError reported against the command-line ``flag``."""
+    try:
+        return build(*args)
+    except DatasetError as exc:
+        option = {"force_off_n": "--force-off", "force_on_n": "--force-threshold"}.get(
+            exc.column or "", flag
+        )
+        raise TeachfitError(f"{option}: {bare(exc)}") from exc
+
+
 @app.command("import")
 @guarded
 def import_(
-    csv_file: Annotated[Path, typer.Argument(help="robot log (CSV)")],
+    log: Annotated[
+        Path, typer.Argument(help="robot log: CSV, ROS 1 .bag, ROS 2 bag folder, .db3 or .mcap")
+    ],
     task: Annotated[str, typer.Option(help="task the log demonstrates")] = "peg2d",
-    columns: Annotated[Path, typer.Option(help="column mapping TOML")] = Path("columns.toml"),
+    columns: Annotated[Path, typer.Option(help="CSV column map (TOML)")] = Path("columns.toml"),
     out: Annotated[Path, typer.Option(help="HDF5 file to write or append to")] = Path("demos.h5"),
-    name: Annotated[str | None, typer.Option(help="demonstration name")] = None,
+    name: Annotated[
+        str | None, typer.Option(help="demonstration name (default: file stem)")
+    ] = None,
+    rate: Annotated[
+        float | None, typer.Option(help="Hz, for a CSV log without a time column")
+    ] = None,
+    transform: Annotated[
+        str | None,
+        typer.Option(help="'first-pose' or 'FRAME:x,y,z,qw,qx,qy,qz' (log frame in FRAME)"),
+    ] = None,
+    pose_topic: Annotated[str | None, typer.Option(help="bag: pose topic")] = None,
+    wrench_topic: Annotated[str | None, typer.Option(help="bag: wrench topic")] = None,
+    wrench_sign: Annotated[
+        int, typer.Option(help="bag: +1 environment-on-tool wrench, -1 robot-applied")
+    ] = 1,
+    child_frame: Annotated[str | None, typer.Option(help="bag: child frame of a tf topic")] = None,
+    segment: Annotated[
+        str | None, typer.Option(help="cut into demonstrations: window, contact or marker")
+    ] = None,
+    window: Annotated[float, typer.Option(help="--segment window: length (s)")] = 30.0,
+    force_threshold: Annotated[
+        float, typer.Option(help="--segment contact: force (N) that starts a contact phase")
+    ] = 5.0,
+    force_off: Annotated[
+        float | None, typer.Option(help="--segment contact: force (N) that ends it (default half)")
+    ] = None,
+    min_duration: Annotated[float, typer.Option(help="shortest piece kept (s)")] = 1.0,
+    marker_value: Annotated[
+        str | None, typer.Option(help="--segment marker: keep runs with this value")
+    ] = None,
+    accept: Annotated[
+        list[str] | None, typer.Option(help=f"accept a failed check: {', '.join(CHECKS)}")
+    ] = None,
+    accept_implausible: Annotated[bool, typer.Option(help="accept every failed check")] = False,
 ) -> None:
-    """Import a real robot log (CSV) as a demonstration, appending to ``--out``."""
+    """Import a real robot log (CSV or ROS bag) as demonstrations, appending to --out."""
     load_task(task)
-    demo = import_csv(csv_file, ColumnMap.from_toml(columns), task=task, name=name)
-    append_dataset(out, [demo])
+    if out.is_dir():
+        raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
+    frame = None if transform is None else _option("--transform", FrameTransform.parse, transform)
+    if is_bag(log):
+        if pose_topic is None:
+            raise TeachfitError(f"{log} is a bag: give --pose-topic (and --wrench-topic)")
+        if rate is not None:
+            raise TeachfitError(f"{log} is a bag: its header stamps give the time, drop --rate")
+        raw = read_bag(
+            log, pose_topic, wrench_topic, wrench_sign=wrench_sign, child_frame=child_frame
+        )
+    else:
+        bag_only = {
+            "--pose-topic": pose_topic,
+            "--wrench-topic": wrench_topic,
+            "--child-frame": child_frame,
+            "--wrench-sign": None if wrench_sign == 1 else 1,
+        }
+        given = [option for option, value in bag_only.items() if value is not None]
+        if given:
+            raise TeachfitError(
+                f"{given[0]} is for ROS bags; {log} is read as CSV with the map {columns}"
+                + (" (set wrench_sign there)" if given[0] == "--wrench-sign" else "")
+            )
+        the_map = ColumnMap.from_toml(columns, rate_hz=rate)
+        frame = frame or the_map.transform
+        raw = read_csv_log(log, the_map)
+    segmenter = None
+    if segment is not None:
+        segmenter = _option(
+            "--segment",
+            Segmenter,
+            segment,
+            window,
+            force_threshold,
+            force_off,
+            min_duration,
+            marker_value,
+        )
+    accepted = frozenset(accept or ()) | ({"all"} if accept_implausible else set())
+    options = ImportOptions(transform=frame, accept=accepted, segmenter=segmenter)
+    result = build_demos(raw, task=task, name=name or log.stem, options=options)
+    for note in result.notes:
+        console.print(f"[yellow]note:[/] {escape(note)}")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)  # like learn/search/skill outputs
+    except OSError as exc:
+        raise TeachfitError(f"--out {out}: cannot create its folder ({exc.strerror})") from exc
+    append_dataset(out, list(result.demos))
+    table = Table(
+        title=f"{log} -> {out}", caption="start, duration: s; rate: Hz; extent: mm; |F|: N"
+    )
+    table.add_column("demonstration", no_wrap=True)
+    for col in ("start", "duration", "samples", "rate", "x-y extent", "peak |F|"):
+        table.add_column(col, justify="right", no_wrap=True)
+    for piece, demo in zip(result.pieces, result.demos, strict=True):
+        table.add_row(
+            piece.name,
+            f"{piece.start_s:.2f}",
+            f"{piece.duration_s:.2f}",
+            str(piece.samples),
+            f"{demo.rate_hz:.1f}",
+            f"{piece.extent_mm[0]:.1f} x {piece.extent_mm[1]:.1f}",
+            "-" if piece.peak_force_n is None else f"{piece.peak_force_n:.1f}",
+        )
+    console.print(table)
     console.print(
-        f"imported {demo.n_samples} samples ({demo.duration:.2f} s at {demo.rate_hz:.1f} Hz) "
-        f"from {csv_file} -> {out}"
+        f"imported {len(result.demos)} demonstration(s) in frame {result.demos[0].frame!r} "
+        f"from {log} -> {out}"
+    )
+
+
+@app.command("export")
+@guarded
+def export(
+    demo: Annotated[str, typer.Argument(help="FILE.h5:INDEX (or FILE.h5 for the first)")],
+    out: Annotated[Path, typer.Option(help="CSV file to write")] = Path("demo.csv"),
+    columns: Annotated[
+        Path | None, typer.Option(help="also write the column map that reads it back")
+    ] = None,
+    overwrite: Annotated[bool, typer.Option(help="replace existing files")] = False,
+) -> None:
+    """Export one demonstration as a CSV log (s, m, w-x-y-z, N, N*m)."""
+    the_demo = read_demo(demo)
+    for target in (out, columns):
+        if target is not None:
+            target.parent.mkdir(parents=True, exist_ok=True)
+    export_csv(the_demo, out, columns=columns, overwrite=overwrite)
+    console.print(
+        f"exported {the_demo.n_samples} samples of {the_demo.name or demo} "
+        f"(frame {the_demo.frame!r}) -> {out}" + (f", map -> {columns}" if columns else "")
     )
 
 
