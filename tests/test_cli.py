@@ -97,8 +97,10 @@ def test_import_csv_and_clear_errors(tmp_path):
     assert res.exit_code == 0, res.output
     columns = ColumnMap.from_toml(EXAMPLES / "columns.toml")
     lib = import_csv(EXAMPLES / "robot_log.csv", columns, task="peg2d")
-    printed = f"imported {lib.n_samples} samples ({lib.duration:.2f} s at {lib.rate_hz:.1f} Hz)"
-    assert printed in _flat(res.output)
+    flat = _flat(res.output)
+    assert "imported 1 demonstration(s)" in flat
+    row = f"{lib.duration:.2f} │ {lib.n_samples} │ {lib.rate_hz:.1f}"
+    assert row in " ".join(flat.split()), flat
     (stored,) = read_dataset(out)
     np.testing.assert_array_equal(stored.pos, lib.pos)
     np.testing.assert_array_equal(stored.wrench, lib.wrench)
