@@ -8,8 +8,9 @@ The kinematics and link inertias are Franka's published ones. Edits made here:
 - the gripper fingers, their tendon, equality and actuator are removed: the task's held part is
   rigidly attached under the Franka Hand at ``mount_offset`` from the flange (part frame = TCP,
   its +z axis pointing back at the flange). The hand's collision mesh collides with the cell;
-  the links' collision meshes do not (the arm works above the fixture, and leaving them out
-  keeps the collision pass cheap);
+  the links' collision meshes are left out (the arm works above the fixture; without them the
+  model compiles in a fraction of a second and the collision pass stays cheap), and so are the
+  visual meshes unless ``FR3Params.visual`` asks for them (rendering);
 - the position servos are replaced by torque motors: gain 1, no bias,
   ``ctrlrange = ±tau_max`` (87/87/87/87/12/12/12 N·m);
 - joint ranges are the FR3 datasheet's; joint friction is Gaz et al.'s identification
@@ -107,10 +108,12 @@ def _arm_spec(params: FR3Params) -> mujoco.MjSpec:
     hand = arm.body("hand")
     for geom in list(arm.geoms):
         visual = geom.contype == 0 and geom.conaffinity == 0
-        if visual and not params.visual:
+        if (visual and not params.visual) or (not visual and geom.parent.name != "hand"):
             arm.delete(geom)
-        elif not visual and geom.parent.name != "hand":
-            geom.contype = geom.conaffinity = 0
+    used = {g.meshname for g in arm.geoms}
+    for mesh in list(arm.meshes):
+        if mesh.name not in used:
+            arm.delete(mesh)
     arm.compiler.degree = False
     hand.add_site(name=FLANGE_SITE.removeprefix(ARM_PREFIX), size=[0.004] * 3, rgba=[0, 0, 1, 1])
     return arm

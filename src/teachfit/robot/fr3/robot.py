@@ -199,6 +199,7 @@ class FR3Robot:
 
     # ------------------------------------------------------------------------ faults
     def _limit_fault(self) -> None:
+        self._check_divergence()  # MuJoCo resets a diverged state: that is not a limit fault
         d = self.data
         q, dq = d.qpos, d.qvel
         bad_q = np.flatnonzero((q < self.q_min) | (q > self.q_max))
