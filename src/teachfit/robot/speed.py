@@ -3,6 +3,10 @@
 Both loops start from the same state: the tool pressed onto the surface at the teacher's start.
 The raw loop keeps the last controller wrench applied (``qfrc_applied`` persists), so it stays
 in the same contact; the controlled loop recomputes the impedance law every 1 ms tick.
+
+For the FR3 (``robot="fr3"``) the raw loop keeps the last joint torques (``ctrl`` persists) and
+the controlled loop runs the whole 1 ms tick (torque law, limits, wrench sensing); the torque
+law's compute time per tick is also timed on its own (median and 99th percentile).
 """
 
 from __future__ import annotations
@@ -13,8 +17,9 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from teachfit.robot.floating import FloatingToolRobot
+from teachfit.core.errors import TeachfitError
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.floating import FloatingToolRobot
 from teachfit.tasks.base import Task
 
 
@@ -45,8 +50,22 @@ def _pressed_robot(task: Task) -> tuple[FloatingToolRobot, ImpedanceCommand]:
     return robot, cmd
 
 
-def measure_sim_speed(task: Task, steps: int = 5000, repeats: int = 3) -> SimSpeed:
+@dataclass(frozen=True)
+class ArmSimSpeed(SimSpeed):
+    """:class:`SimSpeed` plus the torque law's compute time per tick (µs)."""
+
+    compute_p50_us: float = 0.0
+    compute_p99_us: float = 0.0
+
+
+def measure_sim_speed(
+    task: Task, steps: int = 5000, repeats: int = 3, robot: str = "floating"
+) -> SimSpeed:
     """Best-of-``repeats`` throughput of both loops, interleaved so load noise hits both."""
+    if robot == "fr3":
+        return measure_fr3_speed(task, steps, repeats)
+    if robot != "floating":
+        raise TeachfitError(f"no speed benchmark for robot {robot!r} (floating, fr3)")
     raw_best = ctl_best = 0.0
     contacts = 0
     for _ in range(repeats):
@@ -66,3 +85,67 @@ def measure_sim_speed(task: Task, steps: int = 5000, repeats: int = 3) -> SimSpe
         ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
     rtf = ctl_best * robot.control_period
     return SimSpeed(raw_best, ctl_best, ctl_best / raw_best, rtf, contacts)
+
+
+def _pressed_fr3(task: Task):  # -> tuple[FR3Robot, ImpedanceCommand]
+    from teachfit.robot.fr3 import FR3Robot
+
+    robot = FR3Robot(task)
+    start = task.teacher_start(np.random.default_rng(0))
+    robot.reset(start)
+    cmd = ImpedanceCommand(
+        pos=start.pos,
+        quat=start.quat,
+        lin_vel=[0.01, 0.0, 0.0],
+        wrench_ff=[0, 0, -6.0, 0, 0, 0],
+        stiffness=[1500, 150, 100, 40, 40, 40],
+        expires_after=60.0,
+    )
+    robot.command(cmd)
+    robot.step(300)  # settle into contact; the raw loop keeps the last torques (ctrl persists)
+    return robot, cmd
+
+
+def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSimSpeed:
+    """The FR3's figures: raw ``mj_step`` vs. the full controlled tick (best of ``repeats``,
+    interleaved), and the torque law's compute time per tick (p50, p99 over all ticks)."""
+    raw_best = ctl_best = 0.0
+    contacts = 0
+    samples: list[np.ndarray] = []
+    robot = None
+    for _ in range(repeats):
+        robot, cmd = _pressed_fr3(task)
+        m, d = robot.model, robot.data
+        snapshot = (d.qpos.copy(), d.qvel.copy(), d.ctrl.copy(), d.time)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            mujoco.mj_step(m, d)
+        raw_best = max(raw_best, steps / (time.perf_counter() - t0))
+        d.qpos[:], d.qvel[:], d.ctrl[:], d.time = snapshot
+        mujoco.mj_forward(m, d)
+        robot.command(cmd)
+        contacts = int(d.ncon)
+        t0 = time.perf_counter()
+        robot.step(steps)
+        ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
+        ctl, clock = robot.ctl, time.perf_counter_ns
+        ticks = np.empty(steps)
+        for k in range(steps):  # the torque law alone, in the same contact
+            mujoco.mj_step1(m, d)
+            t0 = clock()
+            d.ctrl[:] = ctl.compute(d.time)
+            ticks[k] = clock() - t0
+            mujoco.mj_step2(m, d)
+        samples.append(ticks / 1e3)
+    assert robot is not None
+    rtf = ctl_best * robot.control_period
+    per_tick = np.concatenate(samples)
+    return ArmSimSpeed(
+        raw_best,
+        ctl_best,
+        ctl_best / raw_best,
+        rtf,
+        contacts,
+        float(np.percentile(per_tick, 50)),
+        float(np.percentile(per_tick, 99)),
+    )
