@@ -126,10 +126,12 @@ class TorqueImpedance:
             mujoco.mju_mulMatTVec(self._tmp, jac, self._z)
             mujoco.mju_subFrom(tau0, self._tmp)  # N^T tau_0
             mujoco.mju_addTo(tau, tau0)
-        step = self._tmp
+        step = self._tmp  # (ufuncs: np.clip's Python wrapper costs more than the arithmetic)
         mujoco.mju_sub(step, tau, self.tau_prev)
-        np.clip(step, -self.dtau_step, self.dtau_step, out=step)
+        np.minimum(step, self.dtau_step, out=step)
+        np.maximum(step, -self.dtau_step, out=step)
         mujoco.mju_add(tau, self.tau_prev, step)
-        np.clip(tau, self._neg_tau_max, self.tau_max, out=tau)
+        np.minimum(tau, self.tau_max, out=tau)
+        np.maximum(tau, self._neg_tau_max, out=tau)
         mujoco.mju_copy(self.tau_prev, tau)
         return tau

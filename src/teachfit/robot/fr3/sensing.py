@@ -52,7 +52,6 @@ class JointTorqueObserver:
         self.alpha = lowpass_alpha(cutoff, self.dt)
         self.noise, self.rng = float(noise), rng
         self.tau_ext = np.zeros(nv)
-        self.tau_j = np.zeros(nv)
         self._dq_prev = np.zeros(nv)
         self._ddq = np.zeros(nv)
         self._raw = np.zeros(nv)
@@ -69,7 +68,7 @@ class JointTorqueObserver:
         self._draw_noise()
 
     def _draw_noise(self) -> None:
-        self._noise = self.rng.normal(0.0, self.noise, (_NOISE_BLOCK, self.tau_j.size))
+        self._noise = self.rng.normal(0.0, self.noise, (_NOISE_BLOCK, self._nv))
         self._noise_i = 0
 
     def before_step(self) -> None:
@@ -77,22 +76,24 @@ class JointTorqueObserver:
         mujoco.mju_copy(self._dq_prev, self._qvel)
 
     def after_step(self) -> None:
-        """Call after ``mj_step2``: ``qM`` and ``qfrc_bias`` still hold tick ``k-1``'s values."""
-        d = self.data
-        tau_j, raw = self.tau_j, self._raw
-        mujoco.mju_copy(tau_j, self._qfrc_actuator)
+        """Call after ``mj_step2``: ``qM`` and ``qfrc_bias`` still hold tick ``k-1``'s values.
+
+        ``raw = M (dq_k - dq_{k-1}) / dt + c - tau_J`` with the sensed
+        ``tau_J = tau_motor + tau_friction + noise`` (the friction rows' forces oppose motion).
+        """
+        d, raw = self.data, self._raw
+        mujoco.mju_sub(self._ddq, self._qvel, self._dq_prev)
+        mujoco.mj_mulM(self.model, d, raw, self._ddq)
+        mujoco.mju_scl(raw, raw, self._inv_dt)
+        mujoco.mju_addTo(raw, self._bias)
+        mujoco.mju_subFrom(raw, self._qfrc_actuator)
         if d.nf == self._nv:  # dof friction rows follow the equality rows, in dof order, J = +1
             ne = d.ne
-            mujoco.mju_addTo(tau_j, d.efc_force[ne : ne + self._nv])
+            mujoco.mju_subFrom(raw, d.efc_force[ne : ne + self._nv])
         if self._noise_i == _NOISE_BLOCK:
             self._draw_noise()
-        mujoco.mju_addTo(tau_j, self._noise[self._noise_i])
+        mujoco.mju_subFrom(raw, self._noise[self._noise_i])
         self._noise_i += 1
-        mujoco.mju_sub(self._ddq, self._qvel, self._dq_prev)
-        mujoco.mju_scl(self._ddq, self._ddq, self._inv_dt)
-        mujoco.mj_mulM(self.model, d, raw, self._ddq)
-        mujoco.mju_addTo(raw, self._bias)
-        mujoco.mju_subFrom(raw, tau_j)
         mujoco.mju_subFrom(raw, self.tau_ext)
         mujoco.mju_addToScl(self.tau_ext, raw, self.alpha)
 
