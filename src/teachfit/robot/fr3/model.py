@@ -115,7 +115,7 @@ def _arm_spec(params: FR3Params) -> mujoco.MjSpec:
         arm.delete(arm.body(name))
     for item in [*arm.actuators, *arm.tendons, *arm.equalities, *arm.keys]:
         arm.delete(item)
-    friction = coulomb_friction()
+    friction = coulomb_friction() * params.joint_friction
     for i, name in enumerate(JOINTS):
         joint = arm.joint(name.removeprefix(ARM_PREFIX))
         joint.range = [Q_MIN[i], Q_MAX[i]]

@@ -95,6 +95,7 @@ class FR3Params:
     contact_solref: tuple[float, float] = (0.004, 1.0)
     contact_solimp: tuple[float, float, float] = (0.05, 0.99, 0.0005)
     joint_friction_solref: tuple[float, float] = (0.005, 1.0)
+    joint_friction: float = 1.0
 
     def __post_init__(self) -> None:
         if self.sensor not in SENSORS:
@@ -113,5 +114,7 @@ class FR3Params:
             raise ControlError("solref time constants must be >= 2 timesteps")
         if not 0 < self.contact_solimp[0] <= self.contact_solimp[1] < 1:
             raise ControlError("contact_solimp needs 0 < dmin <= dmax < 1")
+        if self.joint_friction < 0:
+            raise ControlError("joint_friction must be >= 0")
         if self.mount_offset < 0:
             raise ControlError("mount_offset must be >= 0")

@@ -59,8 +59,11 @@ class JointTorqueObserver:
         self._inv_dt = 1.0 / self.dt
         self._qvel, self._bias = data.qvel, data.qfrc_bias
         self._qfrc_actuator = data.qfrc_actuator
-        if nv != model.njnt or np.any(model.dof_frictionloss <= 0):
-            raise ValueError("the observer expects one friction-loss dof per joint")
+        self._friction = bool(np.all(model.dof_frictionloss > 0))
+        if not self._friction and np.any(model.dof_frictionloss > 0):
+            raise ValueError("the observer expects friction on every joint or on none")
+        if nv != model.njnt:
+            raise ValueError("the observer expects one dof per joint")
         self._draw_noise()
 
     def reset(self) -> None:
@@ -87,7 +90,7 @@ class JointTorqueObserver:
         mujoco.mju_scl(raw, raw, self._inv_dt)
         mujoco.mju_addTo(raw, self._bias)
         mujoco.mju_subFrom(raw, self._qfrc_actuator)
-        if d.nf == self._nv:  # dof friction rows follow the equality rows, in dof order, J = +1
+        if self._friction and d.nf == self._nv:  # a friction row per dof, after the equality rows
             ne = d.ne
             mujoco.mju_subFrom(raw, d.efc_force[ne : ne + self._nv])
         if self._noise_i == _NOISE_BLOCK:
