@@ -135,9 +135,15 @@ def test_joint_friction_holds_a_small_disturbance(task):
     assert moved[1] > 30 * moved[0] and moved[1] > 1e-2
 
 
-@pytest.mark.parametrize("sensor", ["joint-torques", "wrist-ft"])
-def test_estimated_external_wrench_matches_an_applied_force(task, sensor):
-    robot = FR3Robot(task, params=FR3Params(sensor=sensor, torque_noise=0.0, ft_noise=(0, 0)))
+@pytest.mark.parametrize(
+    ("sensor", "friction"), [("joint-torques", 1.0), ("joint-torques", 0.0), ("wrist-ft", 1.0)]
+)
+def test_estimated_external_wrench_matches_an_applied_force(task, sensor, friction):
+    params = FR3Params(sensor=sensor, torque_noise=0.0, ft_noise=(0, 0), joint_friction=friction)
+    robot = FR3Robot(task, params=params)
+    assert np.all(
+        robot.model.dof_frictionloss == pytest.approx(np.asarray(GAZ_PHI1) / 2 * friction)
+    )
     pose = free_pose(task)
     robot.reset(pose)
     force = np.array([4.0, -3.0, -8.0])
