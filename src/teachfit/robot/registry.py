@@ -79,3 +79,30 @@ register(
         "a free 6-DOF tool pushed by the impedance wrench, wrist F/T sensor (MuJoCo)",
     )
 )
+
+
+def _fr3(
+    task: Task, *, controller: ControllerSpec | None = None, seed: int = 0, **options: Any
+) -> Robot:
+    import dataclasses
+
+    from teachfit.robot.fr3 import FR3Params, FR3Robot
+
+    params = options.pop("params", None) or FR3Params()
+    known = {f.name for f in dataclasses.fields(FR3Params)}
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise TeachfitError(f"robot 'fr3' takes no option(s) {unknown}; known: {sorted(known)}")
+    if options:
+        params = dataclasses.replace(params, **options)
+    return FR3Robot(task, controller=controller, params=params, seed=seed)
+
+
+register(
+    RobotEntry(
+        "fr3",
+        _fr3,
+        "a torque-controlled 7-DOF Franka FR3: Cartesian impedance in joint torques, external "
+        "wrench from joint torques (sensor='wrist-ft': a wrist F/T sensor) (MuJoCo)",
+    )
+)

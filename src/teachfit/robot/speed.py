@@ -3,6 +3,10 @@
 Both loops start from the same state: the tool pressed onto the surface at the teacher's start.
 The raw loop keeps the last controller wrench applied (``qfrc_applied`` persists), so it stays
 in the same contact; the controlled loop recomputes the impedance law every 1 ms tick.
+
+For the FR3 (``robot="fr3"``) the raw loop keeps the last joint torques (``ctrl`` persists) and
+the controlled loop runs the whole 1 ms tick (torque law, limits, wrench sensing); the torque
+law's compute time per tick is also timed on its own (median and 99th percentile).
 """
 
 from __future__ import annotations
@@ -42,10 +46,19 @@ def _pressed_robot(task: Task, name: str) -> tuple[object, ImpedanceCommand]:
         lin_vel=[0.01, 0.0, 0.0],
         wrench_ff=[0, 0, -6.0, 0, 0, 0],
         stiffness=[1500, 150, 100, 40, 40, 40],
+        expires_after=60.0,  # one command slides the tool for the whole measurement
     )
     robot.command(cmd)
     robot.step(300)  # settle into contact; the raw loop keeps the last applied wrench
     return robot, cmd
+
+
+@dataclass(frozen=True)
+class ArmSimSpeed(SimSpeed):
+    """:class:`SimSpeed` plus the torque law's compute time per tick (µs)."""
+
+    compute_p50_us: float = 0.0
+    compute_p99_us: float = 0.0
 
 
 def measure_sim_speed(
@@ -55,6 +68,8 @@ def measure_sim_speed(
     that load noise hits both."""
     if steps < 1 or repeats < 1:
         raise TeachfitError(f"steps and repeats must be >= 1, got {steps}, {repeats}")
+    if robot == "fr3":
+        return measure_fr3_speed(task, steps, repeats)
     raw_best = ctl_best = 0.0
     contacts = 0
     for _ in range(repeats):
@@ -74,3 +89,79 @@ def measure_sim_speed(
         ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
     rtf = ctl_best * sim.control_period  # type: ignore[attr-defined]
     return SimSpeed(raw_best, ctl_best, ctl_best / raw_best, rtf, contacts)
+
+
+RAW_CHUNK = 50
+
+
+def _pressed_fr3(task: Task):  # -> tuple[FR3Robot, ImpedanceCommand]
+    from teachfit.robot.fr3 import FR3Robot
+
+    robot = FR3Robot(task)
+    start = task.protocol.teacher_start(np.random.default_rng(0))
+    robot.reset(start)
+    cmd = ImpedanceCommand(
+        pos=start.pos,
+        quat=start.quat,
+        lin_vel=[0.01, 0.0, 0.0],
+        wrench_ff=[0, 0, -6.0, 0, 0, 0],
+        stiffness=[1500, 150, 100, 40, 40, 40],
+        expires_after=60.0,
+    )
+    robot.command(cmd)
+    robot.step(300)  # settle into contact; the raw loop keeps the last torques (ctrl persists)
+    return robot, cmd
+
+
+def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSimSpeed:
+    """The FR3's figures: raw ``mj_step`` vs. the full controlled tick (best of ``repeats``,
+    interleaved), and the torque law's compute time per tick (p50, p99 over all ticks)."""
+    if steps < RAW_CHUNK:
+        raise TeachfitError(f"steps must be >= {RAW_CHUNK}")
+    raw_best = ctl_best = 0.0
+    contacts = 0
+    samples: list[np.ndarray] = []
+    robot = None
+    for _ in range(repeats):
+        robot, cmd = _pressed_fr3(task)
+        m, d = robot.model, robot.data
+        snapshot = (d.qpos.copy(), d.qvel.copy(), d.ctrl.copy(), d.time)
+        # the arm drifts off the surface under constant torques: restart the raw loop from the
+        # pressed state every RAW_CHUNK steps (untimed) so that it stays in the same contact
+        raw_time = 0.0
+        for _ in range(steps // RAW_CHUNK):
+            d.qpos[:], d.qvel[:], d.ctrl[:], d.time = snapshot
+            mujoco.mj_forward(m, d)
+            t0 = time.perf_counter()
+            for _ in range(RAW_CHUNK):
+                mujoco.mj_step(m, d)
+            raw_time += time.perf_counter() - t0
+        raw_best = max(raw_best, RAW_CHUNK * (steps // RAW_CHUNK) / raw_time)
+        d.qpos[:], d.qvel[:], d.ctrl[:], d.time = snapshot
+        mujoco.mj_forward(m, d)
+        robot.command(cmd)
+        contacts = int(d.ncon)
+        t0 = time.perf_counter()
+        robot.step(steps)
+        ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
+        ctl, clock = robot.ctl, time.perf_counter_ns
+        ticks = np.empty(steps)
+        for k in range(steps):  # the torque law alone, in the same contact
+            mujoco.mj_step1(m, d)
+            t0 = clock()
+            d.ctrl[:] = ctl.compute(d.time)
+            ticks[k] = clock() - t0
+            mujoco.mj_step2(m, d)
+        samples.append(ticks / 1e3)
+    assert robot is not None
+    rtf = ctl_best * robot.control_period
+    per_tick = np.concatenate(samples)
+    return ArmSimSpeed(
+        raw_best,
+        ctl_best,
+        ctl_best / raw_best,
+        rtf,
+        contacts,
+        float(np.percentile(per_tick, 50)),
+        float(np.percentile(per_tick, 99)),
+    )

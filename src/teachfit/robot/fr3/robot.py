@@ -1,0 +1,228 @@
+"""A torque-controlled Franka Research 3 in MuJoCo behind :class:`~teachfit.robot.interface.Robot`.
+
+One control tick is one 1 ms physics step, split as MuJoCo intends for a controller:
+``mj_step1`` (kinematics, inertia, bias forces of the current state), the torque law of
+:mod:`teachfit.robot.fr3.control` writes ``ctrl``, ``mj_step2`` integrates, and the sensing of
+:mod:`teachfit.robot.fr3.sensing` reads the step's torques. ``reset(pose)`` solves the inverse
+kinematics (:mod:`teachfit.robot.fr3.ik`) and places the arm there at rest.
+
+Faults, latched until the next :meth:`FR3Robot.reset`: a joint outside its position range or
+faster than its speed limit raises :class:`~teachfit.core.errors.LimitViolation` (checked every
+tick, as the FR3's firmware does); a MuJoCo warning or a NaN/inf state raises
+:class:`~teachfit.core.errors.SimulationDiverged`.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from teachfit.control import make_law
+from teachfit.core.control import ControllerSpec, FixedGainSpec
+from teachfit.core.errors import LimitViolation, RobotFault, SimulationDiverged
+from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.fr3 import model as fr3_model
+from teachfit.robot.fr3.control import TorqueImpedance, operational_inertia
+from teachfit.robot.fr3.ik import IKSettings, solve_ik
+from teachfit.robot.fr3.params import DQ_MAX, DTAU_MAX, Q_MAX, Q_MIN, READY_Q, TAU_MAX, FR3Params
+from teachfit.robot.fr3.sensing import JointTorqueObserver, WristFT
+from teachfit.tasks.base import Task
+
+
+class FR3Robot:
+    """The simulated FR3: model + Cartesian impedance in joint torques + wrench sensing.
+
+    ``params.sensor`` chooses the external-wrench measurement (``wrench_source``):
+    ``"joint-torques"`` (default, as the real arm) or ``"wrist-ft"``.
+    """
+
+    name = "fr3"
+
+    def __init__(
+        self,
+        task: Task,
+        controller: ControllerSpec | None = None,
+        params: FR3Params | None = None,
+        seed: int = 0,
+        ik: IKSettings | None = None,
+    ) -> None:
+        self.task = task
+        self.params = params or FR3Params()
+        self.wrench_source = self.params.sensor
+        self.ik_settings = ik or IKSettings()
+        self.model = fr3_model.build_fr3_model(task, self.params)
+        self.data = mujoco.MjData(self.model)
+        self.rng = np.random.default_rng(seed)
+        m, d = self.model, self.data
+        obj = mujoco.mjtObj
+        self._tcp = mujoco.mj_name2id(m, obj.mjOBJ_SITE, fr3_model.TCP_SITE)
+        flange = mujoco.mj_name2id(m, obj.mjOBJ_SITE, fr3_model.FLANGE_SITE)
+        dofs = [m.jnt_dofadr[mujoco.mj_name2id(m, obj.mjOBJ_JOINT, j)] for j in fr3_model.JOINTS]
+        if dofs != list(range(m.nv)) or m.nq != m.nv:
+            raise RobotFault("the FR3 cell must have exactly the 7 arm joints as its dofs")
+        self.q_min, self.q_max = np.array(Q_MIN), np.array(Q_MAX)
+        self.dq_max = np.array(DQ_MAX)
+        self._speed_weight = np.diag(1.0 / self.dq_max**2)
+        self.controller_spec: ControllerSpec = controller or FixedGainSpec()
+        self.ctl = TorqueImpedance(
+            m,
+            d,
+            self._tcp,
+            make_law(self.controller_spec, np.ones(6), self.control_period),
+            np.array(TAU_MAX),
+            DTAU_MAX,
+            self.params.null_stiffness,
+            self.params.null_damping,
+        )
+        self.observer = JointTorqueObserver(
+            m, d, self.params.wrench_cutoff, self.params.torque_noise, self.rng
+        )
+        force = mujoco.mj_name2id(m, obj.mjOBJ_SENSOR, fr3_model.FT_FORCE)
+        torque = mujoco.mj_name2id(m, obj.mjOBJ_SENSOR, fr3_model.FT_TORQUE)
+        self.ft = WristFT(m, d, flange, force, torque, self.params.wrench_cutoff)
+        self._use_ft = self.wrench_source == "wrist-ft"
+        self._warning_numbers = d.warning.number
+        self._warnings = 0
+        self._fault: RobotFault | None = None
+        self._cmd: ImpedanceCommand | None = None
+        self.q_start = np.array(READY_Q)
+        self.reset(task.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.05]))
+
+    # ------------------------------------------------------------------ Robot protocol
+    @property
+    def control_period(self) -> float:
+        return float(self.model.opt.timestep)
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    @property
+    def law(self) -> object:
+        """The Cartesian control law in the loop (inspection and tests only)."""
+        return self.ctl.law
+
+    def reset(self, pose: Pose, controller: ControllerSpec | None = None) -> RobotState:
+        """Place the arm at rest at the IK solution for TCP ``pose``; zero the wrench reading;
+        from now on run ``controller`` (``None``: the current law, its state cleared)."""
+        m, d = self.model, self.data
+        if controller is not None:
+            self.controller_spec = controller
+        ik = solve_ik(m, fr3_model.TCP_SITE, pose, self.q_start, self.q_start, self.ik_settings)
+        self._fault = None
+        mujoco.mj_resetData(m, d)
+        d.qpos[:] = ik.q
+        mujoco.mj_forward(m, d)
+        lam = operational_inertia(m, d, self._tcp)
+        self.apparent_mass = np.diag(lam).copy()
+        self.ctl.law = make_law(self.controller_spec, self.apparent_mass, self.control_period)
+        self.ctl.reset(ik.q)
+        d.ctrl[:] = self.ctl.tau
+        mujoco.mj_forward(m, d)  # the wrist sensor now sees the arm holding itself
+        self.ctl.update_kinematics()
+        self.observer.reset()
+        self.ft.reset(d.site_xpos[self._tcp])
+        self.command(ImpedanceCommand.hold(pose))
+        self._warnings = int(self._warning_numbers.sum())
+        return self.state()
+
+    def command(self, cmd: ImpedanceCommand) -> None:
+        if self._fault is not None:
+            raise self._fault
+        self._cmd = cmd
+        self.ctl.law.set_command(cmd, self.data.time)
+
+    def step(self, n: int = 1) -> RobotState:
+        if self._fault is not None:
+            raise self._fault
+        m, d = self.model, self.data
+        ctl, obs, ft = self.ctl, self.observer, self.ft
+        use_ft = self._use_ft
+        ctrl, dq, speed_w = d.ctrl, d.qvel, self._speed_weight
+        for _ in range(n):
+            mujoco.mj_step1(m, d)
+            mujoco.mju_copy(ctrl, ctl.compute(d.time))
+            if use_ft:
+                mujoco.mj_step2(m, d)
+                ft.after_step()
+            else:
+                obs.before_step()
+                mujoco.mj_step2(m, d)
+                obs.after_step()
+            # limits every tick, cheaply: MuJoCo makes a limit row only for a joint past its
+            # range (margin 0); sum (dq_i / dq_max_i)^2 > 1 whenever some |dq_i| > dq_max_i
+            if d.nl or mujoco.mju_mulVecMatVec(dq, speed_w, dq) > 1.0:
+                self._check_limits()
+        self._check_divergence()
+        return self.state()
+
+    def state(self) -> RobotState:
+        m, d = self.model, self.data
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        self.ctl.update_kinematics()
+        return RobotState(
+            t=float(d.time),
+            pos=self.ctl.pos.copy(),
+            quat=self.ctl.quat.copy(),
+            lin_vel=self.ctl.twist[:3].copy(),
+            ang_vel=self.ctl.twist[3:].copy(),
+            wrench=self.measured_wrench(),
+        )
+
+    def close(self) -> None:
+        """Nothing to release but the simulator's memory (kept until garbage collection)."""
+        self._cmd = None
+
+    def __enter__(self) -> FR3Robot:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # ----------------------------------------------------------------------- sensors
+    def measured_wrench(self) -> np.ndarray:
+        """External wrench on the tool at the TCP (N, N·m, world) from ``wrench_source``."""
+        if self._use_ft:
+            noise = np.concatenate(
+                [
+                    self.rng.normal(0.0, self.params.ft_noise[0], 3),
+                    self.rng.normal(0.0, self.params.ft_noise[1], 3),
+                ]
+            )
+            return self.ft.wrench(self.data.site_xpos[self._tcp]) + noise
+        return self.observer.wrench(self.ctl.jac)
+
+    @property
+    def joint_torques(self) -> np.ndarray:
+        """The torques commanded at the last tick (N·m, joints 1..7)."""
+        return self.ctl.tau.copy()
+
+    # ------------------------------------------------------------------------ faults
+    def _check_limits(self) -> None:
+        self._check_divergence()  # MuJoCo resets a diverged state: that is not a limit fault
+        d = self.data
+        q, dq = d.qpos, d.qvel
+        bad_q = np.flatnonzero((q < self.q_min) | (q > self.q_max))
+        bad_dq = np.flatnonzero(np.abs(dq) > self.dq_max)
+        if not (bad_q.size or bad_dq.size):
+            return
+        what = [f"joint {i + 1} at {q[i]:.4f} rad outside its range" for i in bad_q]
+        what += [f"joint {i + 1} at {dq[i]:.3f} rad/s over its speed limit" for i in bad_dq]
+        self._fault = LimitViolation(f"{'; '.join(what)} at t={d.time:.3f} s")
+        raise self._fault
+
+    def _check_divergence(self) -> None:
+        d = self.data
+        count = int(self._warning_numbers.sum())
+        if count > self._warnings:
+            kinds = [mujoco.mjtWarning(i).name for i, w in enumerate(d.warning) if w.number > 0]
+            self._warnings = count
+            self._fault = SimulationDiverged(
+                f"MuJoCo warning(s) {kinds} at t={d.time:.3f} s: simulation invalid"
+            )
+            raise self._fault
+        if not (np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))):
+            self._fault = SimulationDiverged(f"NaN/inf in the state at t={d.time:.3f} s")
+            raise self._fault

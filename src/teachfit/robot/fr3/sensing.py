@@ -1,0 +1,146 @@
+"""How the FR3 measures the external wrench: from its joint torques, or with a wrist F/T sensor.
+
+**Joint torques** (Franka's ``tau_ext_hat_filtered`` / ``O_F_ext_hat_K``). The link-side torque
+sensors read what the motors transmit past the gear friction, ``tau_J = tau_motor - tau_f``. The
+model of the arm predicts the torque that motion needs, ``tau_model = M(q) ddq + c(q, dq)``, so
+the external joint torque is ``tau_ext = tau_model - tau_J`` (what the environment adds). Its
+discrete generalized-momentum observer (De Luca and Mattone 2005, ``p = M dq``,
+``r_k = r_{k-1} + K_O dt ((p_k - p_{k-1}) / dt - (tau_J - c + dM dq) - r_{k-1})``) is, with the
+momentum step written out, the first-order low-pass
+
+    r_k = r_{k-1} + a (M (dq_k - dq_{k-1}) / dt + c_{k-1} - tau_J,{k-1} - r_{k-1}),
+    a = 1 - exp(-2 pi f_c dt)
+
+(N·m), which is what is implemented (``f_c = wrench_cutoff``; ``M`` includes the rotor inertia,
+whose torque the sensors do not see either way). The TCP wrench is the least-squares solution
+of ``J^T F = r``: ``F = pinv(J^T) r`` (N, N·m, world frame at the TCP), the wrench the
+environment exerts on the tool. The sensors carry white noise of ``torque_noise`` N·m.
+
+**Wrist F/T sensor**: MuJoCo's force and torque sensors on a site at the flange (the interface
+between link 7 and the hand), filtered by the same first-order low-pass, tared at reset (the
+hand and part's weight), turned into the environment's wrench at the TCP as on the floating
+tool. Noise ``ft_noise`` (N, N·m) is added at read-out.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+_NOISE_BLOCK = 1000  # sensor noise drawn this many ticks at a time
+
+
+def lowpass_alpha(cutoff: float, dt: float) -> float:
+    """Smoothing factor of a first-order low-pass of ``cutoff`` Hz sampled every ``dt`` s."""
+    return 1.0 - float(np.exp(-2.0 * np.pi * cutoff * dt))
+
+
+class JointTorqueObserver:
+    """External joint torques from the joint torque sensors and the arm's model (see module)."""
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        cutoff: float,
+        noise: float,
+        rng: np.random.Generator,
+    ) -> None:
+        nv = model.nv
+        self.model, self.data = model, data
+        self.dt = float(model.opt.timestep)
+        self.alpha = lowpass_alpha(cutoff, self.dt)
+        self.noise, self.rng = float(noise), rng
+        self.tau_ext = np.zeros(nv)
+        self._dq_prev = np.zeros(nv)
+        self._ddq = np.zeros(nv)
+        self._raw = np.zeros(nv)
+        self._nv = nv
+        self._inv_dt = 1.0 / self.dt
+        self._qvel, self._bias = data.qvel, data.qfrc_bias
+        self._qfrc_actuator = data.qfrc_actuator
+        self._friction = bool(np.all(model.dof_frictionloss > 0))
+        if not self._friction and np.any(model.dof_frictionloss > 0):
+            raise ValueError("the observer expects friction on every joint or on none")
+        if nv != model.njnt:
+            raise ValueError("the observer expects one dof per joint")
+        self._draw_noise()
+
+    def reset(self) -> None:
+        self.tau_ext[:] = 0.0
+        self._draw_noise()
+
+    def _draw_noise(self) -> None:
+        self._noise = self.rng.normal(0.0, self.noise, (_NOISE_BLOCK, self._nv))
+        self._noise_i = 0
+
+    def before_step(self) -> None:
+        """Call after ``mj_step1`` and setting ``ctrl``: remembers ``dq_{k-1}``."""
+        mujoco.mju_copy(self._dq_prev, self._qvel)
+
+    def after_step(self) -> None:
+        """Call after ``mj_step2``: ``qM`` and ``qfrc_bias`` still hold tick ``k-1``'s values.
+
+        ``raw = M (dq_k - dq_{k-1}) / dt + c - tau_J`` with the sensed
+        ``tau_J = tau_motor + tau_friction + noise`` (the friction rows' forces oppose motion).
+        """
+        d, raw = self.data, self._raw
+        mujoco.mju_sub(self._ddq, self._qvel, self._dq_prev)
+        mujoco.mj_mulM(self.model, d, raw, self._ddq)
+        mujoco.mju_scl(raw, raw, self._inv_dt)
+        mujoco.mju_addTo(raw, self._bias)
+        mujoco.mju_subFrom(raw, self._qfrc_actuator)
+        if self._friction and d.nf == self._nv:  # a friction row per dof, after the equality rows
+            ne = d.ne
+            mujoco.mju_subFrom(raw, d.efc_force[ne : ne + self._nv])
+        if self._noise_i == _NOISE_BLOCK:
+            self._draw_noise()
+        mujoco.mju_subFrom(raw, self._noise[self._noise_i])
+        self._noise_i += 1
+        mujoco.mju_subFrom(raw, self.tau_ext)
+        mujoco.mju_addToScl(self.tau_ext, raw, self.alpha)
+
+    def wrench(self, jac: np.ndarray) -> np.ndarray:
+        """``F = pinv(J^T) tau_ext`` (6,) for the TCP Jacobian ``jac`` (6, nv)."""
+        return np.linalg.lstsq(jac.T, self.tau_ext, rcond=None)[0]
+
+
+class WristFT:
+    """A wrist F/T sensor from MuJoCo force/torque sensors at the flange site (see module)."""
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        site: int,
+        force_sensor: int,
+        torque_sensor: int,
+        cutoff: float,
+    ) -> None:
+        f_adr = int(model.sensor_adr[force_sensor])
+        if int(model.sensor_adr[torque_sensor]) != f_adr + 3:
+            raise ValueError("force and torque sensors must be adjacent")
+        self.data, self.site = data, site
+        self.raw = data.sensordata[f_adr : f_adr + 6]
+        self.filt = np.zeros(6)
+        self.alpha = lowpass_alpha(cutoff, float(model.opt.timestep))
+        self.tare = np.zeros(6)
+
+    def reset(self, tcp: np.ndarray) -> None:
+        """Start the filter at the current reading and tare it (``wrench(tcp)`` reads zero)."""
+        self.filt[:] = self.raw
+        self.tare[:] = 0.0
+        self.tare[:] = self.wrench(tcp)
+
+    def after_step(self) -> None:
+        self.filt += self.alpha * (self.raw - self.filt)
+
+    def wrench(self, tcp: np.ndarray) -> np.ndarray:
+        """Tared environment wrench on the tool at the TCP ``tcp`` (3,) (world frame)."""
+        d = self.data
+        rot = d.site_xmat[self.site].reshape(3, 3)
+        # MuJoCo reports what the hand exerts on link 7; the environment's wrench on the tool
+        # balances it quasi-statically: flip the sign, then move the torque to the TCP
+        f_env = -(rot @ self.filt[:3])
+        t_env = -(rot @ self.filt[3:]) + np.cross(d.site_xpos[self.site] - tcp, f_env)
+        return np.concatenate([f_env, t_env]) - self.tare
