@@ -79,3 +79,23 @@ register(
         "a free 6-DOF tool pushed by the impedance wrench, wrist F/T sensor (MuJoCo)",
     )
 )
+
+
+def _franka(
+    task: Task, *, controller: ControllerSpec | None = None, seed: int = 0, **options: Any
+) -> Robot:
+    from teachfit.robot.franka import franka_for_task
+
+    del seed  # a real robot has no simulated noise to seed
+    return franka_for_task(task, controller=controller, **options)
+
+
+register(
+    RobotEntry(
+        "franka",
+        _franka,
+        "a real Franka FR3/Panda over libfranka (host=ADDRESS), torque control, "
+        "wrench from joint torques (pip install teachfit[franka])",
+        simulated=False,
+    )
+)
