@@ -6,6 +6,7 @@ from collections.abc import Iterator
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from teachfit.core.control import AdaptiveSpec, FixedGainSpec
 from teachfit.core.errors import ConnectionLost, LimitViolation, RobotFault
@@ -41,18 +42,38 @@ def robot(franka_sim: object) -> Iterator[FrankaRobot]:
         r.close()
 
 
-def test_connects_and_reports_the_tcp_in_the_task_world(robot: FrankaRobot) -> None:
-    assert isinstance(robot, Robot)
-    s = robot.step(10)
-    # franky-sim starts at q = (0, 0, 0, -1.57, 0, 1.57, 0.785): EE at (0.554, 0, 0.521) in the
-    # base, pointing down; the TCP is PART further down, the base 0.5 m behind / 0.25 m below
-    np.testing.assert_allclose(s.pos, [0.554 - 0.5, 0.0, 0.521 - PART - 0.25], atol=2e-3)
-    assert abs(abs(s.quat[0]) - 1.0) < 1e-3  # identity: part pointing straight down
-    assert np.linalg.norm(s.lin_vel) < 0.01
-    assert robot.wrench_source == "joint-torques" and robot.control_period == 0.001
-    t0 = robot.ticks
-    robot.step(50)
-    assert robot.ticks >= t0 + 50
+def expected_tcp(frames: FrankaFrames) -> np.ndarray:
+    """The TCP (world) from a plain pylibfranka read of O_T_EE, before the driver connects."""
+    import pylibfranka as pf
+
+    raw = pf.Robot("127.0.0.1", pf.RealtimeConfig.kIgnore)
+    o_t_ee = np.asarray(raw.read_once().O_T_EE).reshape(4, 4, order="F")
+    del raw
+    return (frames.base2world.matrix @ o_t_ee @ frames.ee2tcp.matrix)[:3]
+
+
+def test_connects_and_reports_the_tcp_in_the_task_world(franka_sim: object) -> None:
+    frames = _params().frames
+    want = expected_tcp(frames)
+    with FrankaRobot("127.0.0.1", params=_params(), realtime=False) as robot:
+        assert isinstance(robot, Robot)
+        s = robot.step(10)
+        np.testing.assert_allclose(s.pos, want[:, 3], atol=2e-3)
+        rot = Rotation.from_quat(np.roll(s.quat, -1)).as_matrix()
+        np.testing.assert_allclose(rot, want[:, :3], atol=5e-3)
+        assert np.linalg.norm(s.lin_vel) < 0.01
+        assert robot.wrench_source == "joint-torques" and robot.control_period == 0.001
+        t0 = robot.ticks
+        robot.step(50)
+        assert robot.ticks >= t0 + 50
+
+
+def test_default_frames_put_the_part_pointing_down_above_the_cell(robot: FrankaRobot) -> None:
+    """At franky-sim's start pose (EE 0.554 m ahead, 0.521 m up, pointing down) the default
+    base2world puts the TCP near the cell and an identity quaternion means part down."""
+    s = robot.reset(Pose(np.array([0.054, 0.0, 0.221])))
+    assert abs(abs(s.quat[0]) - 1.0) < 0.01
+    np.testing.assert_allclose(robot.joint_positions[[1, 3, 5]], [0.0, -1.57, 1.57], atol=0.15)
 
 
 def test_reset_moves_to_the_pose_and_zeroes_time(robot: FrankaRobot) -> None:
