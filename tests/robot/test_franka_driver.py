@@ -96,13 +96,13 @@ def test_holds_and_tracks_a_small_cartesian_move(robot: FrankaRobot) -> None:
 
 def test_adaptive_law_runs_in_the_loop(robot: FrankaRobot) -> None:
     robot.reset(HOME, controller=AdaptiveSpec())
-    assert type(robot._law).__name__ == "AdaptiveImpedance"
+    assert type(robot.law).__name__ == "AdaptiveImpedance"
     target = HOME.pos + np.array([0.0, 0.02, 0.0])
     robot.command(ImpedanceCommand(pos=target, quat=HOME.quat, stiffness=STIFF))
     s = robot.step(1500)
     assert np.linalg.norm(s.pos - target) < TOL
     robot.reset(HOME, controller=FixedGainSpec())
-    assert type(robot._law).__name__ == "CartesianImpedance"
+    assert type(robot.law).__name__ == "CartesianImpedance"
 
 
 def test_skill_like_sequence_follows_and_expires(robot: FrankaRobot) -> None:
@@ -192,7 +192,7 @@ def test_ctrl_c_holds_then_finishes_the_loop(robot: FrankaRobot) -> None:
     with pytest.raises(KeyboardInterrupt):
         robot.step(5000)
     timer.join()
-    assert not robot._thread.is_alive()  # type: ignore[union-attr]  # the loop finished
+    assert not robot.running  # the loop finished
     assert np.linalg.norm(robot.state().lin_vel) < 0.02  # held still before finishing
     with pytest.raises(RobotFault, match="Ctrl-C"):
         robot.command(ImpedanceCommand.hold(HOME))

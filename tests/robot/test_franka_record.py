@@ -23,10 +23,10 @@ HOME = Pose(np.array([0.0, 0.0, 0.15]))
 def _at_robot_time(robot: object, t: float, action: object) -> threading.Thread:
     """Run ``action()`` once the recording's own reset is done and ``t`` s of robot time (its
     control ticks) have passed since: scheduled in robot time, not wall-clock time."""
-    before = robot._t0  # type: ignore[attr-defined]
+    before = robot.resets  # type: ignore[attr-defined]
 
     def wait() -> None:
-        while robot._t0 == before or robot.time < t:  # type: ignore[attr-defined]
+        while robot.resets == before or robot.time < t:  # type: ignore[attr-defined]
             time.sleep(0.002)
         action()  # type: ignore[operator]
 
