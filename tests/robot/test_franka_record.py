@@ -78,7 +78,8 @@ def test_pushed_arm_is_recorded_with_the_pushing_wrench(franka: object, push_fil
     assert rec.pos[-1, 0] - rec.pos[first, 0] > 0.01  # the compliant arm gave way along +x
     assert abs(rec.pos[-1, 1] - rec.pos[0, 1]) < 0.01
     assert not rec.interrupted
-    assert rec.t[-1] >= 2.0
+    assert rec.t[-1] >= 1.99
+    np.testing.assert_allclose(np.diff(rec.t[1:]), 0.01, atol=1e-6)  # 100 Hz, none lost
 
 
 def test_ctrl_c_ends_the_recording_and_keeps_every_sample(franka: object) -> None:
@@ -87,5 +88,6 @@ def test_ctrl_c_ends_the_recording_and_keeps_every_sample(franka: object) -> Non
     timer.join()
     assert rec.interrupted
     assert len(rec) >= 10
-    assert np.all(np.diff(rec.t) >= 0.005 - 1e-9)  # at most 200 Hz, in robot time
+    # sampled in the control thread: every 5 ticks exactly, however late the test thread ran
+    np.testing.assert_allclose(np.diff(rec.t[1:]), 0.005, atol=1e-6)
     assert rec.t[-1] >= 0.45  # it ran until the interrupt (0.5 s after the reset)

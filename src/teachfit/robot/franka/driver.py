@@ -192,6 +192,15 @@ class FrankaRobot:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
+    def tap(self, every: int) -> None:
+        """Sample the state every ``every`` ticks *in the control thread* (lossless however
+        late the caller's thread runs) until :meth:`untap`; used by kinesthetic recording."""
+        self._loop.tap(every)
+
+    def untap(self) -> list[RobotState]:
+        """Stop sampling and return the states sampled since :meth:`tap`."""
+        return self._loop.untap()
+
     # ------------------------------------------------------------------ inspection
     @property
     def law(self) -> Controller | None:

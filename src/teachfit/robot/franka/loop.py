@@ -83,6 +83,8 @@ class ControlLoop:
         self.q = np.zeros(7)
         self._finish = False
         self._thread: threading.Thread | None = None
+        self._tap_every = 0
+        self._tapped: list[RobotState] = []
         #: per-tick compute time (s, read -> torques ready) and gap since the previous state (s)
         self.compute_times = np.zeros(buffer)
         self.read_gaps = np.zeros(buffer)
@@ -137,6 +139,18 @@ class ControlLoop:
         if self.fault is not None:
             raise self.fault
 
+    def tap(self, every: int) -> None:
+        """Keep the state of every ``every``-th tick, sampled in the control thread."""
+        with self.cond:
+            self._tapped = []
+            self._tap_every = int(every)
+
+    def untap(self) -> list[RobotState]:
+        """Stop sampling; the states kept since :meth:`tap`."""
+        with self.cond:
+            self._tap_every, out, self._tapped = 0, self._tapped, []
+        return out
+
     def finish(self, timeout: float = 2.0) -> None:
         """End the loop (motion finished) and join the thread."""
         self._finish = True
@@ -188,6 +202,8 @@ class ControlLoop:
         with self.cond:
             self.latest = latest
             self.ticks += 1
+            if self._tap_every and self.ticks % self._tap_every == 0:
+                self._tapped.append(latest)
             self.cond.notify_all()
 
     def _send_finish(self, control: Any, pf: Any) -> None:

@@ -5,6 +5,9 @@ floating tool in tests). The robot is reset *where it is* with fixed-gain impeda
 zeroes the wrench reading, so tare before anyone touches the arm), then runs a zero-stiffness
 law: gravity compensated (the firmware's), light damping only, and nothing pulls the TCP
 anywhere. Samples are taken every ``1 / rate_hz`` s until ``duration`` runs out or Ctrl-C.
+A robot with ``tap(every)`` / ``untap()`` (the Franka driver) samples in its own control
+thread, so no sample is lost when the calling thread runs late; others are sampled by the
+caller after each ``step``.
 """
 
 from __future__ import annotations
@@ -87,14 +90,28 @@ def record_kinesthetic(
             expires_after=1e9,
         )
     )
+    tapped = hasattr(robot, "tap") and hasattr(robot, "untap")
     samples: list[RobotState] = [start]
+    if tapped:
+        robot.tap(every)  # type: ignore[attr-defined]
     try:
-        while duration is None or samples[-1].t - start.t < duration:
-            samples.append(robot.step(every))
+        last = start
+        while duration is None or last.t - start.t < duration:
+            last = robot.step(every)
+            if not tapped:
+                samples.append(last)
     except KeyboardInterrupt:
-        return _pack(samples, start.t, True, "")
+        return _pack(_collect(robot, samples, tapped), start.t, True, "")
     except RobotFault as fault:
-        fault.recording = _pack(samples, start.t, False, str(fault))  # type: ignore[attr-defined]
+        rec = _pack(_collect(robot, samples, tapped), start.t, False, str(fault))
+        fault.recording = rec  # type: ignore[attr-defined]
         raise
+    samples = _collect(robot, samples, tapped)
     robot.command(ImpedanceCommand.hold(samples[-1].pose))  # stay where the person left it
     return _pack(samples, start.t, False, "")
+
+
+def _collect(robot: Robot, samples: list[RobotState], tapped: bool) -> list[RobotState]:
+    if tapped:
+        samples += [s for s in robot.untap() if s.t > samples[0].t]  # type: ignore[attr-defined]
+    return samples

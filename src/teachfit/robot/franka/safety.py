@@ -142,6 +142,9 @@ def limit_torque(
     """Rate-limit ``tau`` (7,) against the last sent ``tau_prev`` to ``max_rate`` (N·m/s) over
     ``period`` (s), then clip to ``±limits`` (N·m); in place, returns ``tau``."""
     step = max_rate * period
-    np.clip(tau, tau_prev - step, tau_prev + step, out=tau)
-    np.clip(tau, -limits, limits, out=tau)
+    # np.minimum/np.maximum: several times cheaper than np.clip at this size (1 kHz path)
+    np.minimum(tau, tau_prev + step, out=tau)
+    np.maximum(tau, tau_prev - step, out=tau)
+    np.minimum(tau, limits, out=tau)
+    np.maximum(tau, -limits, out=tau)
     return tau

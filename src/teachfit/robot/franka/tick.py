@@ -61,7 +61,9 @@ class TorqueTick:
         self.bias = np.zeros(6)
         self._tau_lim = np.asarray(limits.joint_torque_limits, dtype=float)
         self._quat = np.zeros(4)
-        self._eye7 = np.eye(7)
+        self._k_offset: np.ndarray | None = None
+        self._k_lever = np.zeros(3)
+        self._wrench = np.zeros(6)
         self.jacobian = np.zeros((6, 7))
         self.pos = np.zeros(3)
         self.rot = np.eye(3)
@@ -78,7 +80,8 @@ class TorqueTick:
         r_tcp = r_ee @ self._r_et
         lever = r_ee @ self._p_et  # EE -> TCP, base frame
         p_tcp = p_ee + lever
-        jac = np.asarray(model.zero_jacobian(state), dtype=float).reshape(6, 7, order="F")  # type: ignore[attr-defined]
+        zj = model.zero_jacobian(state)  # type: ignore[attr-defined]
+        jac = np.asarray(zj, dtype=float).reshape(6, 7, order="F")
         jac[:3] -= skew(lever) @ jac[3:]  # v_tcp = v_ee + w x lever
         self.jacobian = jac
         twist = jac @ np.asarray(state.dq, dtype=float)  # type: ignore[attr-defined]
@@ -87,8 +90,10 @@ class TorqueTick:
         mujoco.mju_mat2Quat(self._quat, self.rot.reshape(-1))
         self.lin_vel = self._r_wo @ twist[:3]
         self.ang_vel = self._r_wo @ twist[3:]
-        self._p_tcp_base = p_tcp
-        self._p_k_base = p_ee + r_ee @ col_major(state.EE_T_K)[:3, 3]  # type: ignore[attr-defined]
+        if self._k_offset is None:  # EE_T_K is set with set_K, not during control: read once
+            self._k_offset = col_major(state.EE_T_K)[:3, 3].copy()  # type: ignore[attr-defined]
+        # K -> TCP lever (base frame), for moving the measured torque to the TCP
+        self._k_lever = r_ee @ (self._k_offset - self._p_et)
 
     @property
     def quat(self) -> np.ndarray:
@@ -97,10 +102,16 @@ class TorqueTick:
     def raw_wrench(self, state: object) -> np.ndarray:
         """The environment's wrench on the tool at the TCP, world frame, before the bias."""
         ext = np.asarray(state.O_F_ext_hat_K, dtype=float)  # type: ignore[attr-defined]
-        f_env = -ext[:3]  # libfranka: robot on environment -> teachfit: environment on tool
-        t_env_k = -ext[3:]
-        t_env_tcp = t_env_k + np.cross(self._p_k_base - self._p_tcp_base, f_env)
-        return np.concatenate([self._r_wo @ f_env, self._r_wo @ t_env_tcp])
+        f = -ext[:3]  # libfranka: robot on environment -> teachfit: environment on tool
+        r = self._k_lever
+        t = -ext[3:]
+        t[0] += r[1] * f[2] - r[2] * f[1]  # torque moved from K to the TCP: + r x f
+        t[1] += r[2] * f[0] - r[0] * f[2]
+        t[2] += r[0] * f[1] - r[1] * f[0]
+        out = self._wrench
+        out[:3] = self._r_wo @ f
+        out[3:] = self._r_wo @ t
+        return out.copy()
 
     def robot_state(self, t: float, state: object) -> RobotState:
         """A teachfit :class:`RobotState` of the last :meth:`kinematics` call."""
@@ -129,9 +140,8 @@ class TorqueTick:
         tau += np.asarray(model.coriolis(state), dtype=float)  # type: ignore[attr-defined]
         posture = self.k_ns * (self.q_rest - q) - self.d_ns * dq
         jjt = jac @ jac.T
-        jjt[np.diag_indices(6)] += 1e-4
-        null = self._eye7 - jac.T @ np.linalg.solve(jjt, jac)
-        tau += null @ posture
+        jjt.flat[::7] += 1e-4  # damped: well-posed near singularities
+        tau += posture - jac.T @ np.linalg.solve(jjt, jac @ posture)  # null-space projection
         limit_torque(tau, self.tau_prev, self.limits.max_torque_rate, self.period, self._tau_lim)
         self.tau_prev = tau
         return tau
