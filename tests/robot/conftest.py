@@ -8,7 +8,7 @@ when the ``franka`` extra (pylibfranka, franky-sim) is not installed.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -32,3 +32,20 @@ def franka_sim(push_file: Path) -> Iterator[object]:
         yield server
     finally:
         server.stop()
+
+
+@pytest.fixture
+def expected_tcp(franka_sim: object) -> Callable[[object], object]:
+    """``f(frames) -> (3, 4)``: the TCP pose (world) computed from a plain pylibfranka read of
+    ``O_T_EE`` (taken before a driver connects), ``base2world @ O_T_EE @ ee2tcp``."""
+    import numpy as np
+    import pylibfranka as pf
+
+    def tcp(frames: object) -> object:
+        raw = pf.Robot("127.0.0.1", pf.RealtimeConfig.kIgnore)
+        o_t_ee = np.asarray(raw.read_once().O_T_EE).reshape(4, 4, order="F")
+        del raw
+        b2w, e2t = frames.matrices()  # type: ignore[attr-defined]
+        return (b2w @ o_t_ee @ e2t)[:3]
+
+    return tcp

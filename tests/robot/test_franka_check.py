@@ -32,4 +32,5 @@ def test_bench_loop_prints_figures(franka_sim: object) -> None:
     timing = bench_loop("127.0.0.1", seconds=0.5, realtime=False, out=lines.append)
     assert timing.ticks == 500
     assert timing.overruns <= timing.ticks and timing.missed_packets >= 0
-    assert len(lines) == 3 and lines[0].startswith("ticks: 500")
+    assert len(lines) == 4 and lines[0].startswith("ticks: 500")
+    assert timing.wall_rate > 0 and lines[3].startswith("wall-clock rate")

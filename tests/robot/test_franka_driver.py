@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pytest
@@ -42,17 +42,9 @@ def robot(franka_sim: object) -> Iterator[FrankaRobot]:
         r.close()
 
 
-def expected_tcp(frames: FrankaFrames) -> np.ndarray:
-    """The TCP (world) from a plain pylibfranka read of O_T_EE, before the driver connects."""
-    import pylibfranka as pf
-
-    raw = pf.Robot("127.0.0.1", pf.RealtimeConfig.kIgnore)
-    o_t_ee = np.asarray(raw.read_once().O_T_EE).reshape(4, 4, order="F")
-    del raw
-    return (frames.base2world.matrix @ o_t_ee @ frames.ee2tcp.matrix)[:3]
-
-
-def test_connects_and_reports_the_tcp_in_the_task_world(franka_sim: object) -> None:
+def test_connects_and_reports_the_tcp_in_the_task_world(
+    franka_sim: object, expected_tcp: Callable[[FrankaFrames], np.ndarray]
+) -> None:
     frames = _params().frames
     want = expected_tcp(frames)
     with FrankaRobot("127.0.0.1", params=_params(), realtime=False) as robot:

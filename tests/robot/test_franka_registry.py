@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -21,9 +23,7 @@ def test_franka_needs_a_host() -> None:
         make_robot("franka", get_task("peg"))
 
 
-def test_make_robot_connects_with_the_tasks_tcp(franka_sim: object) -> None:
-    from test_franka_driver import expected_tcp
-
+def test_make_robot_connects_with_the_tasks_tcp(expected_tcp: Callable) -> None:
     from teachfit.robot.franka import FrankaFrames, ee2tcp_for_part
 
     task = get_task("peg")
