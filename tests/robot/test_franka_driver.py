@@ -152,6 +152,7 @@ def test_speed_limit_faults_the_loop_and_reset_recovers(franka_sim: object) -> N
 
 def test_killed_server_is_a_lost_connection_with_the_data_kept(franka_sim: object) -> None:
     robot = FrankaRobot("127.0.0.1", params=_params(), realtime=False)
+    old_pid = franka_sim.pid  # type: ignore[attr-defined]
     recorded = []
     try:
         robot.reset(HOME)
@@ -170,6 +171,9 @@ def test_killed_server_is_a_lost_connection_with_the_data_kept(franka_sim: objec
     finally:
         robot.close()
         franka_sim.start()  # type: ignore[attr-defined]
+    import os
+
+    assert not os.path.exists(f"/proc/{old_pid}")  # the killed server is gone, reaped
 
 
 def test_ctrl_c_holds_then_finishes_the_loop(robot: FrankaRobot) -> None:

@@ -72,3 +72,13 @@ def test_launcher_patch_rewrites_all_interfaces_and_refuses_others() -> None:
     )
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["127.0.0.1", "refused", "True"]
+
+
+def test_a_second_server_is_refused_while_the_port_is_taken(franka_sim: object) -> None:
+    from teachfit.core.errors import ConnectionLost
+    from teachfit.robot.franka.sim import SimServer
+
+    second = SimServer()
+    with pytest.raises(ConnectionLost, match="taken"):
+        second.start()
+    assert second.pid is None  # nothing was started

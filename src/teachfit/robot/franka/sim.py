@@ -26,12 +26,14 @@ is ready, and stops it by its PID and group.
 from __future__ import annotations
 
 import argparse
+import collections
 import ipaddress
 import os
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -117,7 +119,7 @@ def main(argv: list[str] | None = None) -> None:
         with franky_sim.SimulationServer(sim, hostname_candidates=[HOST]) as server:
             if args.push_file is not None:
                 _install_push(sim, robot, args.push_file)
-            print(f"{READY} {robot.hostname}", flush=True)
+            print(f"{READY} {robot.hostname}", flush=True)  # listening since the init
             try:
                 server.run_forever()
             except KeyboardInterrupt:
@@ -140,10 +142,22 @@ class SimServer:
         self.startup_timeout = startup_timeout
         self.host = HOST
         self.proc: subprocess.Popen[str] | None = None
+        #: the server's last output lines (diagnostics)
+        self.log: collections.deque[str] = collections.deque(maxlen=200)
+        self._ready = threading.Event()
+
+    def _drain(self, out: object) -> None:
+        try:
+            for line in out:  # type: ignore[attr-defined]
+                self.log.append(line)
+                if line.startswith(READY):
+                    self._ready.set()
+        except (OSError, ValueError):  # closed by stop()
+            pass
 
     def start(self) -> SimServer:
-        """Start the server process and wait until its port accepts."""
-        if _port_open(HOST, ROBOT_PORT):
+        """Start the server process and wait until it listens (it prints READY)."""
+        if not _port_free(HOST, ROBOT_PORT):
             raise ConnectionLost(f"{HOST}:{ROBOT_PORT} is taken: another Franka server runs")
         cmd = [sys.executable, "-m", "teachfit.robot.franka.sim"]
         if self.push_file is not None:
@@ -156,17 +170,17 @@ class SimServer:
             start_new_session=True,  # own process group: stopped as a group by its PID
         )
         deadline = time.monotonic() + self.startup_timeout
-        assert self.proc.stdout is not None
-        lines = []
-        for line in self.proc.stdout:  # blocks until the launcher prints or exits
-            lines.append(line)
-            if line.startswith(READY):
-                break
-        while not _port_open(HOST, ROBOT_PORT):
+        self._ready.clear()
+        # drain its output from the start (a full pipe would block the server), keep the tail
+        threading.Thread(target=self._drain, args=(self.proc.stdout,), daemon=True).start()
+        while not self._ready.wait(0.2):
             if self.proc.poll() is not None or time.monotonic() > deadline:
-                self.stop()
-                raise ConnectionLost("franky-sim did not start:\n" + "".join(lines[-20:]))
-            time.sleep(0.05)
+                break
+        # READY is printed after the server listens. No probe connection here: franky-sim would
+        # accept the probe as its one client and make the real client's connect time out.
+        if not self._ready.is_set():
+            self.stop()
+            raise ConnectionLost("franky-sim did not start:\n" + "".join(list(self.log)[-20:]))
         return self
 
     @property
@@ -203,10 +217,16 @@ class SimServer:
         self.stop()
 
 
-def _port_open(host: str, port: int) -> bool:
+def _port_free(host: str, port: int) -> bool:
+    """Whether nothing listens on ``host:port`` (a bind test: a probe connection would be
+    taken by a franky-sim as its client)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.settimeout(0.2)
-        return s.connect_ex((host, port)) == 0
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind((host, port))
+        except OSError:
+            return False
+    return True
 
 
 if __name__ == "__main__":
