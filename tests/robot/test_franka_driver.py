@@ -194,3 +194,12 @@ def test_ctrl_c_holds_then_finishes_the_loop(robot: FrankaRobot) -> None:
         robot.command(ImpedanceCommand.hold(HOME))
     s = robot.reset(HOME)  # and a reset starts a new loop
     assert np.linalg.norm(s.pos - HOME.pos) < 0.006
+
+
+def test_gil_switch_interval_is_short_while_connected(franka_sim: object) -> None:
+    import sys
+
+    before = sys.getswitchinterval()
+    with FrankaRobot("127.0.0.1", params=_params(), realtime=False):
+        assert sys.getswitchinterval() <= 2e-4  # a busy caller cannot stall a tick for 5 ms
+    assert sys.getswitchinterval() == before

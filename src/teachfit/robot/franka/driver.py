@@ -24,6 +24,7 @@ Cartesian impedance approach with our own law.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,6 +41,8 @@ from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
 
+#: GIL switch interval (s) while a driver runs
+SWITCH_INTERVAL = 2e-4
 #: nominal apparent mass/inertia at the TCP (kg, kg·m²) for critical damping
 FRANKA_APPARENT_MASS = (2.0, 2.0, 2.0, 0.05, 0.05, 0.05)
 
@@ -98,6 +101,11 @@ class FrankaRobot:
         import pylibfranka as pf
 
         self._pf = pf
+        # the control thread must get the GIL within a fraction of a tick when the caller's
+        # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
+        # delay a tick by up to 5 periods. Process-wide; restored by close().
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
         self.host = host
         self.params = params or FrankaParams()
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
@@ -179,6 +187,7 @@ class FrankaRobot:
     def close(self) -> None:
         """Finish the control loop (the arm holds where it is) and release the connection."""
         self._loop.finish()
+        sys.setswitchinterval(self._switch_interval)
         robot, self._robot = self._robot, None
         if robot is not None:
             try:
