@@ -9,7 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from teachfit.core.control import AdaptiveSpec, FixedGainSpec
-from teachfit.core.errors import ConnectionLost, LimitViolation, RobotFault
+from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, RobotFault
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.interface import Robot
@@ -93,6 +93,9 @@ def test_adaptive_law_runs_in_the_loop(robot: FrankaRobot) -> None:
     robot.command(ImpedanceCommand(pos=target, quat=HOME.quat, stiffness=STIFF))
     s = robot.step(1500)
     assert np.linalg.norm(s.pos - target) < TOL
+    with pytest.raises(ControlError, match="k_max"):  # refused here, not in the loop
+        robot.command(ImpedanceCommand(pos=target, stiffness=5000.0))
+    assert robot.running
     robot.reset(HOME, controller=FixedGainSpec())
     assert type(robot.law).__name__ == "CartesianImpedance"
 

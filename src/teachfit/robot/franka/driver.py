@@ -32,8 +32,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.control import make_law
 from teachfit.control.base import Controller
-from teachfit.core.control import ControllerSpec, FixedGainSpec, ImpedanceLimits
-from teachfit.core.errors import ConnectionLost, LimitViolation, RobotFault
+from teachfit.core.control import AdaptiveSpec, ControllerSpec, FixedGainSpec, ImpedanceLimits
+from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, RobotFault
 from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.robot.franka.frames import FrankaFrames
@@ -140,6 +140,11 @@ class FrankaRobot:
         if self._loop.fault is not None:
             raise self._loop.fault
         self.params.limits.check_command(cmd)
+        spec = self.controller_spec
+        if isinstance(spec, AdaptiveSpec):  # what the law's set_command would refuse in-loop
+            diag = np.diag(cmd.stiffness)
+            if np.any(diag > np.asarray(spec.limits.k_max)):
+                raise ControlError(f"command stiffness {diag.tolist()} exceeds k_max")
         self._loop.post(cmd)
 
     def step(self, n: int = 1) -> RobotState:
