@@ -60,3 +60,18 @@ def test_wrench_clipping_keeps_direction() -> None:
     w = clip_wrench_norm(np.array([30.0, 40.0, 0, 0, 0, 3.0]), 10.0, 1.0)
     np.testing.assert_allclose(w, [6.0, 8.0, 0, 0, 0, 1.0])
     assert FrankaLimits().rows()[3] == ("torque rate limit", "1000 N·m/s")
+
+
+def test_approach_waypoints_respect_the_reset_speeds() -> None:
+    from teachfit.core.geometry import Pose, quat_from_rz
+    from teachfit.robot.franka.frames import approach_waypoints
+
+    start = Pose(np.zeros(3))
+    goal = Pose(np.array([0.1, 0.0, 0.0]), quat_from_rz(0.2))
+    way = approach_waypoints(start, goal, speed=0.05, ang_speed=0.3, dt=0.01)
+    pos = np.array([start.pos] + [w.pos for w in way])
+    assert np.max(np.linalg.norm(np.diff(pos, axis=0), axis=1)) <= 0.05 * 0.01 + 1e-12
+    np.testing.assert_allclose(way[-1].pos, goal.pos)
+    np.testing.assert_allclose(way[-1].quat, goal.quat, atol=1e-12)
+    rz = np.array([w.rz for w in way])
+    assert np.max(np.abs(np.diff(rz))) <= 0.3 * 0.01 + 1e-12

@@ -28,15 +28,14 @@ import sys
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.control import make_law
 from teachfit.control.base import Controller
 from teachfit.core.control import AdaptiveSpec, ControllerSpec, FixedGainSpec, ImpedanceLimits
 from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, RobotFault
-from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
+from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
-from teachfit.robot.franka.frames import FrankaFrames
+from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
 from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
@@ -170,9 +169,9 @@ class FrankaRobot:
         if self._loop.fault is not None or not self._loop.running:
             self._restart()
         stiff = np.asarray(self.params.reset_stiffness, dtype=float)
-        start = self.state().pose
+        start, lim = self.state().pose, self.params.limits
         self._loop.install(self._approach_law(), self._hold(start, stiff))
-        for waypoint in _interpolate(start, pose, self.params.limits, 0.01):
+        for waypoint in approach_waypoints(start, pose, lim.reset_speed, lim.reset_ang_speed, 0.01):
             self.command(self._hold(waypoint, stiff))
             self.step(10)
         self._settle(pose)
@@ -321,16 +320,3 @@ class FrankaRobot:
         stiff = np.asarray(self.params.reset_stiffness, dtype=float)
         law.set_command(self._hold(here, stiff), self._loop.t_abs)
         self._loop.start(self._robot, self._model, first, law)
-
-
-def _interpolate(start: Pose, goal: Pose, limits: FrankaLimits, dt: float) -> list[Pose]:
-    """Poses from ``start`` to ``goal`` every ``dt`` s at the reset speeds (goal included),
-    with a smooth (cosine) start and stop."""
-    dist = float(np.linalg.norm(goal.pos - start.pos))
-    r0, r1 = wxyz_to_rotation(start.quat), wxyz_to_rotation(goal.quat)
-    angle = float((r0.inv() * r1).magnitude())
-    duration = max(dist / limits.reset_speed, angle / limits.reset_ang_speed, dt)
-    s = np.linspace(0.0, 1.0, int(np.ceil(duration / dt)) + 1)[1:]
-    s = 0.5 - 0.5 * np.cos(np.pi * s)
-    quats = rotation_to_wxyz(Slerp([0.0, 1.0], Rotation.concatenate([r0, r1]))(s))
-    return [Pose(start.pos + a * (goal.pos - start.pos), q) for a, q in zip(s, quats, strict=True)]

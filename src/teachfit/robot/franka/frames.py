@@ -16,8 +16,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
 
-from teachfit.core.geometry import Pose
+from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 
 #: the task cell 0.5 m in front of and 0.25 m above the robot base
 DEFAULT_BASE2WORLD = Pose(np.array([-0.5, 0.0, -0.25]))
@@ -57,3 +58,19 @@ def col_major(values: object) -> np.ndarray:
 def skew(v: np.ndarray) -> np.ndarray:
     """The cross-product matrix of ``v`` (3,)."""
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def approach_waypoints(
+    start: Pose, goal: Pose, speed: float, ang_speed: float, dt: float
+) -> list[Pose]:
+    """Poses from ``start`` to ``goal`` every ``dt`` s at most ``speed`` (m/s) and
+    ``ang_speed`` (rad/s), with a smooth (cosine) start and stop; the goal is the last one."""
+    dist = float(np.linalg.norm(goal.pos - start.pos))
+    r0, r1 = wxyz_to_rotation(start.quat), wxyz_to_rotation(goal.quat)
+    angle = float((r0.inv() * r1).magnitude())
+    # a cosine profile peaks at pi/2 times the mean speed
+    duration = max(0.5 * np.pi * dist / speed, 0.5 * np.pi * angle / ang_speed, dt)
+    s = np.linspace(0.0, 1.0, int(np.ceil(duration / dt)) + 1)[1:]
+    s = 0.5 - 0.5 * np.cos(np.pi * s)
+    quats = rotation_to_wxyz(Slerp([0.0, 1.0], Rotation.concatenate([r0, r1]))(s))
+    return [Pose(start.pos + a * (goal.pos - start.pos), q) for a, q in zip(s, quats, strict=True)]
