@@ -98,11 +98,30 @@ def _fr3(
     return FR3Robot(task, controller=controller, params=params, seed=seed)
 
 
+def _franka(
+    task: Task, *, controller: ControllerSpec | None = None, seed: int = 0, **options: Any
+) -> Robot:
+    from teachfit.robot.franka import franka_for_task
+
+    del seed  # a real robot has no simulated noise to seed
+    return franka_for_task(task, controller=controller, **options)
+
+
 register(
     RobotEntry(
         "fr3",
         _fr3,
         "a torque-controlled 7-DOF Franka FR3: Cartesian impedance in joint torques, external "
         "wrench from joint torques (sensor='wrist-ft': a wrist F/T sensor) (MuJoCo)",
+    )
+)
+
+register(
+    RobotEntry(
+        "franka",
+        _franka,
+        "a real Franka FR3/Panda over libfranka (host=ADDRESS), torque control, "
+        "wrench from joint torques (pip install teachfit[franka])",
+        simulated=False,
     )
 )

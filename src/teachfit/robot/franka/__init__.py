@@ -1,0 +1,58 @@
+"""A real Franka arm behind :class:`~teachfit.robot.interface.Robot` (pylibfranka torque control).
+
+Modules: :mod:`.driver` (:class:`FrankaRobot`), :mod:`.tick` (the per-tick law-to-torque
+computation), :mod:`.safety` (:class:`FrankaLimits`), :mod:`.frames` (base/world, EE/TCP),
+:mod:`.record` (kinesthetic teaching), :mod:`.check` (``robot check`` and the loop benchmark),
+:mod:`.sim` (the libfranka-protocol simulator franky-sim, confined to loopback).
+Needs the ``franka`` extra (``pylibfranka``; ``franky-sim`` for the simulator).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from teachfit.core.control import ControllerSpec
+from teachfit.core.errors import TeachfitError
+from teachfit.core.geometry import Pose
+from teachfit.robot.franka.frames import DEFAULT_BASE2WORLD, FrankaFrames, ee2tcp_for_part
+from teachfit.robot.franka.safety import FrankaLimits
+
+__all__ = [
+    "DEFAULT_BASE2WORLD",
+    "FrankaFrames",
+    "FrankaLimits",
+    "ee2tcp_for_part",
+    "franka_for_task",
+]
+
+
+def franka_for_task(
+    task: Any,
+    *,
+    host: str | None = None,
+    controller: ControllerSpec | None = None,
+    base2world: Pose | None = None,
+    ee2tcp: Pose | None = None,
+    limits: FrankaLimits | None = None,
+    realtime: bool = True,
+) -> Any:
+    """A connected :class:`~teachfit.robot.franka.driver.FrankaRobot` for ``task``'s cell.
+
+    ``host`` the robot's address (required), ``base2world`` where the robot base sits in the
+    task world (default :data:`DEFAULT_BASE2WORLD`), ``ee2tcp`` the TCP in libfranka's EE frame
+    (default: the task's held part of ``held_part_length`` with its top at EE).
+    """
+    if not host:
+        raise TeachfitError("robot 'franka' needs host=ADDRESS (the robot's or simulator's IP)")
+    try:
+        from teachfit.robot.franka.driver import FrankaParams, FrankaRobot
+    except ImportError as exc:  # pragma: no cover - depends on the installed extras
+        raise TeachfitError(
+            f"robot 'franka' needs pylibfranka: pip install teachfit[franka] ({exc})"
+        ) from exc
+    frames = FrankaFrames(
+        base2world=base2world or DEFAULT_BASE2WORLD,
+        ee2tcp=ee2tcp or ee2tcp_for_part(task.held_part_length),
+    )
+    params = FrankaParams(limits=limits or FrankaLimits(), frames=frames)
+    return FrankaRobot(host, controller=controller, params=params, realtime=realtime)

@@ -1,0 +1,133 @@
+"""``teachfit robot check`` and ``teachfit bench robot --robot franka``: library functions.
+
+:func:`check_robot` connects, reads the state, reports the driver's limits and measures the
+loop timing while holding the current pose. :func:`bench_loop` runs the torque loop for a
+while (10 s by default) and prints the per-tick compute time (read -> torques ready) and the
+missed deadlines. Neither moves the arm: the loop holds the pose it finds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from teachfit.robot.franka.driver import FrankaParams, FrankaRobot
+from teachfit.robot.franka.safety import FrankaLimits
+
+
+@dataclass(frozen=True)
+class LoopTiming:
+    """Timing of ``ticks`` control ticks.
+
+    ``compute_p50``/``compute_p99``/``compute_max`` per-tick compute time (s), ``overruns``
+    ticks whose compute took longer than the period, ``missed_packets`` robot states the loop
+    did not read (gaps between consecutive states over 1.5 periods, counted in periods),
+    ``period`` (s), ``wall_rate`` ticks per wall-clock second (0: not measured; a real robot
+    runs at 1000, a simulator may run slower than real time).
+    """
+
+    ticks: int
+    compute_p50: float
+    compute_p99: float
+    compute_max: float
+    overruns: int
+    missed_packets: int
+    period: float
+    wall_rate: float = 0.0
+
+    def lines(self) -> list[str]:
+        """Human-readable figures."""
+        return [
+            f"ticks: {self.ticks} ({self.ticks * self.period:.1f} s at {1 / self.period:.0f} Hz)",
+            f"tick compute time: p50 {self.compute_p50 * 1e6:.0f} µs, p99 "
+            f"{self.compute_p99 * 1e6:.0f} µs, max {self.compute_max * 1e6:.0f} µs",
+            f"missed deadlines: {self.overruns} ticks over {self.period * 1e3:.0f} ms, "
+            f"{self.missed_packets} robot states never read",
+        ] + ([f"wall-clock rate: {self.wall_rate:.0f} ticks/s"] if self.wall_rate else [])
+
+
+@dataclass(frozen=True)
+class RobotCheck:
+    """What ``teachfit robot check`` prints: connection, state, limits, loop timing."""
+
+    host: str
+    robot_mode: str
+    q: tuple[float, ...]
+    tcp_pos: tuple[float, float, float]
+    limits: tuple[tuple[str, str], ...]
+    timing: LoopTiming
+
+    def lines(self) -> list[str]:
+        out = [f"robot at {self.host}: mode {self.robot_mode}"]
+        out.append("joints (rad): " + ", ".join(f"{v:+.3f}" for v in self.q))
+        out.append("TCP (m, world): " + ", ".join(f"{v:+.4f}" for v in self.tcp_pos))
+        out += [f"{name}: {value}" for name, value in self.limits]
+        return out + self.timing.lines()
+
+
+def loop_timing(robot: FrankaRobot, ticks: int) -> LoopTiming:
+    """Timing of the last ``ticks`` ticks the driver ran (at most its ring buffer)."""
+    size = len(robot.compute_times)
+    n = min(ticks, robot.ticks, size)
+    idx = (np.arange(robot.ticks - n, robot.ticks)) % size
+    comp, gaps = robot.compute_times[idx], robot.read_gaps[idx]
+    period = robot.control_period
+    missed = np.round(gaps / period) - 1
+    return LoopTiming(
+        ticks=int(n),
+        compute_p50=float(np.percentile(comp, 50)) if n else 0.0,
+        compute_p99=float(np.percentile(comp, 99)) if n else 0.0,
+        compute_max=float(comp.max()) if n else 0.0,
+        overruns=int(np.sum(comp > period)),
+        missed_packets=int(np.sum(missed[gaps > 1.5 * period])),
+        period=period,
+    )
+
+
+def bench_loop(
+    host: str,
+    seconds: float = 10.0,
+    params: FrankaParams | None = None,
+    realtime: bool = True,
+    out: Callable[[str], None] | None = print,
+) -> LoopTiming:
+    """Run the torque loop holding the current pose for ``seconds`` s and report its timing."""
+    with FrankaRobot(host, params=params, realtime=realtime) as robot:
+        robot.step(100)  # let the loop start up
+        ticks = int(round(seconds / robot.control_period))
+        start = time.perf_counter()
+        robot.step(ticks)
+        wall = time.perf_counter() - start
+        timing = dataclasses.replace(loop_timing(robot, ticks), wall_rate=ticks / wall)
+    if out is not None:
+        for line in timing.lines():
+            out(line)
+    return timing
+
+
+def check_robot(
+    host: str,
+    limits: FrankaLimits | None = None,
+    seconds: float = 1.0,
+    realtime: bool = True,
+) -> RobotCheck:
+    """Connect to the Franka at ``host``, read its state, and time ``seconds`` s of the loop."""
+    params = FrankaParams(limits=limits or FrankaLimits())
+    with FrankaRobot(host, params=params, realtime=realtime) as robot:
+        mode = robot.robot_mode
+        ticks = int(round(seconds / robot.control_period))
+        state = robot.step(ticks)
+        timing = loop_timing(robot, ticks)
+        q = tuple(float(v) for v in robot.joint_positions)
+    return RobotCheck(
+        host=host,
+        robot_mode=mode,
+        q=q,
+        tcp_pos=tuple(float(v) for v in state.pos),  # type: ignore[arg-type]
+        limits=tuple(params.limits.rows()),
+        timing=timing,
+    )

@@ -1,0 +1,322 @@
+"""A real Franka (FR3 / Panda) behind :class:`~teachfit.robot.interface.Robot`, over pylibfranka.
+
+The driver runs libfranka's torque control in its own control thread
+(:mod:`teachfit.robot.franka.loop`): every tick it reads the state, runs teachfit's impedance
+law (fixed-gain or adaptive, from the ``ControllerSpec`` given at :meth:`reset`), maps the TCP
+wrench to joint torques (:mod:`teachfit.robot.franka.tick`) and writes them. :meth:`command`
+posts a set-point (after the safety checks) that the loop adopts at its next tick;
+:meth:`step` blocks on a condition until ``n`` more ticks ran and raises the latched fault.
+
+Faults: libfranka's ``ControlException`` becomes :class:`ReflexFault` (a reflex) or
+:class:`LimitViolation` (a limit), ``NetworkException`` :class:`ConnectionLost` (so does a loop
+that stops ticking); the driver's own limits (:mod:`teachfit.robot.franka.safety`) raise
+:class:`LimitViolation`. After a fault no torque is commanded and every call but
+:meth:`reset` / :meth:`close` re-raises it. Ctrl-C (``KeyboardInterrupt``) during :meth:`step`
+holds the TCP where it is for ``stop_hold`` s, finishes the motion, and re-raises.
+
+Why pylibfranka and not franky-control: teachfit's law must run in the 1 kHz torque loop;
+pylibfranka (Apache-2.0, Franka's own bindings) gives that loop, the model (Jacobian,
+Coriolis) and the state with nothing in between. franky-control (MIT) is built around its own
+motion generators and impedance motions: a second controller stack, and no way to run our law
+per tick. Its motion-level parts (joint motions for reset) are not needed: reset is a slow
+Cartesian impedance approach with our own law.
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from teachfit.control import make_law
+from teachfit.control.base import Controller
+from teachfit.core.control import AdaptiveSpec, ControllerSpec, FixedGainSpec, ImpedanceLimits
+from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, RobotFault
+from teachfit.core.geometry import Pose, wxyz_to_rotation
+from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
+from teachfit.robot.franka.loop import ControlLoop, fault_from
+from teachfit.robot.franka.safety import FrankaLimits
+from teachfit.robot.franka.tick import TorqueTick
+
+#: GIL switch interval (s) while a driver runs
+SWITCH_INTERVAL = 2e-4
+#: nominal apparent mass/inertia at the TCP (kg, kg·m²) for critical damping
+FRANKA_APPARENT_MASS = (2.0, 2.0, 2.0, 0.05, 0.05, 0.05)
+
+
+@dataclass(frozen=True)
+class FrankaParams:
+    """Driver settings.
+
+    ``limits`` the safety limits, ``frames`` base/world and EE/TCP, ``apparent_mass`` (6,)
+    (kg, kg·m²) for critical damping, ``reset_stiffness`` (N/m, N·m/rad) of the approach in
+    :meth:`FrankaRobot.reset`, ``reset_tolerance`` (m, rad) it must reach, ``settle_timeout``
+    (s of robot time) it may take after the set-point arrived, ``bias_ticks`` how many ticks
+    the wrench bias averages, ``stop_hold`` (s) the hold before the loop ends on Ctrl-C,
+    ``tick_timeout`` (s) without a tick after which the connection counts as lost.
+    """
+
+    limits: FrankaLimits = field(default_factory=FrankaLimits)
+    frames: FrankaFrames = field(default_factory=FrankaFrames)
+    apparent_mass: tuple[float, ...] = FRANKA_APPARENT_MASS
+    reset_stiffness: tuple[float, ...] = (2000.0,) * 3 + (100.0,) * 3
+    reset_tolerance: tuple[float, float] = (0.005, 0.05)
+    settle_timeout: float = 3.0
+    bias_ticks: int = 50
+    stop_hold: float = 0.2
+    tick_timeout: float = 1.5
+
+
+class FrankaRobot:
+    """A Franka arm driven in torque control with teachfit's impedance law.
+
+    Implements :class:`~teachfit.robot.interface.Robot`. Connecting starts the control loop
+    holding the current pose; :meth:`reset` moves to a pose.
+
+    Parameters
+    ----------
+    host : str
+        Robot (or simulator) address.
+    controller : ControllerSpec or None
+        Law run after the first :meth:`reset` (default fixed-gain).
+    params : FrankaParams or None
+    realtime : bool
+        Enforce libfranka's real-time scheduling check (a real robot needs an RT kernel; the
+        simulator and the tests pass ``False``).
+    """
+
+    name = "franka"
+    wrench_source = "joint-torques"
+
+    def __init__(
+        self,
+        host: str,
+        controller: ControllerSpec | None = None,
+        params: FrankaParams | None = None,
+        realtime: bool = True,
+    ) -> None:
+        import pylibfranka as pf
+
+        self._pf = pf
+        # the control thread must get the GIL within a fraction of a tick when the caller's
+        # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
+        # delay a tick by up to 5 periods. Process-wide; restored by close().
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
+        self.host = host
+        self.params = params or FrankaParams()
+        self.controller_spec: ControllerSpec = controller or FixedGainSpec()
+        self._realtime = pf.RealtimeConfig.kEnforce if realtime else pf.RealtimeConfig.kIgnore
+        self._robot = None
+        self._connect()
+        self._mass = np.asarray(self.params.apparent_mass, dtype=float)
+        tick = TorqueTick(self.params.frames, self.params.limits, self.control_period)
+        self._loop = ControlLoop(tick, self.params.limits, self.control_period)
+        #: completed resets (a reset restarts the clock)
+        self.resets = 0
+        self.robot_mode = "unknown"
+        self._start()
+
+    # ------------------------------------------------------------------ Robot protocol
+    @property
+    def control_period(self) -> float:
+        return 0.001
+
+    @property
+    def time(self) -> float:
+        return self._loop.t_abs - self._loop.t0
+
+    def state(self) -> RobotState:
+        if self._loop.latest is None:
+            raise ConnectionLost("no state received from the robot yet")
+        return self._loop.latest
+
+    def command(self, cmd: ImpedanceCommand) -> None:
+        """Post ``cmd`` to the control loop (adopted at its next tick) after the safety checks;
+        a command over a limit raises :class:`LimitViolation` and is not sent."""
+        if self._loop.fault is not None:
+            raise self._loop.fault
+        self.params.limits.check_command(cmd)
+        spec = self.controller_spec
+        if isinstance(spec, AdaptiveSpec):  # what the law's set_command would refuse in-loop
+            diag = np.diag(cmd.stiffness)
+            if np.any(diag > np.asarray(spec.limits.k_max)):
+                raise ControlError(f"command stiffness {diag.tolist()} exceeds k_max")
+        self._loop.post(cmd)
+
+    def step(self, n: int = 1) -> RobotState:
+        """Wait until ``n`` more control ticks have run; raise the latched fault if any."""
+        try:
+            self._loop.wait(n, self.params.tick_timeout)
+        except KeyboardInterrupt:
+            self.stop()
+            raise
+        return self.state()
+
+    def reset(self, pose: Pose, controller: ControllerSpec | None = None) -> RobotState:
+        """Move the TCP to ``pose`` (world) at the reset speeds, wait until it settles, zero the
+        wrench reading, and run ``controller`` (``None``: the current spec, state cleared).
+
+        Clears a latched fault (libfranka's automatic error recovery, or a reconnection after a
+        lost connection, then a new control loop). Raises :class:`LimitViolation` if ``pose``
+        is outside the workspace (nothing moves) or is not reached within the tolerance.
+        """
+        self.params.limits.check_target(pose.pos, "reset pose")
+        if controller is not None:
+            self.controller_spec = controller
+        if self._loop.fault is not None or not self._loop.running:
+            self._restart()
+        stiff = np.asarray(self.params.reset_stiffness, dtype=float)
+        start, lim = self.state().pose, self.params.limits
+        self._loop.install(self._approach_law(), self._hold(start, stiff))
+        for waypoint in approach_waypoints(start, pose, lim.reset_speed, lim.reset_ang_speed, 0.01):
+            self.command(self._hold(waypoint, stiff))
+            self.step(10)
+        self._settle(pose)
+        tick = self._loop.tick
+        bias = np.zeros(6)
+        for _ in range(self.params.bias_ticks):
+            bias += self.step(1).wrench + tick.bias
+        tick.bias = bias / self.params.bias_ticks
+        tick.q_rest = self._loop.q.copy()
+        law = make_law(self.controller_spec, self._mass, self.control_period)
+        self._loop.install(law, ImpedanceCommand.hold(pose))
+        self.step(1)
+        self._loop.t0 = self._loop.t_abs
+        self.resets += 1
+        return self.step(1)
+
+    def close(self) -> None:
+        """Finish the control loop (the arm holds where it is) and release the connection."""
+        self._loop.finish()
+        sys.setswitchinterval(self._switch_interval)
+        robot, self._robot = self._robot, None
+        if robot is not None:
+            try:
+                robot.stop()
+            except Exception:  # noqa: BLE001 - best effort on a robot already gone
+                pass
+
+    def __enter__(self) -> FrankaRobot:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def tap(self, every: int) -> None:
+        """Sample the state every ``every`` ticks *in the control thread* (lossless however
+        late the caller's thread runs) until :meth:`untap`; used by kinesthetic recording."""
+        self._loop.tap(every)
+
+    def untap(self) -> list[RobotState]:
+        """Stop sampling and return the states sampled since :meth:`tap`."""
+        return self._loop.untap()
+
+    # ------------------------------------------------------------------ inspection
+    @property
+    def law(self) -> Controller | None:
+        """The control law running in the loop (inspection and tests)."""
+        return self._loop.law
+
+    @property
+    def running(self) -> bool:
+        """Whether the control loop runs."""
+        return self._loop.running
+
+    @property
+    def ticks(self) -> int:
+        """Control ticks run since the driver connected."""
+        return self._loop.ticks
+
+    @property
+    def joint_positions(self) -> np.ndarray:
+        """The last measured joint angles (7,) (rad)."""
+        return self._loop.q.copy()
+
+    @property
+    def compute_times(self) -> np.ndarray:
+        """Ring buffer of per-tick compute times (s), indexed by tick modulo its length."""
+        return self._loop.compute_times
+
+    @property
+    def read_gaps(self) -> np.ndarray:
+        """Ring buffer of robot time between consecutive states read (s)."""
+        return self._loop.read_gaps
+
+    # ------------------------------------------------------------------ stopping
+    def stop(self) -> None:
+        """Hold the TCP where it is for ``stop_hold`` s, then finish the motion (Ctrl-C path)."""
+        loop = self._loop
+        if loop.fault is None and loop.latest is not None:
+            stiff = np.asarray(self.params.reset_stiffness, dtype=float)
+            loop.post(self._hold(loop.latest.pose, stiff))
+            try:
+                loop.wait(int(self.params.stop_hold / self.control_period), 1.0)
+            except RobotFault:
+                pass
+        loop.finish()
+        if loop.fault is None:
+            loop.fault = RobotFault("the control loop was stopped (Ctrl-C); reset() to go on")
+
+    # ------------------------------------------------------------------ internals
+    def _hold(self, pose: Pose, stiffness: np.ndarray) -> ImpedanceCommand:
+        return ImpedanceCommand.hold(pose, stiffness=stiffness, expires_after=1.0)
+
+    def _approach_law(self) -> Controller:
+        lim = self.params.limits
+        spec = FixedGainSpec(
+            ImpedanceLimits(lim.max_force, lim.max_torque, lim.reset_speed, lim.reset_ang_speed)
+        )
+        return make_law(spec, self._mass, self.control_period)
+
+    def _settle(self, pose: Pose) -> None:
+        tol_p, tol_r = self.params.reset_tolerance
+        target = wxyz_to_rotation(pose.quat).inv()
+        for _ in range(int(self.params.settle_timeout / 0.01)):
+            s = self.step(10)
+            dp = float(np.linalg.norm(s.pos - pose.pos))
+            dr = float((target * wxyz_to_rotation(s.quat)).magnitude())
+            if dp < tol_p and dr < tol_r and np.linalg.norm(s.lin_vel) < 0.005:
+                return
+        raise LimitViolation(
+            f"reset did not reach {np.round(pose.pos, 4).tolist()} within {tol_p} m / "
+            f"{tol_r} rad (at {np.round(s.pos, 4).tolist()}: {dp:.4f} m, {dr:.3f} rad)"
+        )
+
+    def _connect(self) -> None:
+        pf = self._pf
+        try:
+            self._robot = pf.Robot(self.host, self._realtime)
+            self._model = self._robot.load_model()
+        except (pf.NetworkException, RuntimeError) as exc:
+            raise ConnectionLost(f"cannot connect to the Franka at {self.host}: {exc}") from exc
+
+    def _restart(self) -> None:
+        lost = isinstance(self._loop.fault, ConnectionLost) or self._robot is None
+        self._loop.finish()
+        if lost:
+            self._connect()
+        else:
+            try:
+                self._robot.automatic_error_recovery()  # type: ignore[union-attr]
+            except Exception as exc:  # noqa: BLE001 - any failure here is a robot fault
+                raise fault_from(exc) from exc
+        self._start()
+
+    def _start(self) -> None:
+        """Start a control loop holding the current pose."""
+        try:
+            first = self._robot.read_once()  # type: ignore[union-attr]
+        except Exception as exc:  # noqa: BLE001
+            raise fault_from(exc) from exc
+        self.robot_mode = str(first.robot_mode).split(".")[-1]
+        tick = self._loop.tick
+        tick.kinematics(first, self._model)
+        tick.q_rest = np.asarray(first.q, dtype=float)
+        here = Pose(tick.pos.copy(), tick.quat.copy())
+        law = self._approach_law()
+        stiff = np.asarray(self.params.reset_stiffness, dtype=float)
+        law.set_command(self._hold(here, stiff), self._loop.t_abs)
+        self._loop.start(self._robot, self._model, first, law)

@@ -1,0 +1,208 @@
+"""FrankaRobot through the real libfranka protocol (pylibfranka client, franky-sim server)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from teachfit.core.control import AdaptiveSpec, FixedGainSpec
+from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, RobotFault
+from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.interface import Robot
+
+pytest.importorskip("pylibfranka", reason="needs the franka extra (pylibfranka)")
+
+from teachfit.robot.franka import FrankaFrames, FrankaLimits, ee2tcp_for_part  # noqa: E402
+from teachfit.robot.franka.driver import FrankaParams, FrankaRobot  # noqa: E402
+
+PART = 0.05  # held part length (m)
+HOME = Pose(np.array([0.0, 0.0, 0.15]))  # part pointing straight down above the cell
+STIFF = np.array([3000.0] * 3 + [150.0] * 3)
+# franky-sim's FR3 joints have 1.14 N·m Coulomb friction (frictionloss): at 3000 N/m the TCP
+# stops a few mm short of a set-point. The tolerances below are that, not control error.
+TOL = 0.006
+
+
+def _params(limits: FrankaLimits | None = None) -> FrankaParams:
+    return FrankaParams(
+        limits=limits or FrankaLimits(), frames=FrankaFrames(ee2tcp=ee2tcp_for_part(PART))
+    )
+
+
+@pytest.fixture
+def robot(franka_sim: object) -> Iterator[FrankaRobot]:
+    r = FrankaRobot("127.0.0.1", params=_params(), realtime=False)
+    try:
+        yield r
+    finally:
+        r.close()
+
+
+def test_connects_and_reports_the_tcp_in_the_task_world(
+    franka_sim: object, expected_tcp: Callable[[FrankaFrames], np.ndarray]
+) -> None:
+    frames = _params().frames
+    want = expected_tcp(frames)
+    with FrankaRobot("127.0.0.1", params=_params(), realtime=False) as robot:
+        assert isinstance(robot, Robot)
+        s = robot.step(10)
+        np.testing.assert_allclose(s.pos, want[:, 3], atol=2e-3)
+        rot = Rotation.from_quat(np.roll(s.quat, -1)).as_matrix()
+        np.testing.assert_allclose(rot, want[:, :3], atol=5e-3)
+        assert np.linalg.norm(s.lin_vel) < 0.01
+        assert robot.wrench_source == "joint-torques" and robot.control_period == 0.001
+        t0 = robot.ticks
+        robot.step(50)
+        assert robot.ticks >= t0 + 50
+
+
+def test_default_frames_put_the_part_pointing_down_above_the_cell(robot: FrankaRobot) -> None:
+    """At franky-sim's start pose (EE 0.554 m ahead, 0.521 m up, pointing down) the default
+    base2world puts the TCP near the cell and an identity quaternion means part down."""
+    s = robot.reset(Pose(np.array([0.054, 0.0, 0.221])))
+    assert abs(abs(s.quat[0]) - 1.0) < 0.01
+    np.testing.assert_allclose(robot.joint_positions[[1, 3, 5]], [0.0, -1.57, 1.57], atol=0.15)
+
+
+def test_reset_moves_to_the_pose_and_zeroes_time(robot: FrankaRobot) -> None:
+    s = robot.reset(HOME)
+    assert 0.0 < s.t < 0.05  # the clock restarted at the end of the reset (in robot ticks)
+    assert robot.time >= s.t
+    assert np.linalg.norm(s.pos - HOME.pos) < 0.006
+    assert np.linalg.norm(s.wrench) < 1e-6  # bias taken at rest
+
+
+def test_holds_and_tracks_a_small_cartesian_move(robot: FrankaRobot) -> None:
+    start = robot.reset(HOME)
+    target = start.pos + np.array([0.02, -0.01, -0.01])
+    robot.command(ImpedanceCommand(pos=target, quat=HOME.quat, stiffness=STIFF))
+    s = robot.step(1500)
+    assert np.linalg.norm(s.pos - target) < TOL
+    assert np.linalg.norm(s.pos - start.pos) > 0.02  # it did move
+    assert np.linalg.norm(s.lin_vel) < 0.01  # and came to rest
+
+
+def test_adaptive_law_runs_in_the_loop(robot: FrankaRobot) -> None:
+    robot.reset(HOME, controller=AdaptiveSpec())
+    assert type(robot.law).__name__ == "AdaptiveImpedance"
+    target = HOME.pos + np.array([0.0, 0.02, 0.0])
+    robot.command(ImpedanceCommand(pos=target, quat=HOME.quat, stiffness=STIFF))
+    s = robot.step(1500)
+    assert np.linalg.norm(s.pos - target) < TOL
+    with pytest.raises(ControlError, match="k_max"):  # refused here, not in the loop
+        robot.command(ImpedanceCommand(pos=target, stiffness=5000.0))
+    assert robot.running
+    robot.reset(HOME, controller=FixedGainSpec())
+    assert type(robot.law).__name__ == "CartesianImpedance"
+
+
+def test_skill_like_sequence_follows_and_expires(robot: FrankaRobot) -> None:
+    """A line at 2 cm/s commanded every 50 ms, then one moving command left to expire."""
+    start = robot.reset(HOME)
+    v = np.array([0.02, 0.0, 0.0])
+    states = []
+    for k in range(20):  # 1 s
+        robot.command(
+            ImpedanceCommand(
+                pos=start.pos + v * 0.05 * k, lin_vel=v, stiffness=STIFF, expires_after=0.1
+            )
+        )
+        states.append(robot.step(50))
+    ys = np.array([s.pos for s in states])
+    assert np.all(np.diff(ys[:, 0])[3:] > 0)  # moving along +x throughout
+    assert abs(ys[-1, 0] - (start.pos[0] + 0.02)) < TOL
+    # the set-point moves only for expires_after = 0.2 s: 4 mm, not the 2 cm of 1 s
+    here = robot.state().pos
+    robot.command(ImpedanceCommand(pos=here, lin_vel=v, stiffness=STIFF, expires_after=0.2))
+    s = robot.step(1000)
+    assert np.linalg.norm(s.pos[0] - here[0]) < 0.004 + TOL
+    assert np.linalg.norm(s.lin_vel) < 0.01
+
+
+def test_wrench_over_the_limit_is_refused_before_sending(robot: FrankaRobot) -> None:
+    s = robot.reset(HOME)
+    too_much = ImpedanceCommand.hold(s.pose, wrench_ff=[0, 0, -80.0, 0, 0, 0])
+    with pytest.raises(LimitViolation, match="nothing was sent"):
+        robot.command(too_much)
+    after = robot.step(300)
+    assert np.linalg.norm(after.pos - s.pos) < 0.003  # it still just holds
+    with pytest.raises(LimitViolation, match="workspace"):
+        robot.reset(Pose(np.array([0.0, 0.0, 0.9])))
+    with pytest.raises(LimitViolation, match="workspace"):
+        robot.command(ImpedanceCommand(pos=[0.5, 0.0, 0.1]))
+
+
+def test_speed_limit_faults_the_loop_and_reset_recovers(franka_sim: object) -> None:
+    limits = FrankaLimits(max_tcp_speed=0.02)
+    with FrankaRobot("127.0.0.1", params=_params(limits), realtime=False) as robot:
+        robot.reset(HOME)
+        robot.command(
+            ImpedanceCommand(pos=HOME.pos + [0.05, 0.0, 0.0], stiffness=STIFF, expires_after=5)
+        )
+        with pytest.raises(LimitViolation, match="TCP speed"):
+            robot.step(2000)
+        with pytest.raises(LimitViolation):  # latched: nothing more is accepted
+            robot.command(ImpedanceCommand.hold(HOME))
+        kept = robot.state()
+        assert np.linalg.norm(kept.lin_vel) >= 0.02  # the state that tripped it is kept
+        s = robot.reset(HOME)
+        assert np.linalg.norm(s.pos - HOME.pos) < 0.006
+
+
+def test_killed_server_is_a_lost_connection_with_the_data_kept(franka_sim: object) -> None:
+    robot = FrankaRobot("127.0.0.1", params=_params(), realtime=False)
+    old_pid = franka_sim.pid  # type: ignore[attr-defined]
+    recorded = []
+    try:
+        robot.reset(HOME)
+        v = np.array([0.0, 0.02, 0.0])
+        with pytest.raises(ConnectionLost) as err:
+            for k in range(40):
+                robot.command(ImpedanceCommand(pos=HOME.pos + v * 0.05 * k, lin_vel=v))
+                recorded.append(robot.step(50))
+                if k == 10:
+                    franka_sim.kill()  # type: ignore[attr-defined]
+        assert "no control tick" in str(err.value) or "Network" in str(err.value)
+        assert 10 <= len(recorded) <= 12
+        assert all(np.all(np.isfinite(s.pos)) for s in recorded)
+        with pytest.raises(RobotFault):
+            robot.step(1)
+    finally:
+        robot.close()
+        franka_sim.start()  # type: ignore[attr-defined]
+    import os
+
+    assert not os.path.exists(f"/proc/{old_pid}")  # the killed server is gone, reaped
+
+
+def test_ctrl_c_holds_then_finishes_the_loop(robot: FrankaRobot) -> None:
+    import os
+    import signal
+    import threading
+
+    robot.reset(HOME)
+    robot.command(ImpedanceCommand(pos=HOME.pos + [0.0, 0.03, 0.0], lin_vel=[0, 0.01, 0]))
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        robot.step(5000)
+    timer.join()
+    assert not robot.running  # the loop finished
+    assert np.linalg.norm(robot.state().lin_vel) < 0.02  # held still before finishing
+    with pytest.raises(RobotFault, match="Ctrl-C"):
+        robot.command(ImpedanceCommand.hold(HOME))
+    s = robot.reset(HOME)  # and a reset starts a new loop
+    assert np.linalg.norm(s.pos - HOME.pos) < 0.006
+
+
+def test_gil_switch_interval_is_short_while_connected(franka_sim: object) -> None:
+    import sys
+
+    before = sys.getswitchinterval()
+    with FrankaRobot("127.0.0.1", params=_params(), realtime=False):
+        assert sys.getswitchinterval() <= 2e-4  # a busy caller cannot stall a tick for 5 ms
+    assert sys.getswitchinterval() == before

@@ -1,0 +1,81 @@
+"""The per-tick conversions of the Franka driver on real pylibfranka states and model."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pf = pytest.importorskip("pylibfranka", reason="needs the franka extra (pylibfranka)")
+
+from teachfit.core.errors import ConnectionLost, LimitViolation, ReflexFault, RobotFault  # noqa: E402
+from teachfit.robot.franka import FrankaFrames, FrankaLimits, ee2tcp_for_part  # noqa: E402
+from teachfit.robot.franka.loop import fault_from  # noqa: E402
+from teachfit.robot.franka.tick import TorqueTick  # noqa: E402
+
+
+@pytest.fixture
+def state_and_model(franka_sim: object) -> tuple[object, object]:
+    robot = pf.Robot("127.0.0.1", pf.RealtimeConfig.kIgnore)
+    return robot.read_once(), robot.load_model()
+
+
+def test_measured_wrench_is_the_environments_on_the_tool_at_the_tcp(
+    state_and_model: tuple[object, object],
+) -> None:
+    state, model = state_and_model
+    tick = TorqueTick(FrankaFrames(ee2tcp=ee2tcp_for_part(0.05)), FrankaLimits())
+    # libfranka: the robot pushes the environment along -x (and twists it about -z) at K = EE
+    state.O_F_ext_hat_K = [-4.0, 0.0, 0.0, 0.0, 0.0, -0.3]  # type: ignore[attr-defined]
+    tick.kinematics(state, model)
+    w = tick.raw_wrench(state)
+    o_t_ee = np.asarray(state.O_T_EE).reshape(4, 4, order="F")  # type: ignore[attr-defined]
+    lever = o_t_ee[:3, :3] @ np.array([0.0, 0.0, -0.05])  # TCP -> EE (base = world rotation)
+    np.testing.assert_allclose(w[:3], [4.0, 0.0, 0.0], atol=1e-6)
+    np.testing.assert_allclose(w[3:], [0.0, 0.0, 0.3] + np.cross(lever, [4.0, 0.0, 0.0]), atol=1e-6)
+
+
+def test_tcp_jacobian_moves_the_point_with_the_lever(
+    state_and_model: tuple[object, object],
+) -> None:
+    state, model = state_and_model
+    near = TorqueTick(FrankaFrames(ee2tcp=ee2tcp_for_part(0.0)), FrankaLimits())
+    far = TorqueTick(FrankaFrames(ee2tcp=ee2tcp_for_part(0.2)), FrankaLimits())
+    near.kinematics(state, model)
+    far.kinematics(state, model)
+    lever = far.pos - near.pos
+    assert np.linalg.norm(lever) == pytest.approx(0.2, abs=1e-6)
+    # same angular rows; linear rows differ by w x lever (v_far = v_near + w x lever)
+    np.testing.assert_allclose(far.jacobian[3:], near.jacobian[3:])
+    for col in range(7):
+        w = near.jacobian[3:, col]
+        np.testing.assert_allclose(
+            far.jacobian[:3, col], near.jacobian[:3, col] + np.cross(w, lever), atol=1e-9
+        )
+
+
+def test_first_torques_are_rate_limited(state_and_model: tuple[object, object]) -> None:
+    from teachfit.control import make_law
+    from teachfit.core.control import FixedGainSpec
+    from teachfit.core.geometry import Pose
+    from teachfit.core.state import ImpedanceCommand
+
+    state, model = state_and_model
+    tick = TorqueTick(FrankaFrames(), FrankaLimits())
+    tick.kinematics(state, model)
+    law = make_law(FixedGainSpec(), np.ones(6), 0.001)
+    far = Pose(tick.pos + np.array([0.05, 0.0, 0.0]), tick.quat.copy())
+    law.set_command(ImpedanceCommand.hold(far, stiffness=3000.0), 0.0)
+    tau = tick.torques(0.001, law, state, model)
+    assert np.abs(tau).max() == pytest.approx(1.0)  # 1000 N·m/s for 1 ms from zero
+    assert np.linalg.norm(tick.wrench_cmd[:3]) == pytest.approx(60.0)  # clipped to max_force
+
+
+def test_libfranka_exceptions_become_typed_faults() -> None:
+    reflex = fault_from(pf.ControlException("libfranka: Move command aborted: cartesian_reflex"))
+    assert type(reflex) is ReflexFault
+    limit = fault_from(pf.ControlException("aborted: joint_velocity_violation"))
+    assert type(limit) is LimitViolation
+    assert (
+        type(fault_from(pf.NetworkException("libfranka: UDP receive: Timeout"))) is ConnectionLost
+    )
+    assert type(fault_from(ValueError("bad"))) is RobotFault
