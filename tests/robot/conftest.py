@@ -8,6 +8,8 @@ when the ``franka`` extra (pylibfranka, franky-sim) is not installed.
 
 from __future__ import annotations
 
+import fcntl
+import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -27,11 +29,19 @@ def franka_sim(push_file: Path) -> Iterator[object]:
     pytest.importorskip("franky_sim", reason="needs the franka extra (franky-sim)")
     from teachfit.robot.franka.sim import SimServer
 
-    server = SimServer(push_file=push_file).start()
+    # one franky-sim per machine (its port 1337 is fixed): a pytest-xdist worker holds this
+    # machine-wide lock while its server runs, and another worker's first franka test waits
+    lock = (Path(tempfile.gettempdir()) / "teachfit-franky-sim.lock").open("w")
+    fcntl.flock(lock, fcntl.LOCK_EX)
     try:
-        yield server
+        server = SimServer(push_file=push_file).start()
+        try:
+            yield server
+        finally:
+            server.stop()
     finally:
-        server.stop()
+        fcntl.flock(lock, fcntl.LOCK_UN)
+        lock.close()
 
 
 @pytest.fixture

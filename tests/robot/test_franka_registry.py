@@ -27,12 +27,12 @@ def test_make_robot_connects_with_the_tasks_tcp(expected_tcp: Callable) -> None:
     from teachfit.robot.franka import FrankaFrames, ee2tcp_for_part
 
     task = get_task("peg")
-    want = expected_tcp(FrankaFrames(ee2tcp=ee2tcp_for_part(task.held_part_length)))
+    want = expected_tcp(FrankaFrames(ee2tcp=ee2tcp_for_part(task.scene.held_part_length)))
     robot = make_robot("franka", task, host="127.0.0.1", realtime=False)
     try:
         assert robot.name == "franka"
         ee2tcp = robot.params.frames.ee2tcp  # type: ignore[attr-defined]
-        np.testing.assert_allclose(ee2tcp.pos, [0, 0, task.held_part_length])
+        np.testing.assert_allclose(ee2tcp.pos, [0, 0, task.scene.held_part_length])
         s = robot.step(5)
         np.testing.assert_allclose(s.pos, want[:, 3], atol=2e-3)
     finally:

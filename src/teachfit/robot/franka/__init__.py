@@ -52,7 +52,7 @@ def franka_for_task(
         ) from exc
     frames = FrankaFrames(
         base2world=base2world or DEFAULT_BASE2WORLD,
-        ee2tcp=ee2tcp or ee2tcp_for_part(task.held_part_length),
+        ee2tcp=ee2tcp or ee2tcp_for_part(task.scene.held_part_length),
     )
     params = FrankaParams(limits=limits or FrankaLimits(), frames=frames)
     return FrankaRobot(host, controller=controller, params=params, realtime=realtime)
