@@ -20,6 +20,17 @@ RobotOpt = Annotated[
     typer.Option("--robot", help="robot to run on (teachfit robot list; simulated: floating)"),
 ]
 
+#: ``--host ADDRESS``: a real robot's address (``--robot franka``)
+HostOpt = Annotated[
+    str | None, typer.Option("--host", help="address of a real robot (--robot franka)")
+]
+
+
+def robot_options(host: str | None) -> dict[str, object]:
+    """The ``make_robot`` options the CLI's ``--host`` gives (none for simulated robots)."""
+    return {} if host is None else {"host": host}
+
+
 P = ParamSpec("P")
 R = TypeVar("R")
 

@@ -10,7 +10,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
 from teachfit.core.errors import DatasetError, TeachfitError
 from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
@@ -45,11 +45,28 @@ def record(
     append: Annotated[bool, typer.Option(help="append to an existing file")] = False,
     overwrite: Annotated[bool, typer.Option(help="replace an existing file")] = False,
     robot: RobotOpt = "floating",
+    host: HostOpt = None,
+    duration: Annotated[
+        float | None, typer.Option(help="real robot: seconds to record (default: until Ctrl-C)")
+    ] = None,
 ) -> None:
-    """Record demonstrations with the simulated blind teacher."""
+    """Record demonstrations: the simulated blind teacher on a simulated robot, or a person
+    guiding a real robot (--robot franka --host ADDRESS; Ctrl-C ends it, every sample kept)."""
+    from teachfit.robot.registry import ROBOTS, make_robot
+
     the_task = load_task(task)
-    teacher = BlindTeacher(the_task, TeacherStyle(pattern=pattern), seed=seed, robot=robot)
-    demos, discarded = teacher.record(n, progress=True)
+    if robot in ROBOTS and not ROBOTS[robot].simulated:
+        from teachfit.demonstrations.kinesthetic import record_demonstration
+
+        arm = make_robot(robot, the_task, **robot_options(host))
+        try:
+            console.print("guide the arm; Ctrl-C ends the recording")
+            demos, discarded = [record_demonstration(arm, the_task.name, duration)], []
+        finally:
+            arm.close()
+    else:
+        teacher = BlindTeacher(the_task, TeacherStyle(pattern=pattern), seed=seed, robot=robot)
+        demos, discarded = teacher.record(n, progress=True)
     if append:
         append_dataset(out, demos)
     else:

@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import HostOpt, RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.core.params import LearningError
 
@@ -60,6 +60,7 @@ def learn_skill(
         typer.Option(help="re-run the best parameters once and plot force and pose over time"),
     ] = None,
     robot: RobotOpt = "floating",
+    host: HostOpt = None,
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.bench.learning import method_options
@@ -73,7 +74,9 @@ def learn_skill(
     if method not in METHODS:
         raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
     get_task(task)  # an unknown task fails here, before any study file is created
-    obj = SkillObjective(task, skill, controller, seed, starts, _overrides(task_param), robot)
+    obj = SkillObjective(
+        task, skill, controller, seed, starts, _overrides(task_param), robot, host or ""
+    )
     tags = stored_tags(study)  # resuming keeps the stored options (e.g. the LHS design size)
     same = tags is not None and tags.get("method") == method
     options = tags.get("options", {}) if same else method_options(method, trials)

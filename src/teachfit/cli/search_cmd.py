@@ -10,7 +10,7 @@ import typer
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
 from teachfit.core.errors import TeachfitError
 from teachfit.execution.batch import episode_rng
 
@@ -125,6 +125,7 @@ def run(
     seed: int = 0,
     plot: Annotated[Path | None, typer.Option(help="figure of the executed paths")] = None,
     robot: RobotOpt = "floating",
+    host: HostOpt = None,
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
@@ -157,7 +158,7 @@ def run(
             "the hole; without --demo a nominal demonstration start is assumed"
         )
     start_poses = the_task.protocol.protocol_starts(protocol, starts, rng, demo_start)
-    the_robot = make_robot(robot, the_task, seed=seed)
+    the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host))
     fixed = plan_search(model, method, n, rng) if method.startswith("ergodic") else None
     if passes > 1 and method != "tshix":
         raise TeachfitError(f"--passes needs --method tshix, not {method}")

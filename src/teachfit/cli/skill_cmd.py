@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
 
 skill_app = typer.Typer(
     help="Manipulation skills (seed B): show a skill's graph, run it on a task.",
@@ -95,6 +95,7 @@ def run(
     width: int = 640,
     height: int = 480,
     robot: RobotOpt = "floating",
+    host: HostOpt = None,
 ) -> None:
     """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
     from teachfit.core.errors import SkillError
@@ -122,7 +123,7 @@ def run(
                 f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
                 "their defaults are used"
             )
-    trial = SkillTrial(setup, controller, robot=robot, seed=seed)
+    trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host))
     est = setup.task2world.inverse().compose(the_task.hole2world)
     console.print(
         f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate off by "

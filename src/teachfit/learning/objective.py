@@ -48,7 +48,7 @@ class SkillObjective:
     task_overrides : tuple of (name, value)
         Task parameter overrides, e.g. ``(("hole_pos_sigma", 0.001),)`` (SI units).
     robot : str
-        Robot name in :data:`teachfit.robot.registry.ROBOTS`.
+        Robot name in :data:`teachfit.robot.registry.ROBOTS`; ``host`` a real robot's address.
     """
 
     task: str
@@ -58,6 +58,7 @@ class SkillObjective:
     n_starts: int = 4
     task_overrides: tuple[tuple[str, float], ...] = ()
     robot: str = "floating"
+    host: str = ""
 
     def __post_init__(self) -> None:
         if self.n_starts < 1:
@@ -76,7 +77,8 @@ class SkillObjective:
             task = get_task(self.task, **dict(self.task_overrides))
             skill = get_skill(self.skill, self.controller)
             setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
-            found = SkillTrial(setup, self.controller, robot=self.robot, seed=self.seed)
+            options = {"host": self.host} if self.host else {}
+            found = SkillTrial(setup, self.controller, robot=self.robot, seed=self.seed, **options)
             _CACHE.clear()  # one experiment per worker at a time: keep memory flat
             _CACHE[self] = found
         return found

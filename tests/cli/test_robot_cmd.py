@@ -1,0 +1,28 @@
+"""``teachfit robot list`` / ``robot check``: what the registry holds, clear errors."""
+
+from __future__ import annotations
+
+from typer.testing import CliRunner
+
+from teachfit.cli import app
+from teachfit.robot.registry import ROBOTS
+
+runner = CliRunner()
+
+
+def test_list_names_every_registered_robot_and_its_kind() -> None:
+    res = runner.invoke(app, ["robot", "list"], env={"COLUMNS": "200"})
+    assert res.exit_code == 0, res.output
+    rows = {line.split("│")[1].strip(): line for line in res.output.splitlines() if "│" in line}
+    for name, entry in ROBOTS.items():
+        assert ("simulated" if entry.simulated else "real") in rows[name]
+    assert "teachfit[franka]" in res.output  # markup-like text is printed as is
+
+
+def test_check_needs_a_real_robot_and_its_address() -> None:
+    res = runner.invoke(app, ["robot", "check", "--robot", "floating"])
+    assert res.exit_code == 2 and "simulated" in res.output
+    res = runner.invoke(app, ["robot", "check"])
+    assert res.exit_code == 2 and "--host" in res.output
+    res = runner.invoke(app, ["bench", "robot", "--host", "127.0.0.1", "--seconds", "0"])
+    assert res.exit_code == 2 and "--seconds" in res.output
