@@ -19,7 +19,6 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.core.geometry import Pose
 from teachfit.demonstrations.dataset import write_dataset
 from teachfit.execution.batch import episode_rng
 from teachfit.execution.engine import ExecutionResult
@@ -67,7 +66,7 @@ def run_quickstart(
     )
     demo = demos[0]
     rng = np.random.default_rng(seed + 1)
-    demo_start = Pose(demo.pos[0], demo.quat[0])
+    demo_start = demo.start_pose
     starts = task.protocol.protocol_starts("table1", n_starts, rng, demo_start)
     robot = make_robot(robot_name, task, seed=seed)
     model = SearchModel.fit([demo], task.name)

@@ -128,7 +128,7 @@ def table1(
     overrides, demo, model = _peg_setup(seed, clearance)
     task = get_task("peg2d", **overrides)
     rng = np.random.default_rng(seed + 1)
-    starts = task.protocol.protocol_starts("table1", n_starts, rng, Pose(demo.pos[0], demo.quat[0]))
+    starts = task.protocol.protocol_starts("table1", n_starts, rng, demo.start_pose)
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
     tshix = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds)
     iid = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds, sampling="random")
@@ -161,7 +161,7 @@ def table2(
     overrides, demo, model = _peg_setup(seed, clearance)
     task = get_task("peg2d", **overrides)
     start = task.protocol.protocol_starts(
-        "table2", 1, np.random.default_rng(seed), Pose(demo.pos[0], demo.quat[0])
+        "table2", 1, np.random.default_rng(seed), demo.start_pose
     )[0]
     starts = [start] * n_traj
     jobs: list[SearchJob] = []

@@ -12,7 +12,6 @@ from rich.table import Table
 
 from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.batch import episode_rng
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
 
@@ -132,7 +131,7 @@ def run(
     Seed A's Table I starts lie in a 3 cm circle halfway between the demonstration's start and
     the hole: pass the demonstration the model was learned from with ``--demo``.
     """
-    from teachfit.execution.search import plan_search, run_search
+    from teachfit.execution.search import run_protocol
     from teachfit.metrics.stats import summarize
     from teachfit.models.search_model import SearchModel
     from teachfit.robot.registry import make_robot
@@ -140,10 +139,8 @@ def run(
 
     the_task = load_task(task)
     model = SearchModel.load(model_file, task=the_task.name)
-    rng = np.random.default_rng(seed)
     demo_start = None
     if demo is not None:
-        from teachfit.core.geometry import Pose
         from teachfit.demonstrations.dataset import read_demo
 
         d = read_demo(demo)
@@ -151,27 +148,25 @@ def run(
             raise TeachfitError(
                 f"--demo {demo} is a {d.task!r} demonstration, not {the_task.name!r}"
             )
-        demo_start = Pose(d.pos[0], d.quat[0])
+        demo_start = d.start_pose
     elif protocol == "table1":
         console.print(
             "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
             "the hole; without --demo a nominal demonstration start is assumed"
         )
-    start_poses = the_task.protocol.protocol_starts(protocol, starts, rng, demo_start)
     the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host))
-    fixed = plan_search(model, method, n, rng) if method.startswith("ergodic") else None
-    if passes > 1 and method != "tshix":
-        raise TeachfitError(f"--passes needs --method tshix, not {method}")
-    outcomes, paths = [], []
-    with Progress(console=console, transient=True) as bar:
-        job = bar.add_task(f"{method} from {starts} starts", total=starts)
-        for i, start in enumerate(start_poses):
-            traj = fixed or plan_search(model, method, n, episode_rng(seed, i), passes=passes)
-            r = run_search(the_robot, the_task, model, start, traj, feedforward=feedforward)
-            outcomes.append(r.result)
-            paths.append((r.result.log.pos, r.result.success))
-            bar.advance(job)
-    the_robot.close()
+    try:
+        with Progress(console=console, transient=True) as bar:
+            job = bar.add_task(f"{method} from {starts} starts", total=starts)
+            runs = run_protocol(
+                the_robot, the_task, model, method, n, starts, protocol, seed,
+                passes=passes, feedforward=feedforward, demo_start=demo_start,
+                on_done=lambda _run: bar.advance(job),
+            )  # fmt: skip
+    finally:
+        the_robot.close()
+    outcomes = [r.result for r in runs]
+    paths = [(o.log.pos, o.success) for o in outcomes]
     s = summarize([o.success for o in outcomes], [o.time_to_success for o in outcomes])
     table = Table(title=f"{method} on {the_task.name} ({protocol}, seed {seed})")
     for col in ("starts", "successes", "rate [95 % CI]", "median time", "reasons"):

@@ -36,6 +36,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.core.errors import DatasetError
+from teachfit.core.geometry import Pose
 
 SOURCES: tuple[str, ...] = ("simulated-teacher", "imported", "captured", "synthetic")
 MIN_SAMPLES = 2
@@ -206,6 +207,18 @@ class Demonstration:
     def n_samples(self) -> int:
         """Number of samples T."""
         return int(self.t.shape[0])
+
+    @property
+    def start_pose(self) -> Pose:
+        """The first pose as a world pose (``tool2world``); a demonstration stored in another
+        frame (e.g. a robot base) raises :class:`DatasetError` saying how to import it."""
+        if self.frame != "world":
+            raise DatasetError(
+                f"demonstration {self.name!r} is stored in frame {self.frame!r}, not the "
+                "simulation world: its start is no world pose; import it with the log-to-world "
+                "transform (--transform world:x,y,z,qw,qx,qy,qz)"
+            )
+        return Pose(self.pos[0], self.quat[0])
 
     @property
     def duration(self) -> float:

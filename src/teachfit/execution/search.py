@@ -8,7 +8,7 @@ translated so that its first pose is the origin.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -166,25 +166,36 @@ def run_search(
     return SearchRun(run_trajectory(robot, task, setpoints, start, config), traj, setpoints)
 
 
-def run_searches(
+def run_protocol(
     robot: Robot,
     task: Task,
     model: SearchModel,
-    starts: Sequence[Pose],
     method: str,
     n_points: int,
+    n_starts: int,
+    protocol: str,
     seed: int,
     *,
     passes: int = 1,
     feedforward: bool = True,
+    demo_start: Pose | None = None,
     config: FollowConfig | None = None,
     on_done: Callable[[SearchRun], None] | None = None,
 ) -> list[SearchRun]:
-    """Plan and run a ``method`` search from each start ``i``, planned with
-    :func:`~teachfit.execution.batch.episode_rng` ``(seed, i)``; ``on_done`` after each."""
+    """Seed A's protocol: ``n_starts`` starts of the task's ``protocol`` (drawn with ``seed``;
+    Table I's lie halfway between ``demo_start`` and the hole), a ``method`` search from each,
+    TSHIX planned with :func:`~teachfit.execution.batch.episode_rng` ``(seed, i)`` (an ergodic
+    trajectory is deterministic: planned once); ``on_done`` after each run."""
+    if n_starts < 1:
+        raise TeachfitError(f"number of starts must be >= 1, got {n_starts}")
+    if passes > 1 and method != "tshix":
+        raise TeachfitError(f"passes > 1 needs method tshix, not {method}")
+    rng = np.random.default_rng(seed)
+    starts = task.protocol.protocol_starts(protocol, n_starts, rng, demo_start)
+    fixed = plan_search(model, method, n_points, rng) if method.startswith("ergodic") else None
     runs = []
     for i, start in enumerate(starts):
-        traj = plan_search(model, method, n_points, episode_rng(seed, i), passes=passes)
+        traj = fixed or plan_search(model, method, n_points, episode_rng(seed, i), passes=passes)
         run = run_search(robot, task, model, start, traj, feedforward=feedforward, config=config)
         runs.append(run)
         if on_done is not None:
