@@ -8,7 +8,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
-from demonstrations.panda_logs import panda_log, write_bag, write_log, write_map
+from panda_logs import panda_log, write_bag, write_log, write_map
 from typer.testing import CliRunner
 
 from teachfit.cli import app

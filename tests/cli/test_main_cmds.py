@@ -12,7 +12,7 @@ from teachfit.demonstrations.csv_import import ColumnMap, import_csv
 from teachfit.demonstrations.dataset import dataset_summary, read_dataset
 
 runner = CliRunner()
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def invoke(*args):
