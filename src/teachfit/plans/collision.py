@@ -15,25 +15,21 @@ import numpy as np
 import trimesh
 
 from teachfit.core.errors import PlanningError
+from teachfit.core.geometry import quat_normalize_into, quat_to_matrix_into
 
 __all__ = ["CollisionChecker", "pose_to_matrix", "quat_to_matrix", "validate_mesh"]
 
 
 def quat_to_matrix(w: float, x: float, y: float, z: float) -> np.ndarray:
-    """(3, 3) rotation matrix of a quaternion (w, x, y, z), normalised first."""
-    # Plain float arithmetic: ~10x faster than scipy's Rotation for a single quaternion, and
-    # this sits on the planner's hot path (one call per validity check).
-    n = (w * w + x * x + y * y + z * z) ** 0.5
-    if n == 0.0:
+    """(3, 3) rotation matrix of a quaternion (w, x, y, z), normalised first.
+
+    Through the geometry kernel's MuJoCo-backed :func:`quat_to_matrix_into` (a few µs, against
+    ~100 µs for a scipy ``Rotation`` round trip): this sits on the planner's hot path.
+    """
+    q = np.array((w, x, y, z), dtype=float)
+    if quat_normalize_into(q) == 0.0:
         raise PlanningError("zero quaternion")
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    return quat_to_matrix_into(np.empty(9), q).reshape(3, 3)
 
 
 def pose_to_matrix(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
