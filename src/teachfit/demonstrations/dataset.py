@@ -36,6 +36,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.core.errors import DatasetError
+from teachfit.core.geometry import rotation_to_wxyz
 
 SOURCES: tuple[str, ...] = ("simulated-teacher", "imported", "captured", "synthetic")
 MIN_SAMPLES = 2
@@ -59,8 +60,8 @@ def _rot(quat: np.ndarray) -> Rotation:
 
 
 def _quat_wxyz(rot: Rotation) -> np.ndarray:
-    """Quaternions of a rotation in w, x, y, z order, shape (T, 4) or (4,)."""
-    return rot.as_quat()[..., [3, 0, 1, 2]]
+    """Quaternions of a rotation in w, x, y, z order, shape (T, 4) or (4,) (scipy's sign)."""
+    return rotation_to_wxyz(rot, canonical=False)
 
 
 def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
