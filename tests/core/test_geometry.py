@@ -10,6 +10,7 @@ from teachfit.core.geometry import (
     array_to_poses,
     poses_to_array,
     poses_to_matrices,
+    quat_angle,
     quat_conj_into,
     quat_diff_into,
     quat_from_rz,
@@ -127,6 +128,14 @@ def test_array_pose_round_trip_and_shape_errors(rots):
         Pose.from_array(np.r_[0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0])
     with pytest.raises(TeachfitError, match=r"\(4, 4\)"):
         Pose.from_matrix(np.eye(3))
+
+
+def test_quat_angle_matches_scipy_magnitude_and_ignores_sign(rots):
+    q = rotation_to_wxyz(rots)
+    expected = (rots[0].inv() * rots).magnitude()
+    assert np.allclose(quat_angle(q[0], q), expected, atol=1e-7)
+    assert np.allclose(quat_angle(q[0], -q), expected, atol=1e-7)
+    assert quat_angle(q[0], q[:1])[0] == pytest.approx(0.0, abs=1e-7)
 
 
 def test_yaw_matches_scipy_zyx_euler(rots):

@@ -62,6 +62,13 @@ def rz_from_quat(quat: np.ndarray) -> np.ndarray:
     return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
+def quat_angle(q: np.ndarray, qs: np.ndarray) -> np.ndarray:
+    """Angle (rad, in ``[0, pi]``) of the rotation between unit (4,) ``q`` and each of ``qs``
+    (N, 4), w-x-y-z: ``2 arccos |q . qs|`` (sign-blind, one batched numpy expression)."""
+    dot = np.clip(np.abs(np.asarray(qs, dtype=float) @ np.asarray(q, dtype=float)), 0.0, 1.0)
+    return 2 * np.arccos(dot)
+
+
 def yaw_of(quat: np.ndarray) -> float:
     """Yaw (rad, in ``(-pi, pi]``) of one (4,) w-x-y-z quaternion: :func:`rz_from_quat`."""
     return float(rz_from_quat(quat))

@@ -37,6 +37,7 @@ from teachfit.core.geometry import (
     array_to_poses,
     poses_to_array,
     poses_to_matrices,
+    quat_angle,
     rotation_to_wxyz,
     wxyz_to_rotation,
 )
@@ -290,8 +291,8 @@ class MotionPlanner:
 
     def _distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Motion bound (m) between state a (7,) and states b (N, 7)."""
-        dot = np.clip(np.abs(b[:, 3:] @ a[3:]), 0.0, 1.0)
-        return np.linalg.norm(b[:, :3] - a[:3], axis=1) + self.radius * 2 * np.arccos(dot)
+        angle = quat_angle(a[3:], b[:, 3:])
+        return np.linalg.norm(b[:, :3] - a[:3], axis=1) + self.radius * angle
 
     # -- key poses ----------------------------------------------------------------------------
     def repair(self, state: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
