@@ -110,6 +110,8 @@ class CollisionChecker:
         self._dreq = coal.DistanceRequest()
         self._dres = coal.DistanceResult()
         self._L2G = coal.Transform3s()
+        self._q = np.zeros(4)  # buffers of the hot path: quaternion and rotation (row-major)
+        self._R9 = np.zeros(9)
         self._G = coal.Transform3s()
         self.n_checks = 0
 
@@ -117,7 +119,11 @@ class CollisionChecker:
         self, x: float, y: float, z: float, w: float, qx: float, qy: float, qz: float
     ) -> bool:
         """Collision test for ``L2G`` given as position (m) and quaternion w-x-y-z (hot path)."""
-        self._L2G.setRotation(quat_to_matrix(w, qx, qy, qz))
+        q = self._q
+        q[0], q[1], q[2], q[3] = w, qx, qy, qz
+        if quat_normalize_into(q) == 0.0:
+            raise PlanningError("zero quaternion")
+        self._L2G.setRotation(quat_to_matrix_into(self._R9, q).reshape(3, 3))
         self._L2G.setTranslation(np.array((x, y, z)))
         return self._check()
 
