@@ -26,6 +26,10 @@ def test_steepest_pitch_is_ranked_first():
     assert np.all(np.diff(np.abs(keys.derivative[keys.order])) <= 1e-12)
     assert sorted(keys.ranks) == list(range(1, len(keys.indices) + 1))
     assert np.all(np.diff(keys.indices) > 0)
+    # the candidates as poses: the demonstrated samples themselves
+    t_, pos, q = _pitch_demo(pitch)
+    for pose, i in zip(keys.poses, keys.indices, strict=True):
+        assert np.allclose(pose.pos, pos[i]) and abs(abs(pose.quat @ q[i]) - 1) < 1e-12
 
 
 def test_auto_picks_the_most_changing_parameter():

@@ -3,13 +3,16 @@
 import re
 
 import numpy as np
+import pytest
 from media_checks import read_png, read_video
 from typer.testing import CliRunner
 
 from teachfit.bench.planning import PlanningBenchConfig, report_table, run_planning_bench
 from teachfit.cli.plan_cmd import app
+from teachfit.core.errors import RenderError
+from teachfit.core.geometry import Pose, poses_to_array
 from teachfit.demonstrations.dataset import read_demo
-from teachfit.plans import MotionPlanner, PlannerConfig, build_assembly, matrix_to_state
+from teachfit.plans import MotionPlanner, PlannerConfig, build_assembly
 from teachfit.viz.plan_video import render_path_video
 
 runner = CliRunner()
@@ -50,7 +53,8 @@ def test_plan_saves_the_path_the_library_plans(tmp_path):
     mp = MotionPlanner(asm, PlannerConfig(max_checks=1000))
     expected = mp.plan(read_demo(f"{h5}:0"), seed=2)
     assert expected.success
-    assert np.array_equal(np.load(npy), expected.path)
+    assert np.array_equal(np.load(npy), poses_to_array(expected.poses))
+    assert np.allclose(np.load(npy), expected.path, rtol=0, atol=1e-15)
     out = _flat(result.output)
     assert f"key poses used {expected.used_key_poses}/{expected.candidates}" in out
     assert f"{expected.collision_checks} collision checks" in out
@@ -74,12 +78,14 @@ def test_plan_needs_exactly_one_of_demo_and_no_demo():
 
 def test_video_shows_the_part_moving(tmp_path):
     asm = build_assembly("tenon")
-    path = np.stack([matrix_to_state(asm.start), matrix_to_state(asm.goal)])
+    path = (Pose.from_matrix(asm.start), Pose.from_matrix(asm.goal))
     out = render_path_video(asm, path, tmp_path / "p.mp4", frames=3, size_px=160)
     frames = read_video(out)
     assert frames.shape == (3, 160, 160, 3)
     moved = np.abs(frames[0].astype(int) - frames[-1].astype(int)).max(axis=2) > 40
     assert moved.mean() > 0.005  # the moving part is elsewhere in the last frame
+    with pytest.raises(RenderError, match="Pose"):
+        render_path_video(asm, np.zeros((2, 7)), tmp_path / "q.mp4")
 
 
 def test_bench_planning_prints_and_appends_what_the_library_computes(tmp_path):

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from teachfit.core.errors import PlanningError
+from teachfit.core.geometry import Pose, poses_to_array
 from teachfit.plans import MotionPlanner, PlannerConfig, build_assembly, synth_demo
 
 CHECKS = 1000  # collision checks per attempt
@@ -41,6 +42,13 @@ def _check_path(planner, result):
     )
     dense = planner.densify(path, 0.0005)
     assert not any(planner.checker.collides_xyzq(*s) for s in dense)
+    # outside the planner the path is poses: the same states, the same transforms
+    poses = result.poses
+    assert len(poses) == len(path) and all(isinstance(p, Pose) for p in poses)
+    assert np.allclose(poses_to_array(poses), path, rtol=0, atol=1e-12)
+    assert np.allclose(result.L2G(), np.stack([p.matrix for p in poses]), atol=1e-12)
+    dense_poses = planner.dense_poses(poses, 0.002)
+    assert np.allclose(poses_to_array(dense_poses), planner.densify(path, 0.002), atol=1e-12)
 
 
 def test_l_groove_with_demonstration_succeeds(lgroove):
@@ -87,7 +95,8 @@ def test_without_demonstration_a_short_budget_fails_cleanly(lgroove):
     _, planner = lgroove
     result = planner.plan(None, max_checks=300, seed=0)
     assert not result.success
-    assert result.path.shape == (0, 7)
+    assert result.path.shape == (0, 7) and result.poses == ()
+    assert planner.dense_poses(result.poses) == ()
     assert result.message == "no path within 300 collision checks per attempt after 1 attempt(s)"
     assert result.candidates == 0 and result.attempts == 1
     assert result.collision_checks >= 300

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from teachfit.capture.geometry import rotation_angle_deg
 from teachfit.capture.markers import read_markers
@@ -25,6 +24,7 @@ from teachfit.capture.rig import read_rig
 from teachfit.capture.sources import VideoSet
 from teachfit.capture.synth import SynthConfig, write_synth_capture
 from teachfit.capture.track import Track, TrackConfig, Tracker, track_frames
+from teachfit.core.geometry import wxyz_to_rotation
 from teachfit.demonstrations.dataset import Demonstration, read_demo
 
 __all__ = [
@@ -73,7 +73,7 @@ def pose_errors(track: Track, truth: Demonstration) -> tuple[np.ndarray, np.ndar
     if truth.n_samples != track.n_frames:
         raise ValueError(f"truth has {truth.n_samples} samples, track {track.n_frames} frames")
     ok = track.valid
-    R_true = Rotation.from_quat(np.asarray(truth.quat)[ok][:, [1, 2, 3, 0]]).as_matrix()
+    R_true = wxyz_to_rotation(np.asarray(truth.quat)[ok]).as_matrix()
     est = track.L2G[ok]
     mm = 1e3 * np.linalg.norm(est[:, :3, 3] - np.asarray(truth.pos)[ok], axis=1)
     deg = rotation_angle_deg(np.transpose(R_true, (0, 2, 1)) @ est[:, :3, :3])

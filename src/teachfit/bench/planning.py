@@ -19,12 +19,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import PlanningError
+from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.plans.collision import CollisionChecker
 from teachfit.plans.parts import PARTS, Assembly, build_assembly
-from teachfit.plans.planner import PLANNERS, MotionPlanner, PlannerConfig, matrix_to_state
+from teachfit.plans.planner import PLANNERS, MotionPlanner, PlannerConfig
 from teachfit.plans.synth import synth_demo
 
 __all__ = [
@@ -112,7 +112,7 @@ class CheckCost:
 
     ``contact_us``: at the goal pose (the parts a clearance apart: coal's narrow phase works
     hardest); ``free_us``: at the start pose. ``baseline_us``: one quaternion-to-matrix
-    conversion by scipy (``Rotation.from_quat(q).as_matrix()``), timed in the same run, so
+    conversion by scipy (``wxyz_to_rotation(q).as_matrix()``), timed in the same run, so
     that the ratios compare across machines. Each figure is the fastest of ``repeats`` loops
     of ``n`` calls.
     """
@@ -207,12 +207,15 @@ def collision_check_cost(asm: Assembly, n: int = 2000, repeats: int = 3) -> Chec
     if n < 1 or repeats < 1:
         raise PlanningError(f"n and repeats must be >= 1, got {n}, {repeats}")
     checker = CollisionChecker(asm.moving, asm.fixed)
-    goal, start = (tuple(float(v) for v in matrix_to_state(T)) for T in (asm.goal, asm.start))
-    quat = np.array([goal[4], goal[5], goal[6], goal[3]])
+    goal_pose = Pose.from_matrix(asm.goal)
+    goal, start = (
+        tuple(float(v) for v in p.as_array()) for p in (goal_pose, Pose.from_matrix(asm.start))
+    )
+    quat = goal_pose.quat
     return CheckCost(
         contact_us=_per_call_us(lambda: checker.collides_xyzq(*goal), n, repeats),
         free_us=_per_call_us(lambda: checker.collides_xyzq(*start), n, repeats),
-        baseline_us=_per_call_us(lambda: Rotation.from_quat(quat).as_matrix(), n, repeats),
+        baseline_us=_per_call_us(lambda: wxyz_to_rotation(quat).as_matrix(), n, repeats),
         n=n,
     )
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from teachfit.capture.geometry import transform
 from teachfit.capture.markers import aruco_dictionary, square_points
 from teachfit.core.errors import CaptureError
 
@@ -140,9 +141,8 @@ def square_poses(
     )
     out = []
     for k in range(n):
-        T = np.eye(4)
-        T[:3, :3] = cv2.Rodrigues(rvecs[k])[0]
-        T[:3, 3] = np.asarray(tvecs[k]).reshape(3)
+        # OpenCV's rvec/tvec stop here: the transform is built by scipy (capture.geometry)
+        T = transform(np.asarray(rvecs[k]).reshape(3), np.asarray(tvecs[k]).reshape(3))
         if T[2, 3] > 0:  # in front of the camera
             out.append((T, float(np.asarray(errs).reshape(-1)[k])))
     return sorted(out, key=lambda p: p[1])

@@ -80,9 +80,12 @@ def skew(v: np.ndarray) -> np.ndarray:
 
 
 def rotation_angle_deg(R: np.ndarray) -> np.ndarray:
-    """Angle(s) in degrees of rotation matrices (..., 3, 3): ``acos((trace R - 1) / 2)``."""
-    tr = np.trace(np.asarray(R), axis1=-2, axis2=-1)
-    return np.degrees(np.arccos(np.clip((tr - 1.0) / 2.0, -1.0, 1.0)))
+    """Angle(s) in degrees of rotation matrices (..., 3, 3), by scipy (``Rotation.magnitude``:
+    accurate for small angles too, where ``acos((trace R - 1) / 2)`` loses digits)."""
+    R = np.asarray(R, dtype=float)
+    angle = Rotation.from_matrix(R.reshape(-1, 3, 3)).magnitude()
+    deg = np.degrees(angle)
+    return deg[0] if R.ndim == 2 else deg.reshape(R.shape[:-2])
 
 
 def toml_matrix(M: np.ndarray, indent: str = "") -> str:

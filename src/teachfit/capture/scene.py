@@ -17,6 +17,8 @@ import numpy as np
 import trimesh
 from scipy.spatial.transform import Rotation
 
+from teachfit.core.geometry import rotation_to_wxyz
+
 __all__ = ["Carrier", "Quad", "camera_K", "look_at", "scene_xml"]
 
 CV2MJ = np.diag([1.0, -1.0, -1.0])
@@ -72,7 +74,7 @@ def _floats(values: np.ndarray) -> str:
 
 
 def _pose_attrs(T: np.ndarray) -> str:
-    q = Rotation.from_matrix(T[:3, :3]).as_quat()[[3, 0, 1, 2]]
+    q = rotation_to_wxyz(Rotation.from_matrix(T[:3, :3]), canonical=False)
     return f'pos="{_floats(T[:3, 3])}" quat="{_floats(q)}"'
 
 

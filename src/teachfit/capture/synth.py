@@ -26,6 +26,7 @@ from teachfit.capture.markers import Marker, MarkerSet, marker_image, write_mark
 from teachfit.capture.rig import Camera, Rig, write_rig
 from teachfit.capture.scene import Carrier, Quad, camera_K, look_at, scene_xml
 from teachfit.core.errors import CaptureError, RenderError
+from teachfit.core.geometry import rotation_to_wxyz, wxyz_to_rotation
 from teachfit.demonstrations.dataset import Demonstration, write_dataset
 from teachfit.plans.parts import Assembly, build_assembly, pose_from_xyz_rpy
 from teachfit.plans.synth import synth_demo
@@ -198,7 +199,9 @@ class SynthScene:
     def _set_body(self, name: str, T: np.ndarray) -> None:
         mocap = int(self.model.body_mocapid[self.model.body(name).id])
         self.data.mocap_pos[mocap] = T[:3, 3]
-        self.data.mocap_quat[mocap] = Rotation.from_matrix(T[:3, :3]).as_quat()[[3, 0, 1, 2]]
+        self.data.mocap_quat[mocap] = rotation_to_wxyz(
+            Rotation.from_matrix(T[:3, :3]), canonical=False
+        )
 
     def render(self, L2G: np.ndarray, rng: np.random.Generator, phase: float = 0.0) -> list:
         """RGB images (H, W, 3) uint8 of every camera with the moving part at ``L2G`` (4, 4).
@@ -240,7 +243,7 @@ def truth_demo(asm: Assembly, seed: int, cfg: SynthConfig) -> Demonstration:
 
 
 def _matrices(demo: Demonstration) -> Iterator[np.ndarray]:
-    rot = Rotation.from_quat(np.asarray(demo.quat)[:, [1, 2, 3, 0]]).as_matrix()
+    rot = wxyz_to_rotation(demo.quat).as_matrix()
     for R, p in zip(rot, demo.pos, strict=True):
         T = np.eye(4)
         T[:3, :3], T[:3, 3] = R, p

@@ -20,6 +20,7 @@ from teachfit.capture.rig import Rig
 from teachfit.capture.scene import Quad, scene_xml
 from teachfit.capture.synth import SynthConfig, synth_rig
 from teachfit.core.errors import RenderError
+from teachfit.core.geometry import rotation_to_wxyz
 from teachfit.plans.parts import pose_from_xyz_rpy
 
 __all__ = ["write_charuco_shots"]
@@ -73,7 +74,7 @@ def write_charuco_shots(
             T = pose_from_xyz_rpy(centre, rpy)
             T[:3, 3] -= T[:3, :3] @ np.array([size[0] / 2, size[1] / 2, 0.0])  # board centred
             data.mocap_pos[0] = T[:3, 3]
-            data.mocap_quat[0] = Rotation.from_matrix(T[:3, :3]).as_quat()[[3, 0, 1, 2]]
+            data.mocap_quat[0] = rotation_to_wxyz(Rotation.from_matrix(T[:3, :3]), canonical=False)
             mujoco.mj_forward(model, data)
             for i, r in enumerate(renderers):
                 r.update_scene(data, camera=f"cam{i}")

@@ -22,6 +22,7 @@ from teachfit.capture.markers import MarkerSet
 from teachfit.capture.rig import Rig
 from teachfit.capture.temporal import FilterConfig, PoseFilter
 from teachfit.core.errors import CaptureError
+from teachfit.core.geometry import rotation_to_wxyz
 from teachfit.demonstrations.dataset import Demonstration
 
 __all__ = ["STATUS", "Track", "TrackConfig", "Tracker", "track_frames"]
@@ -89,8 +90,7 @@ class Track:
                 f"(statuses: {self.summary()})"
             )
         T = self.L2G[keep]
-        quat = Rotation.from_matrix(T[:, :3, :3]).as_quat()[:, [3, 0, 1, 2]]
-        quat *= np.where(quat[:, :1] < 0, -1.0, 1.0)
+        quat = rotation_to_wxyz(Rotation.from_matrix(T[:, :3, :3]))  # w >= 0
         info = {
             "frames_total": self.n_frames,
             "frames_valid": int(keep.size),

@@ -124,11 +124,14 @@ def plan(
     keyposes: Annotated[
         Path | None, typer.Option(help="write the ranked key poses figure (png)")
     ] = None,
-    save: Annotated[Path | None, typer.Option(help="write the path (N, 7) as .npy")] = None,
+    save: Annotated[
+        Path | None, typer.Option(help="write the path (N, 7) x,y,z,qw,qx,qy,qz as .npy")
+    ] = None,
 ) -> None:
     """Plan the moving part from its initial to its final pose."""
     import numpy as np
 
+    from teachfit.core.geometry import poses_to_array
     from teachfit.plans.parts import build_assembly
     from teachfit.plans.planner import MotionPlanner, PlannerConfig
 
@@ -152,17 +155,17 @@ def plan(
     if not result.success:
         raise typer.Exit(code=1)
     if save is not None:
-        np.save(save, result.path)
+        np.save(save, poses_to_array(result.poses))
         console.print(f"wrote {save}")
     if strip is not None:
         from teachfit.viz.plan_figures import path_strip_figure
 
-        path_strip_figure(asm, mp.densify(result.path, 0.002), out=strip)
+        path_strip_figure(asm, mp.dense_poses(result.poses, 0.002), out=strip)
         console.print(f"wrote {strip}")
     if render is not None:
         from teachfit.viz.plan_video import render_path_video
 
-        render_path_video(asm, mp.densify(result.path, 0.002), render)
+        render_path_video(asm, mp.dense_poses(result.poses, 0.002), render)
         console.print(f"wrote {render}")
 
 

@@ -36,9 +36,15 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.core.errors import DatasetError
-from teachfit.core.geometry import Pose
+from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 
-SOURCES: tuple[str, ...] = ("simulated-teacher", "imported", "captured", "synthetic")
+SOURCES: tuple[str, ...] = (
+    "simulated-teacher",
+    "imported",
+    "captured",
+    "synthetic",
+    "kinesthetic",
+)
 MIN_SAMPLES = 2
 QUAT_NORM_TOL = 1e-3
 FORMAT = "teachfit-demos"
@@ -56,27 +62,12 @@ def _first_row(bad: np.ndarray) -> int | None:
 
 def _rot(quat: np.ndarray) -> Rotation:
     """Rotation from (T, 4) or (4,) quaternions in w, x, y, z order."""
-    return Rotation.from_quat(np.asarray(quat)[..., [1, 2, 3, 0]])
+    return wxyz_to_rotation(quat)
 
 
 def _quat_wxyz(rot: Rotation) -> np.ndarray:
-    """Quaternions of a rotation in w, x, y, z order, shape (T, 4) or (4,)."""
-    return rot.as_quat()[..., [3, 0, 1, 2]]
-
-
-def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product ``a * b`` of w, x, y, z quaternions, broadcasting over leading axes."""
-    aw, ax, ay, az = np.moveaxis(np.asarray(a), -1, 0)
-    bw, bx, by, bz = np.moveaxis(np.asarray(b), -1, 0)
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=-1,
-    )
+    """Quaternions of a rotation in w, x, y, z order, shape (T, 4) or (4,) (scipy's sign)."""
+    return rotation_to_wxyz(rot, canonical=False)
 
 
 def _array(value: Any, column: str, width: int | None, n: int | None) -> np.ndarray:
@@ -243,7 +234,7 @@ class Demonstration:
         """
         r0_inv = _rot(self.quat[0]).inv()
         pos = r0_inv.apply(self.pos - self.pos[0])
-        quat = _qmul(self.quat[0] * np.array([1.0, -1.0, -1.0, -1.0]), self.quat)
+        quat = np.array(_quat_wxyz(r0_inv * _rot(self.quat)))
         quat[0] = (1.0, 0.0, 0.0, 0.0)  # exactly, rather than to round-off
         wrench = None
         if self.wrench is not None:

@@ -15,10 +15,10 @@ def _demo(rec: KinestheticRecording, task: str, robot: Robot) -> Demonstration:
         quat=rec.quat,
         wrench=rec.wrench,
         task=task,
-        source=f"kinesthetic:{robot.name}",
+        source="kinesthetic",
         frame="world",
         child_frame="tcp",
-        meta={"interrupted": bool(rec.interrupted), "fault": rec.fault},
+        meta={"robot": robot.name, "interrupted": bool(rec.interrupted), "fault": rec.fault},
     )
 
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from teachfit.core.control import ControllerSpec
 from teachfit.core.errors import ControlError, RobotFault, SimulationDiverged, SkillError
-from teachfit.core.geometry import Pose, quat_mul_into
+from teachfit.core.geometry import Pose, quat_integrate_into, quat_mul_into
 from teachfit.core.outcome import Outcome
 from teachfit.core.state import ImpedanceCommand
 from teachfit.execution.log import ExecutionLog, LogBuffer
@@ -230,11 +230,10 @@ def execute(
         sp_pos[:] = pos_w
         sp_ff[:] = ff
         pc.p_d += v * dt
-        ang = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * dt
-        if ang > 0.0:
-            s = math.sin(ang / 2) / (ang / dt)
-            dq[:] = (math.cos(ang / 2), w[0] * s, w[1] * s, w[2] * s)
-            quat_mul_into(qtmp, dq, pc.q_d)
+        if w[0] != 0.0 or w[1] != 0.0 or w[2] != 0.0:
+            dq[:] = (1.0, 0.0, 0.0, 0.0)
+            quat_integrate_into(dq, w, dt)  # exp(w dt)
+            quat_mul_into(qtmp, dq, pc.q_d)  # a task-frame angular velocity: left product
             pc.q_d[:] = qtmp / math.sqrt(float(qtmp @ qtmp))
 
     def advance(node_index: int) -> None:

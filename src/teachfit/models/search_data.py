@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from teachfit.core.errors import ModelError, TaskError
+from teachfit.core.geometry import rotation_to_wxyz, rz_from_quat, wxyz_to_rotation
 from teachfit.tasks.registry import search_dims_of
 
 _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rx": 3, "ry": 4, "rz": 5}
@@ -103,18 +104,13 @@ class SearchData:
 def yaw_relative(quat: np.ndarray) -> np.ndarray:
     """Unwrapped rotation about z of each orientation relative to the first one.
 
-    With ``q_rel = q_0^{-1} ⊗ q_t`` = (w, x, y, z), ``rz = atan2(2(w z + x y), 1 - 2(y² + z²))``.
-    ``quat`` is (T, 4) (w, x, y, z); returns (T,) rad, unwrapped, ``rz[0] = 0``.
+    With ``q_rel = q_0^{-1} ⊗ q_t`` (scipy, through the geometry kernel), ``rz`` is the z-y-x
+    yaw of ``q_rel`` (:func:`~teachfit.core.geometry.rz_from_quat`). ``quat`` is (T, 4)
+    (w, x, y, z; normalised here); returns (T,) rad, unwrapped, ``rz[0] = 0``.
     """
     q = np.asarray(quat, dtype=float)
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    w0, x0, y0, z0 = q[0, 0], -q[0, 1], -q[0, 2], -q[0, 3]  # conjugate of q0
-    w, x, y, z = q.T
-    rw = w0 * w - x0 * x - y0 * y - z0 * z
-    rx = w0 * x + x0 * w + y0 * z - z0 * y
-    ry = w0 * y - x0 * z + y0 * w + z0 * x
-    rz = w0 * z + x0 * y - y0 * x + z0 * w
-    yaw = np.arctan2(2.0 * (rw * rz + rx * ry), 1.0 - 2.0 * (ry**2 + rz**2))
+    rot = wxyz_to_rotation(q / np.linalg.norm(q, axis=1, keepdims=True))
+    yaw = rz_from_quat(rotation_to_wxyz(rot[0].inv() * rot))
     return np.unwrap(yaw - yaw[0])
 
 

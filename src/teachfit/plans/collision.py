@@ -15,25 +15,21 @@ import numpy as np
 import trimesh
 
 from teachfit.core.errors import PlanningError
+from teachfit.core.geometry import quat_normalize_into, quat_to_matrix_into
 
 __all__ = ["CollisionChecker", "pose_to_matrix", "quat_to_matrix", "validate_mesh"]
 
 
 def quat_to_matrix(w: float, x: float, y: float, z: float) -> np.ndarray:
-    """(3, 3) rotation matrix of a quaternion (w, x, y, z), normalised first."""
-    # Plain float arithmetic: ~10x faster than scipy's Rotation for a single quaternion, and
-    # this sits on the planner's hot path (one call per validity check).
-    n = (w * w + x * x + y * y + z * z) ** 0.5
-    if n == 0.0:
+    """(3, 3) rotation matrix of a quaternion (w, x, y, z), normalised first.
+
+    Through the geometry kernel's MuJoCo-backed :func:`quat_to_matrix_into` (a few µs, against
+    ~100 µs for a scipy ``Rotation`` round trip): this sits on the planner's hot path.
+    """
+    q = np.array((w, x, y, z), dtype=float)
+    if quat_normalize_into(q) == 0.0:
         raise PlanningError("zero quaternion")
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
+    return quat_to_matrix_into(np.empty(9), q).reshape(3, 3)
 
 
 def pose_to_matrix(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
@@ -114,6 +110,8 @@ class CollisionChecker:
         self._dreq = coal.DistanceRequest()
         self._dres = coal.DistanceResult()
         self._L2G = coal.Transform3s()
+        self._q = np.zeros(4)  # buffers of the hot path: quaternion and rotation (row-major)
+        self._R9 = np.zeros(9)
         self._G = coal.Transform3s()
         self.n_checks = 0
 
@@ -121,7 +119,11 @@ class CollisionChecker:
         self, x: float, y: float, z: float, w: float, qx: float, qy: float, qz: float
     ) -> bool:
         """Collision test for ``L2G`` given as position (m) and quaternion w-x-y-z (hot path)."""
-        self._L2G.setRotation(quat_to_matrix(w, qx, qy, qz))
+        q = self._q
+        q[0], q[1], q[2], q[3] = w, qx, qy, qz
+        if quat_normalize_into(q) == 0.0:
+            raise PlanningError("zero quaternion")
+        self._L2G.setRotation(quat_to_matrix_into(self._R9, q).reshape(3, 3))
         self._L2G.setTranslation(np.array((x, y, z)))
         return self._check()
 

@@ -10,9 +10,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import PlanningError
+from teachfit.core.geometry import Pose, wxyz_to_rotation
 
 __all__ = ["PARAMS", "KeyPoses", "pose_parameters", "rank_key_poses", "select_candidates"]
 
@@ -28,7 +28,7 @@ def pose_parameters(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
     pos : (T, 3) positions in m. quat : (T, 4) quaternions w-x-y-z.
     """
     quat = np.asarray(quat, dtype=float)
-    rpy = Rotation.from_quat(quat[:, [1, 2, 3, 0]]).as_euler("xyz")
+    rpy = wxyz_to_rotation(quat).as_euler("xyz")
     return np.concatenate([np.asarray(pos, dtype=float), np.unwrap(rpy, axis=0)], axis=1)
 
 
@@ -88,7 +88,7 @@ class KeyPoses:
     t : (K,) float
         Their time stamps (s).
     L2G : (K, 4, 4) float
-        Their poses of ``L`` in ``G``.
+        Their poses of ``L`` in ``G`` (m), as transforms; :attr:`poses` as :class:`Pose`.
     param : str
         Ranked parameter (one of :data:`PARAMS`).
     values : (K,) float
@@ -121,6 +121,11 @@ class KeyPoses:
         ranks = np.empty(len(self.order), dtype=int)
         ranks[self.order] = np.arange(1, len(self.order) + 1)
         return ranks
+
+    @property
+    def poses(self) -> tuple[Pose, ...]:
+        """The candidates' poses ``L2G`` (m, w-x-y-z), in the order of :attr:`indices`."""
+        return tuple(Pose.from_matrix(T) for T in self.L2G)
 
 
 def rank_key_poses(
@@ -179,7 +184,7 @@ def rank_key_poses(
     poly = np.polynomial.Polynomial.fit(t, column, deg=int(min(degree, len(t) - 1)))
     derivative = poly.deriv()(t[idx])
     order = np.argsort(-np.abs(derivative), kind="stable")
-    rot = Rotation.from_quat(quat[idx][:, [1, 2, 3, 0]]).as_matrix()
+    rot = wxyz_to_rotation(quat[idx]).as_matrix()
     L2G = np.tile(np.eye(4), (len(idx), 1, 1))
     L2G[:, :3, :3] = rot
     L2G[:, :3, 3] = pos[idx]

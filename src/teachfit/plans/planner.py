@@ -13,13 +13,16 @@ the process (worker processes included). With a budget in collision checks
 (``PlannerConfig.max_checks``) instead of seconds, a query's result is a function of its
 inputs and seed alone, whatever the machine's speed or load.
 
-States are ``(7,)`` arrays ``[x, y, z, qw, qx, qy, qz]``: ``L2G`` in m and a unit quaternion.
+Inside this module (the OMPL boundary) states are ``(7,)`` arrays ``[x, y, z, qw, qx, qy, qz]``:
+``L2G`` in m and a unit quaternion. Outside it, poses are :class:`~teachfit.core.geometry.Pose`:
+:attr:`PlanResult.poses` and :meth:`MotionPlanner.dense_poses`. Rotations go through the geometry
+kernel (scipy for batches, its MuJoCo-backed matrix routine in the collision checks).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +32,15 @@ import ompl.util as ou
 from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.core.errors import PlanningError
+from teachfit.core.geometry import (
+    Pose,
+    array_to_poses,
+    poses_to_array,
+    poses_to_matrices,
+    quat_angle,
+    rotation_to_wxyz,
+    wxyz_to_rotation,
+)
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
 from teachfit.plans.keyposes import KeyPoses, rank_key_poses
 from teachfit.plans.parts import Assembly
@@ -81,9 +93,10 @@ def seed_ompl(seed: int) -> None:
 
 
 def matrix_to_state(T: np.ndarray) -> np.ndarray:
-    """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform."""
-    q = Rotation.from_matrix(np.asarray(T)[:3, :3]).as_quat()
-    return np.array([*np.asarray(T)[:3, 3], q[3], q[0], q[1], q[2]])
+    """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform (scipy's quaternion sign)."""
+    T = np.asarray(T, dtype=float)
+    q = rotation_to_wxyz(Rotation.from_matrix(T[:3, :3]), canonical=False)
+    return np.concatenate([T[:3, 3], q])
 
 
 @dataclass(frozen=True)
@@ -158,7 +171,8 @@ class PlanResult:
     success : bool
         A path was found and passed dense verification.
     path : (N, 7) float
-        States ``[x, y, z, qw, qx, qy, qz]`` of ``L2G`` from start to goal (empty on failure).
+        The OMPL states ``[x, y, z, qw, qx, qy, qz]`` of ``L2G`` from start to goal (empty on
+        failure); outside the planner use :attr:`poses`.
     time_s : float
         Planning time (s): ranking the key poses and the attempts, up to a collision-free path
         (what the paper's Table I reports).
@@ -192,9 +206,14 @@ class PlanResult:
     message: str
     key_poses: KeyPoses | None = None
 
+    @property
+    def poses(self) -> tuple[Pose, ...]:
+        """The path as poses ``L2G`` (m, w-x-y-z) from start to goal (empty on failure)."""
+        return array_to_poses(self.path)
+
     def L2G(self) -> np.ndarray:
         """(N, 4, 4) path as homogeneous transforms."""
-        return np.array([pose_to_matrix(s[:3], s[3:]) for s in self.path]).reshape(-1, 4, 4)
+        return poses_to_matrices(self.poses)
 
 
 class MotionPlanner:
@@ -272,8 +291,8 @@ class MotionPlanner:
 
     def _distance(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """Motion bound (m) between state a (7,) and states b (N, 7)."""
-        dot = np.clip(np.abs(b[:, 3:] @ a[3:]), 0.0, 1.0)
-        return np.linalg.norm(b[:, :3] - a[:3], axis=1) + self.radius * 2 * np.arccos(dot)
+        angle = quat_angle(a[3:], b[:, 3:])
+        return np.linalg.norm(b[:, :3] - a[:3], axis=1) + self.radius * angle
 
     # -- key poses ----------------------------------------------------------------------------
     def repair(self, state: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
@@ -290,8 +309,7 @@ class MotionPlanner:
             n = self.config.repair_samples
             dp = rng.normal(0.0, sigma_p, (n, 3))
             dr = Rotation.from_rotvec(rng.normal(0.0, sigma_r, (n, 3)))
-            base = Rotation.from_quat(state[[4, 5, 6, 3]])
-            q = (dr * base).as_quat()[:, [3, 0, 1, 2]]
+            q = rotation_to_wxyz(dr * wxyz_to_rotation(state[3:]), canonical=False)
             cand = np.concatenate([state[:3] + dp, q], axis=1)
             inside = np.all((cand[:, :3] >= lo) & (cand[:, :3] <= hi), axis=1)
             cand = cand[inside]
@@ -492,10 +510,19 @@ class MotionPlanner:
         for a, b in zip(path[:-1], path[1:], strict=True):
             n = max(int(np.ceil(self._distance(a, b[None])[0] / res)), 1)
             s = np.linspace(0.0, 1.0, n + 1)[1:]
-            rots = Rotation.from_quat(np.stack([a[[4, 5, 6, 3]], b[[4, 5, 6, 3]]]))
-            q = Slerp([0.0, 1.0], rots)(s).as_quat()[:, [3, 0, 1, 2]]
+            rots = wxyz_to_rotation(np.stack([a[3:], b[3:]]))
+            q = rotation_to_wxyz(Slerp([0.0, 1.0], rots)(s), canonical=False)
             out.append(np.concatenate([a[:3] + s[:, None] * (b[:3] - a[:3]), q], axis=1))
         return np.concatenate(out)
+
+    def dense_poses(
+        self, poses: Sequence[Pose], resolution: float | None = None
+    ) -> tuple[Pose, ...]:
+        """:meth:`densify` for poses ``L2G`` (e.g. :attr:`PlanResult.poses`): the same
+        interpolation, so no part point moves more than ``resolution`` (m) a step."""
+        if len(poses) == 0:
+            return ()
+        return array_to_poses(self.densify(poses_to_array(poses), resolution))
 
     def verify(self, path: np.ndarray) -> bool:
         """True when every state of the densified ``path`` is collision-free and inside bounds."""

@@ -15,6 +15,7 @@ from scipy.signal import butter, sosfiltfilt
 from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import TaskError
+from teachfit.core.geometry import rotation_to_wxyz
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.plans.collision import CollisionChecker
 from teachfit.plans.parts import Assembly
@@ -164,9 +165,7 @@ def synth_demo(
         i0 = int(rng.integers(n // 3, max(n // 3 + 1, n - 8)))
         span = slice(i0, min(i0 + 4, n - 1))
         pos[span, 1] += rng.choice([-1.0, 1.0]) * (asm.dimensions["clearance"] + 0.0008)
-    quat_xyzw = Rotation.from_euler("xyz", rpy, degrees=True).as_quat()
-    quat = quat_xyzw[:, [3, 0, 1, 2]]
-    quat *= np.sign(quat[:, :1] + 1e-12)
+    quat = rotation_to_wxyz(Rotation.from_euler("xyz", rpy, degrees=True))  # w >= 0
     checker = CollisionChecker(asm.moving, asm.fixed)
     colliding = sum(checker.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True))
     return Demonstration(

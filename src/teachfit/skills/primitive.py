@@ -26,9 +26,17 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import SkillError
-from teachfit.core.geometry import quat_conj_into, quat_mul_into, quat_to_rotvec_into
+from teachfit.core.geometry import (
+    quat_conj_into,
+    quat_from_rz,
+    quat_mul_into,
+    quat_to_rotvec_into,
+    rotation_to_wxyz,
+    yaw_of,
+)
 from teachfit.skills.params import Value, ref_name, resolve
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.profile import Trapezoid, synchronized
@@ -109,12 +117,8 @@ def _stiffness(values: Mapping[str, float], vec: Vec6V) -> np.ndarray:
 
 
 def _quat_rz_ry(yaw: float, tilt: float) -> np.ndarray:
-    """``Rz(yaw) Ry(tilt)`` as a quaternion (w, x, y, z)."""
-    qz = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
-    qy = np.array([math.cos(tilt / 2), 0.0, math.sin(tilt / 2), 0.0])
-    out = np.zeros(4)
-    quat_mul_into(out, qz, qy)
-    return out
+    """``Rz(yaw) Ry(tilt)`` (rad, intrinsic z then y) as a quaternion (w, x, y, z)."""
+    return rotation_to_wxyz(Rotation.from_euler("ZY", [yaw, tilt]), canonical=False)
 
 
 def _check_len(name: str, vec: tuple[Value, ...] | None, n: int) -> None:
@@ -218,15 +222,8 @@ class _MoveToRun(PrimitiveRun):
         if self.q_goal_spec is not None:
             q_goal = self.q_goal_spec.copy()
             if self.rz_period > 0:  # nearest symmetric yaw to the entry yaw
-                w, x, y, z = pc.q_d
-                yaw_now = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-                w, x, y, z = q_goal
-                yaw_goal = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-                k = round((yaw_now - yaw_goal) / self.rz_period)
-                shift = np.array(
-                    [math.cos(k * self.rz_period / 2), 0, 0, math.sin(k * self.rz_period / 2)]
-                )
-                quat_mul_into(q_goal, shift, self.q_goal_spec)
+                k = round((yaw_of(pc.q_d) - yaw_of(q_goal)) / self.rz_period)
+                quat_mul_into(q_goal, quat_from_rz(k * self.rz_period), self.q_goal_spec)
             # rotation vector r (task frame) with exp(r) q_d = q_goal
             dq, inv = np.zeros(4), np.zeros(4)
             quat_conj_into(inv, pc.q_d)

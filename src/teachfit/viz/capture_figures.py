@@ -14,6 +14,7 @@ from matplotlib.ticker import MaxNLocator  # noqa: E402
 from scipy.spatial.transform import Rotation  # noqa: E402
 
 from teachfit.capture.track import Track  # noqa: E402
+from teachfit.core.geometry import wxyz_to_rotation  # noqa: E402
 from teachfit.demonstrations.dataset import Demonstration  # noqa: E402
 
 __all__ = ["track_figure"]
@@ -37,7 +38,7 @@ def track_figure(track: Track, out: str | Path, truth: Demonstration | None = No
         axes[0].plot(t, pos[:, k], ".-", ms=3, color=f"C{k}", label=label)
         axes[1].plot(t, rpy[:, k], ".-", ms=3, color=f"C{k}", label=("roll", "pitch", "yaw")[k])
         if truth is not None:
-            R = Rotation.from_quat(np.asarray(truth.quat)[:, [1, 2, 3, 0]]).as_matrix()
+            R = wxyz_to_rotation(truth.quat).as_matrix()
             axes[0].plot(truth.t, 1e3 * truth.pos[:, k], "--", color=f"C{k}", lw=0.8)
             axes[1].plot(truth.t, _rpy(R)[:, k], "--", color=f"C{k}", lw=0.8)
     dt = np.median(np.diff(t)) if len(t) > 1 else 1.0

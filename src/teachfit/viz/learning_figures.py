@@ -17,6 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from teachfit.core.geometry import rz_from_quat, wxyz_to_rotation  # noqa: E402
 from teachfit.core.params import ParamSpace  # noqa: E402
 from teachfit.execution.engine import ExecutionResult  # noqa: E402
 from teachfit.learning.curves import Band, best_so_far  # noqa: E402
@@ -166,9 +167,9 @@ def plot_best_execution(trace: ExecutionResult, path: str | Path, title: str = "
     for i, lab in enumerate(("x", "y", "z")):
         ax1.plot(log.t, rel[:, i], lw=1.0, label=lab)
     ax1.set_ylabel("TCP from start (mm)")
-    w, x, y, z = log.quat.T
-    tilt = np.arccos(np.clip(np.abs(1.0 - 2.0 * (x * x + y * y)), 0.0, 1.0))  # tool z vs +-z
-    yaw = np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    axis_z = wxyz_to_rotation(log.quat).apply([0.0, 0.0, 1.0])[:, 2]
+    tilt = np.arccos(np.clip(np.abs(axis_z), 0.0, 1.0))  # tool z vs +-z
+    yaw = rz_from_quat(log.quat)
     ax2.plot(log.t, tilt, lw=1.0, label="tilt")
     ax2.plot(log.t, np.unwrap(yaw), lw=1.0, label="yaw")
     ax2.set_ylabel("orientation (rad)")

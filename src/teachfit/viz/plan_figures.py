@@ -3,6 +3,7 @@ fitted pose parameter with ranked key poses (paper Fig. 6)."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib
@@ -12,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-from teachfit.plans.collision import pose_to_matrix  # noqa: E402
+from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.plans.keyposes import KeyPoses  # noqa: E402
 from teachfit.plans.parts import Assembly  # noqa: E402
 
@@ -93,23 +94,23 @@ def parts_figure(asm: Assembly, path: str | Path | None = None) -> plt.Figure:
 
 
 def path_strip_figure(
-    asm: Assembly, path: np.ndarray, n: int = 6, out: str | Path | None = None
+    asm: Assembly, path: Sequence[Pose], n: int = 6, out: str | Path | None = None
 ) -> plt.Figure:
     """The path as a strip of ``n`` poses evenly spaced along it.
 
     Parameters
     ----------
-    path : (N, 7) states ``[x, y, z, qw, qx, qy, qz]`` of ``L2G``.
+    path : sequence of Pose
+        Poses ``L2G`` of the moving part in ``G`` (m), e.g. :meth:`MotionPlanner.dense_poses`.
     """
-    path = np.asarray(path, dtype=float)
+    positions = np.stack([p.pos for p in path])
     idx = np.unique(np.linspace(0, len(path) - 1, n).round().astype(int))
     fig = plt.figure(figsize=(3.2 * len(idx), 3.4))
     for k, i in enumerate(idx):
         ax = fig.add_subplot(1, len(idx), k + 1, projection="3d")
         add_mesh(ax, asm.fixed)
-        T = pose_to_matrix(path[i, :3], path[i, 3:])
-        add_mesh(ax, asm.moving, T, color=MOVING_COLOR, alpha=0.85)
-        _frame_axes(ax, asm, extra=path[:, :3])
+        add_mesh(ax, asm.moving, path[i].matrix, color=MOVING_COLOR, alpha=0.85)
+        _frame_axes(ax, asm, extra=positions)
         ax.view_init(elev=20, azim=-70)
         ax.set_title(f"{k + 1}/{len(idx)}", fontsize=9)
         ax.tick_params(labelsize=6)

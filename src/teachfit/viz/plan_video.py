@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import imageio.v2 as imageio
@@ -12,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from teachfit.core.errors import RenderError  # noqa: E402
-from teachfit.plans.collision import pose_to_matrix  # noqa: E402
+from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.plans.parts import Assembly  # noqa: E402
 from teachfit.viz.plan_figures import MOVING_COLOR, _frame_axes, add_mesh  # noqa: E402
 
@@ -21,7 +22,7 @@ __all__ = ["render_path_video"]
 
 def render_path_video(
     asm: Assembly,
-    path: np.ndarray,
+    path: Sequence[Pose],
     out: str | Path,
     *,
     fps: int = 20,
@@ -34,9 +35,9 @@ def render_path_video(
     ----------
     asm : Assembly
         Parts (drawn in frame ``G``, mm).
-    path : (N, 7) float
-        States ``[x, y, z, qw, qx, qy, qz]`` of ``L2G``; resampled to ``frames`` frames by
-        index (the path's own spacing).
+    path : sequence of Pose
+        Poses ``L2G`` of the moving part in ``G`` (m); resampled to ``frames`` frames by index
+        (the path's own spacing).
     out : path
         Output ``.mp4`` file.
     fps, frames, size_px : int
@@ -47,18 +48,18 @@ def render_path_video(
     RenderError
         No path to draw, or ffmpeg unavailable.
     """
-    path = np.asarray(path, dtype=float)
-    if path.ndim != 2 or path.shape[1] != 7 or len(path) < 1:
-        raise RenderError(f"need an (N, 7) path with N >= 1, got {path.shape}")
+    if len(path) < 1 or not all(isinstance(p, Pose) for p in path):
+        raise RenderError(f"need a path of at least one Pose, got {len(path)} item(s)")
+    positions = np.stack([p.pos for p in path])
     out = Path(out)
     dpi = 80
     inch = (size_px - size_px % 16) / dpi  # libx264 wants sizes divisible by 16 (macroblocks)
     fig = plt.figure(figsize=(inch, inch), dpi=dpi)
     ax = fig.add_subplot(projection="3d")
     add_mesh(ax, asm.fixed)
-    _frame_axes(ax, asm, extra=path[:, :3])
+    _frame_axes(ax, asm, extra=positions)
     ax.view_init(elev=22, azim=-65)
-    ax.plot(*(1e3 * path[:, :3].T), "-", color="C0", lw=0.8)
+    ax.plot(*(1e3 * positions.T), "-", color="C0", lw=0.8)
     idx = np.linspace(0, len(path) - 1, max(frames, 2)).round().astype(int)
     moving = None
     try:
@@ -73,7 +74,7 @@ def render_path_video(
             moving = add_mesh(
                 ax,
                 asm.moving,
-                pose_to_matrix(path[i, :3], path[i, 3:]),
+                path[i].matrix,
                 color=MOVING_COLOR,
                 alpha=0.9,
             )
