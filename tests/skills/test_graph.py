@@ -36,7 +36,7 @@ from teachfit.skills.percept import Percept
 from teachfit.skills.primitive import Move, MoveTo
 from teachfit.skills.profile import Trapezoid, synchronized
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "skills" / "peg_in_hole.toml"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "skills" / "peg_in_hole.toml"
 
 
 # ----------------------------------------------------------------------------- profile
