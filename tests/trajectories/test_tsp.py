@@ -41,17 +41,13 @@ def test_open_end_is_free_and_start_fixed():
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_close_to_lkh_on_gaussian_samples(dim):
-    import time
-
     rng = np.random.default_rng(10 + dim)
     pts = rng.normal(size=(300, dim)) * np.array([1.0, 0.5, 0.3][:dim])
-    t0 = time.perf_counter()
     r = open_tour(pts, rng=np.random.default_rng(0))
-    wall = time.perf_counter() - t0
     assert sorted(r.order.tolist()) == list(range(300))
     ref = open_tour(pts, solver="lkh")
     assert r.length <= 1.05 * ref.length
-    assert wall < 0.5  # generous: shared CI machine; the benchmark reports the real figure
+    # the solver's speed is a benchmark figure (benchmarks/search_speed.py), not a test
 
 
 def test_weights_change_the_metric():
