@@ -130,20 +130,30 @@ def learn_skill(
             f"{trials}[/]: nothing to run; raise --trials to continue"
         )
     best = [math.inf]
-    with _bar() as bar:
-        job = bar.add_task(f"{method} {task}", total=trials, completed=min(st.n_finished, trials))
+    try:
+        with _bar() as bar:
+            done = min(st.n_finished, trials)
+            job = bar.add_task(f"{method} {task}", total=trials, completed=done)
 
-        def progress(rec: object) -> None:
-            if rec.feasible:  # type: ignore[attr-defined]
-                best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
-            bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
+            def progress(rec: object) -> None:
+                if rec.feasible:  # type: ignore[attr-defined]
+                    best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
+                bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
 
-        if ray:
-            from teachfit.learning.ray_runner import run_study_ray
+            if ray:
+                from teachfit.learning.ray_runner import run_study_ray
 
-            rep = run_study_ray(st, obj, trials, address=ray, workers=workers, on_trial=progress)
-        else:
-            rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+                rep = run_study_ray(
+                    st, obj, trials, address=ray, workers=workers, on_trial=progress
+                )
+            else:
+                rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+    except KeyboardInterrupt:  # a second Ctrl-C / SIGTERM: running trials were dropped
+        console.print(
+            f"[red]interrupted again[/]: aborted; the {st.n_finished} finished trial(s) are "
+            "stored, the running ones were dropped; continue with the same command and --resume"
+        )
+        raise typer.Exit(130) from None
     console.print(
         f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
         f"trials/s), {rep.failed} failed by crash/divergence; study holds "
