@@ -1,11 +1,13 @@
 """One of several processes working on one shared study (run by ``test_study.py``).
 
 ``python share_worker.py URL BUDGET METHOD [SLEEP_S]``: opens the study, runs it to BUDGET
-trials in this process (no worker pool) and prints ``finished=N restored=M``.
+trials in this process (no worker pool) and prints ``finished=N restored=M``. With
+``SHARE_WORKER_MARK=FILE`` it appends a line to FILE as each trial begins.
 """
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 
@@ -38,8 +40,16 @@ def cost(p: dict[str, float], sleep_s: float = 0.0) -> tuple[float, bool]:
 def main() -> None:
     url, budget, method = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     sleep_s = float(sys.argv[4]) if len(sys.argv) > 4 else 0.0
+    mark = os.environ.get("SHARE_WORKER_MARK")  # a line per trial begun, for the test
+
+    def objective(p: dict[str, float]) -> tuple[float, bool]:
+        if mark:
+            with open(mark, "a") as fh:
+                fh.write("trial\n")
+        return cost(p, sleep_s)
+
     study = open_shared(url, method)
-    rep = run_study(study, lambda p: cost(p, sleep_s), budget, workers=0)
+    rep = run_study(study, objective, budget, workers=0)
     print(f"finished={rep.finished} restored={rep.restored} holds={study.n_finished}", flush=True)
 
 

@@ -65,6 +65,7 @@ def ray_cluster(workers: int = 2, cpus: int = 1) -> Iterator[str]:
     port = free_port()
     address = f"127.0.0.1:{port}"
     nodes: list[subprocess.Popen[bytes]] = []
+    ok = False
 
     def start(*args: str) -> None:
         ports = {
@@ -105,10 +106,19 @@ def ray_cluster(workers: int = 2, cpus: int = 1) -> Iterator[str]:
                     log = (Path(tmp) / "node0.log").read_text()[-3000:]
                     pytest.fail(f"the Ray head did not start: {log}")
                 time.sleep(0.2)
-        for _ in range(workers):
+        sockets = Path(tmp, "session_latest", "sockets")
+        for k in range(1, workers + 1):
+            # one at a time: nodes of one machine pick their socket names (raylet.k,
+            # plasma_store.k) by what exists, and two starting together take the same one
             start("--address", address)
+            deadline = time.monotonic() + 120
+            while len([*sockets.glob("raylet*")]) <= k or len([*sockets.glob("plasma*")]) <= k:
+                if nodes[-1].poll() is not None or time.monotonic() > deadline:
+                    log = (Path(tmp) / f"node{k}.log").read_text()[-3000:]
+                    pytest.fail(f"Ray worker node {k} did not start: {log}")
+                time.sleep(0.2)
         yield address
-        shutil.rmtree(tmp, ignore_errors=True)  # kept when the test fails: the node logs
+        ok = True
     finally:
         for node in reversed(nodes):
             node.send_signal(signal.SIGTERM)
@@ -130,6 +140,10 @@ def ray_cluster(workers: int = 2, cpus: int = 1) -> Iterator[str]:
         os.environ.pop("RAY_AUTH_TOKEN", None)
         _reset_ray_token_cache()
         print(f"\nRay cluster stopped by PID: {len(left)} process(es) needed SIGKILL")
+        if ok:
+            shutil.rmtree(tmp, ignore_errors=True)
+        else:
+            print(f"node logs kept in {tmp}")
 
 
 @pytest.mark.cluster

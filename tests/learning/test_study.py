@@ -61,13 +61,16 @@ def test_four_processes_share_one_study_and_one_is_killed(shared_url: str, tmp_p
     run_study(ref, cost, budget, workers=0)
     expected = sorted((t.key, t.cost) for t in ref.trials())
 
-    env = dict(os.environ, PYTHONPATH=SRC)
+    base = dict(os.environ, PYTHONPATH=SRC)
+    mark = tmp_path / "victim.marks"
 
-    def start(sleep_s: str) -> subprocess.Popen[str]:
+    def begun() -> int:
+        return len(mark.read_text().splitlines()) if mark.exists() else 0
+
+    def start(sleep_s: str, **extra: str) -> subprocess.Popen[str]:
         cmd = [sys.executable, str(WORKER), shared_url, str(budget), "cmaes", sleep_s]
-        return subprocess.Popen(
-            cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
-        )
+        out = {"stdout": subprocess.PIPE, "stderr": subprocess.STDOUT, "text": True}
+        return subprocess.Popen(cmd, env=dict(base, **extra), **out)  # type: ignore[call-overload]
 
     def wait_for(what: str, cond: Callable[[], bool], timeout: float = 180.0) -> None:
         deadline = time.monotonic() + timeout
@@ -78,18 +81,15 @@ def test_four_processes_share_one_study_and_one_is_killed(shared_url: str, tmp_p
             time.sleep(0.05)
 
     # the victim is slow (3 s trials), so that it is killed while running one
-    victim = start("3.0")
+    victim = start("3.0", SHARE_WORKER_MARK=str(mark))
     procs = [victim]
     try:
-        wait_for(
-            "a first claim of the victim", lambda: bool(_running_claims(shared_url, victim.pid))
-        )
+        wait_for("a first trial of the victim", lambda: begun() > 0)
         procs += [start("0.05") for _ in range(3)]
         others = {p.pid for p in procs[1:]}
         wait_for("a claim of the others", lambda: bool(_claim_pids(shared_url) & others))
-        wait_for(
-            "the victim running a trial", lambda: bool(_running_claims(shared_url, victim.pid))
-        )
+        n = begun()
+        wait_for("the victim beginning a trial", lambda: begun() > n)  # 3 s before it ends
         victim.send_signal(signal.SIGKILL)
         victim.wait(timeout=10)
         held = _running_claims(shared_url, victim.pid)  # what it held when it died
