@@ -34,6 +34,9 @@ __all__ = [
     "method_options",
     "run_experiment",
     "run_learning_bench",
+    "ScalingRow",
+    "scaling",
+    "scaling_markdown",
     "speedup",
     "to_markdown",
 ]
@@ -165,9 +168,11 @@ def run_experiment(
     storage: str | Path | None = None,
     on_trial: Callable[[TrialRecord], None] | None = None,
     handle_signals: bool = True,
+    ray: str | None = None,
 ) -> Experiment:
     """One learning run of ``trials`` trials; the study goes to ``storage`` (default: a
-    temporary SQLite file, removed afterwards)."""
+    temporary SQLite file, removed afterwards). ``ray``: run the trials on Ray (``"local"``
+    or the address of a running cluster), ``workers`` of them at once."""
     if method not in METHODS:
         raise LearningError(f"unknown method {method!r}; known: {list(METHODS)}")
     with tempfile.TemporaryDirectory(prefix="teachfit-bench-") as tmp:
@@ -186,15 +191,29 @@ def run_experiment(
             name=f"{objective.task}-{method}-{objective.seed}",
         )
         t0 = time.perf_counter()
-        run_study(
-            study,
-            objective,
-            trials,
-            workers=workers,
-            on_trial=on_trial,
-            handle_signals=handle_signals,
-        )
+        if ray is not None:
+            from teachfit.learning.ray_runner import run_study_ray
+
+            run_study_ray(
+                study,
+                objective,
+                trials,
+                address=ray,
+                workers=workers,
+                on_trial=on_trial,
+                handle_signals=handle_signals,
+            )
+        else:
+            run_study(
+                study,
+                objective,
+                trials,
+                workers=workers,
+                on_trial=on_trial,
+                handle_signals=handle_signals,
+            )
         wall = time.perf_counter() - t0
+        study.close()
         return Experiment.from_records(objective.task, method, objective.seed, study.trials(), wall)
 
 
@@ -211,8 +230,10 @@ def run_learning_bench(
     overrides: Mapping[str, float] | None = None,
     on_trial: Callable[[str, TrialRecord], None] | None = None,
     robot: str = "floating",
+    ray: str | None = None,
 ) -> LearningBench:
-    """Every task x method x experiment; ``on_trial(label, record)`` reports progress."""
+    """Every task x method x experiment; ``on_trial(label, record)`` reports progress;
+    ``ray``: trials on Ray (see :func:`run_experiment`)."""
     if experiments < 1 or trials < 1:
         raise LearningError(f"experiments and trials must be >= 1, got {experiments}, {trials}")
     bad = [m for m in methods if m not in METHODS]
@@ -235,7 +256,9 @@ def run_learning_bench(
                 )
                 label = f"{task}/{method} #{e + 1}"
                 cb = None if on_trial is None else (lambda r, lb=label: on_trial(lb, r))
-                mine.append(run_experiment(obj, method, trials, workers=workers, on_trial=cb))
+                mine.append(
+                    run_experiment(obj, method, trials, workers=workers, on_trial=cb, ray=ray)
+                )
             cells.append(CellStats.of(mine))
             exps.extend(mine)
     n_workers = workers if workers is not None else _cores()
@@ -270,6 +293,77 @@ def speedup(
         t1 = min(t1, run_experiment(obj, method, trials, workers=1).wall_s)
         tn = min(tn, run_experiment(obj, method, trials, workers=workers).wall_s)
     return t1, tn, t1 / tn
+
+
+@dataclass(frozen=True)
+class ScalingRow:
+    """One worker count of :func:`scaling`: ``trials`` trials in ``wall_s`` seconds."""
+
+    workers: int
+    trials: int
+    wall_s: float
+
+    @property
+    def trials_per_s(self) -> float:
+        return self.trials / self.wall_s if self.wall_s > 0 else math.nan
+
+
+def scaling(
+    workers: Sequence[int] = (1, 2, 4),
+    *,
+    task: str = "puzzle",
+    trials_per_worker: int = 6,
+    n_starts: int = 1,
+    seed: int = 0,
+    ray: str | None = None,
+) -> list[ScalingRow]:
+    """Trials/s of a learning study with each worker count, measured in one run.
+
+    Each count runs ``trials_per_worker * workers`` trials of a Latin hypercube study (no
+    generation barrier: this measures the runner, not a learner's parallelism). With ``ray``
+    the counts share one Ray connection, and a warm-up study on ``max(workers)`` workers
+    first starts the Ray workers and builds their MuJoCo scenes, so the figures are trials
+    alone. Without it each count starts a fresh local process pool (start-up included).
+    """
+    counts = sorted({int(w) for w in workers})
+    if not counts or counts[0] < 1 or trials_per_worker < 1:
+        raise LearningError(f"need worker counts >= 1 and trials >= 1, got {workers}")
+    obj = SkillObjective(task, seed=seed, n_starts=n_starts)
+    started = False
+    if ray is not None:
+        from teachfit.learning.ray_runner import _init, import_ray
+
+        started = _init(import_ray(), ray, counts[-1])
+    try:
+        if ray is not None:
+            run_experiment(obj, "lhs", counts[-1], workers=counts[-1], ray=ray)  # warm-up
+        rows = []
+        for w in counts:
+            n = trials_per_worker * w
+            exp = run_experiment(obj, "lhs", n, workers=w, ray=ray)
+            rows.append(ScalingRow(w, len(exp.costs), exp.wall_s))
+        return rows
+    finally:
+        if started:
+            import_ray().shutdown()
+
+
+def scaling_markdown(rows: Sequence[ScalingRow]) -> str:
+    """The scaling as a markdown table: speed-up over the fewest workers, and per worker."""
+    base = rows[0]
+    head = (
+        "| workers | trials | wall (s) | trials/s | speed-up | per worker (x linear) |\n"
+        "|---|---|---|---|---|---|\n"
+    )
+    lines = []
+    for r in rows:
+        up = r.trials_per_s / base.trials_per_s
+        per = up * base.workers / r.workers
+        lines.append(
+            f"| {r.workers} | {r.trials} | {r.wall_s:.1f} | {r.trials_per_s:.2f} | "
+            f"x{up:.2f} | {per:.2f} |"
+        )
+    return head + "\n".join(lines) + "\n"
 
 
 def _pm(mean: float, sd: float) -> str:

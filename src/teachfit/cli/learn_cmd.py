@@ -114,20 +114,30 @@ def learn_skill(
             f"{trials}[/]: nothing to run; raise --trials to continue"
         )
     best = [math.inf]
-    with progress_bar() as bar:
-        job = bar.add_task(f"{method} {task}", total=trials, completed=min(st.n_finished, trials))
+    try:
+        with progress_bar() as bar:
+            done = min(st.n_finished, trials)
+            job = bar.add_task(f"{method} {task}", total=trials, completed=done)
 
-        def progress(rec: object) -> None:
-            if rec.feasible:  # type: ignore[attr-defined]
-                best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
-            bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
+            def progress(rec: object) -> None:
+                if rec.feasible:  # type: ignore[attr-defined]
+                    best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
+                bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
 
-        if ray:
-            from teachfit.learning.ray_runner import run_study_ray
+            if ray:
+                from teachfit.learning.ray_runner import run_study_ray
 
-            rep = run_study_ray(st, obj, trials, address=ray, workers=workers, on_trial=progress)
-        else:
-            rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+                rep = run_study_ray(
+                    st, obj, trials, address=ray, workers=workers, on_trial=progress
+                )
+            else:
+                rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+    except KeyboardInterrupt:  # a second Ctrl-C / SIGTERM: running trials were dropped
+        console.print(
+            f"[red]interrupted again[/]: aborted; the {st.n_finished} finished trial(s) are "
+            "stored, the running ones were dropped; continue with the same command and --resume"
+        )
+        raise typer.Exit(130) from None
     console.print(
         f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
         f"trials/s), {rep.failed} failed by crash/divergence; study holds "
@@ -218,12 +228,30 @@ def bench_learning(
     ] = 24,
     markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")] = None,
     robot: RobotOpt = "floating",
+    ray: Annotated[
+        str | None, typer.Option(help="run trials on Ray: 'local' or the address of a cluster")
+    ] = None,
+    scaling: Annotated[
+        bool,
+        typer.Option(
+            help="only measure trials/s with each of --scaling-workers workers (one run) "
+            "and print the scaling"
+        ),
+    ] = False,
+    scaling_workers: Annotated[str, typer.Option(help="worker counts of --scaling")] = "1,2,4",
+    scaling_trials: Annotated[
+        int, typer.Option(help="trials per worker of each --scaling count")
+    ] = 6,
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
     import os
 
     from teachfit.bench import learning as bl
     from teachfit.learning.objective import SkillObjective
+
+    if scaling:
+        _bench_scaling(tasks, scaling_workers, scaling_trials, starts, seed, ray, markdown)
+        return
 
     task_list = [t for t in tasks.split(",") if t]
     method_list = [m for m in methods.split(",") if m]
@@ -242,6 +270,7 @@ def bench_learning(
             overrides=dict(_overrides(task_param)),
             on_trial=lambda label, _r: bar.update(job, advance=1, description=label),
             robot=robot,
+            ray=ray,
         )
     extra = "".join(f" --task-param {p}" for p in task_param or [])
     text = (
@@ -286,6 +315,45 @@ def bench_learning(
             bands, plot, f"best cost so far, mean and 95 % CI over {experiments} experiment(s)"
         )
         console.print(f"learning curves -> {path}")
+    if markdown is not None:
+        markdown.parent.mkdir(parents=True, exist_ok=True)
+        markdown.write_text(text)
+        console.print(f"markdown -> {markdown}")
+
+
+def _bench_scaling(
+    tasks: str,
+    workers: str,
+    trials: int,
+    starts: int,
+    seed: int,
+    ray: str | None,
+    markdown: Path | None,
+) -> None:
+    """``bench learning --scaling``: trials/s with 1, 2, 4, ... workers, in one run."""
+    import os
+
+    from rich.markdown import Markdown
+
+    from teachfit.bench import learning as bl
+
+    try:
+        counts = [int(w) for w in workers.split(",") if w.strip()]
+    except ValueError:
+        raise LearningError(f"--scaling-workers wants counts like 1,2,4, got {workers!r}") from None
+    task = tasks.split(",")[0]
+    with console.status(f"scaling: {task}, {trials} trial(s) per worker, {counts} workers"):
+        rows = bl.scaling(
+            counts, task=task, trials_per_worker=trials, n_starts=starts, seed=seed, ray=ray
+        )
+    where = f"Ray at {ray}" if ray else "a local process pool per count (start-up included)"
+    text = (
+        f"`teachfit bench learning --scaling --tasks {task} --scaling-workers {workers} "
+        f"--scaling-trials {trials} --starts {starts}{f' --ray {ray}' if ray else ''}`: "
+        f"Latin hypercube trials on {where}; this machine has {os.cpu_count()} cores, "
+        f"1-min load average {os.getloadavg()[0]:.1f}\n\n" + bl.scaling_markdown(rows)
+    )
+    console.print(Markdown(text))
     if markdown is not None:
         markdown.parent.mkdir(parents=True, exist_ok=True)
         markdown.write_text(text)

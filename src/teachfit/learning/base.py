@@ -76,6 +76,17 @@ class Learner(Protocol):
         """On a fresh learner: adopt previously finished trials as if told, in their order."""
         ...
 
+    def release(self, candidate: Candidate) -> Candidate | None:
+        """``candidate.key`` is claimed by another process sharing the study. Returns the same
+        point under a fresh key to claim instead, or ``None``: the learner then waits for that
+        key's result from the other process (:meth:`adopt`)."""
+        ...
+
+    def adopt(self, finished: Finished) -> None:
+        """A trial finished by another process sharing the study (or re-run here after its
+        process died): take it as told. Keys this learner has no use for are ignored."""
+        ...
+
 
 class GenerationalLearner:
     """Base of population learners (CMA-ES, PSO): generations of keyed candidates.
@@ -145,6 +156,17 @@ class GenerationalLearner:
 
     def tell(self, candidate: Candidate, cost: float, feasible: bool = True) -> None:
         self._record(candidate, cost)
+
+    def release(self, candidate: Candidate) -> Candidate | None:
+        return None  # a key names a member: every process asks the same one
+
+    def adopt(self, finished: Finished) -> None:
+        key = finished.candidate.key
+        if not any(m.key == key for m in self._members):
+            self._restored[key] = finished  # of a later generation: told when it starts
+        elif key not in self._told:
+            self._queue = [c for c in self._queue if c.key != key]
+            self._record(finished.candidate, finished.cost)
 
     def restore(self, finished: Sequence[Finished]) -> None:
         if self._gen >= 0:

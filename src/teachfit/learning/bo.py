@@ -68,15 +68,33 @@ class BayesOpt:
         self._known: set[str] = set()
         self._counter = 0
 
-    def ask(self) -> Candidate | None:
-        trial = self._study.ask(self._dists)
+    def _new_key(self) -> str:
         while f"b{self._counter}" in self._known:
             self._counter += 1
         key = f"b{self._counter}"
         self._counter += 1
         self._known.add(key)
+        return key
+
+    def ask(self) -> Candidate | None:
+        trial = self._study.ask(self._dists)
+        key = self._new_key()
         self._running[key] = trial
         return Candidate.of(key, [trial.params[f"u{i}"] for i in range(self.space.dim)])
+
+    def release(self, candidate: Candidate) -> Candidate | None:
+        trial = self._running.pop(candidate.key, None)
+        if trial is None:
+            return None
+        key = self._new_key()  # keys are names only: the point is still worth a trial
+        self._running[key] = trial
+        return Candidate(key, candidate.u)
+
+    def adopt(self, finished: Finished) -> None:
+        if finished.candidate.key in self._running:
+            raise LearningError(f"candidate {finished.candidate.key!r} is pending here")
+        self._known.add(finished.candidate.key)
+        self._add(finished)
 
     def tell(self, candidate: Candidate, cost: float, feasible: bool = True) -> None:
         trial = self._running.pop(candidate.key, None)
@@ -91,13 +109,16 @@ class BayesOpt:
             raise LearningError("restore() needs a fresh learner")
         for f in finished:
             self._known.add(f.candidate.key)
-            self._study.add_trial(
-                optuna.trial.create_trial(
-                    params={f"u{i}": float(u) for i, u in enumerate(f.candidate.u)},
-                    distributions=self._dists,
-                    value=float(f.cost),
-                    constraints=(
-                        {_CONSTRAINT: 0.0 if f.feasible else 1.0} if self.constraints else None
-                    ),
-                )
+            self._add(f)
+
+    def _add(self, f: Finished) -> None:
+        self._study.add_trial(
+            optuna.trial.create_trial(
+                params={f"u{i}": float(u) for i, u in enumerate(f.candidate.u)},
+                distributions=self._dists,
+                value=float(f.cost),
+                constraints=(
+                    {_CONSTRAINT: 0.0 if f.feasible else 1.0} if self.constraints else None
+                ),
             )
+        )

@@ -57,6 +57,14 @@ class LatinHypercube:
         self._out.discard(i)
         self._done.add(i)
 
+    def release(self, candidate: Candidate) -> Candidate | None:
+        return None  # point i is key i in every process
+
+    def adopt(self, finished: Finished) -> None:
+        i = self._index(finished.candidate.key)
+        self._out.discard(i)
+        self._done.add(i)
+
     def restore(self, finished: Sequence[Finished]) -> None:
         for f in finished:
             self.tell(f.candidate, f.cost, f.feasible)

@@ -26,7 +26,7 @@ from typing import Any
 
 from teachfit.core.params import LearningError
 from teachfit.learning.base import Candidate, TrialResult
-from teachfit.learning.runner import Objective, RunReport, _Signals, evaluate
+from teachfit.learning.runner import POLL_S, Objective, RunReport, _Signals, evaluate
 from teachfit.learning.study import Study, TrialRecord
 
 
@@ -93,7 +93,7 @@ def run_study_ray(
     ray = import_ray()
     t0 = time.perf_counter()
     started = _init(ray, address, workers)
-    restored, failed = study.n_finished, 0
+    restored, here, failed = study.n_finished, study.n_here, 0
     pending: dict[Any, Candidate] = {}
     try:
         slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
@@ -101,17 +101,16 @@ def run_study_ray(
         obj_ref = ray.put(objective)
         with _Signals(handle_signals) as sig:
             while True:
-                while (
-                    not sig.stop
-                    and len(pending) < slots
-                    and study.n_finished + len(pending) < budget
-                ):
-                    cand = study.ask()
+                while not sig.stop and len(pending) < slots:
+                    cand = study.ask(budget)
                     if cand is None:
                         break
                     pending[task.remote(obj_ref, study.params_of(cand))] = cand
                 if not pending:
-                    break
+                    if sig.stop or study.settled(budget):
+                        break
+                    time.sleep(POLL_S)  # other processes run trials this learner waits for
+                    continue
                 done, _ = ray.wait(list(pending), num_returns=1, timeout=0.2)
                 for ref in done:
                     cand = pending.pop(ref)
@@ -122,6 +121,8 @@ def run_study_ray(
                         why = str(exc).strip().splitlines()[-1:] or [""]
                         result, error = None, f"Ray worker failed: {type(exc).__name__}: {why[0]}"
                     rec = study.tell(cand, result, error)
+                    if rec is None:
+                        continue  # the claim was lost to another process, which runs it
                     failed += rec.outcome == "error"
                     if on_trial is not None:
                         on_trial(rec)
@@ -129,10 +130,9 @@ def run_study_ray(
     except BaseException:
         for ref in pending:
             ray.cancel(ref, force=True)
+        study.abandon()  # other processes may run our unfinished trials at once
         raise
     finally:
         if started:
             ray.shutdown()
-    return RunReport(
-        restored, study.n_finished - restored, failed, interrupted, time.perf_counter() - t0
-    )
+    return RunReport(restored, study.n_here - here, failed, interrupted, time.perf_counter() - t0)

@@ -15,10 +15,22 @@ SIGINT / SIGTERM: the first one stops asking for new trials and lets the running
 and be stored, then :func:`run_study` returns with ``interrupted=True``; a second one aborts at
 once (running trials are dropped and asked anew on resume) by raising ``KeyboardInterrupt``.
 A ``KeyboardInterrupt`` raised by the objective itself aborts the same way.
+
+Workers die with this process: each sits in its own process group (a Ctrl-C at the terminal
+reaches only this process, which decides what it means), has the default SIGINT / SIGTERM
+actions (not this process's handlers, inherited through ``fork``), and on Linux asks the kernel
+to SIGKILL it when its parent dies (``PR_SET_PDEATHSIG``), so even a ``kill -9`` of this
+process leaves no worker behind.
+
+Several processes may run one study together (see :mod:`teachfit.learning.study`): each claims
+the keys it runs, and one whose learner waits on trials running elsewhere polls until they
+finish (or their process dies and it claims them).
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import math
 import multiprocessing
 import os
@@ -73,9 +85,32 @@ def evaluate(objective: Objective, params: Mapping[str, float]) -> tuple[TrialRe
     return result, ""
 
 
-def _worker_init() -> None:
-    # Ctrl-C reaches the whole process group; only the main process decides what it means
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+#: seconds between looks at a study while only other processes run its trials
+POLL_S = 0.5
+
+_PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent(parent: int | None = None) -> bool:
+    """Have the kernel SIGKILL this process when its parent dies (Linux ``prctl``); exit at
+    once if ``parent`` (the expected parent PID) is already gone. False where unsupported."""
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        ok = libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        ok = False
+    if parent is not None and os.getppid() != parent:
+        os._exit(1)  # the parent died before the request took effect
+    return ok
+
+
+def _worker_init(parent: int | None) -> None:
+    # not the parent's handlers (inherited through fork, they ignored a first SIGTERM)
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    # a Ctrl-C at the terminal reaches the foreground group: the main process alone decides
+    os.setpgid(0, 0)
+    die_with_parent(parent)
 
 
 class _Signals:
@@ -132,29 +167,38 @@ def run_study(
     if n_workers < 0:
         raise LearningError(f"workers must be >= 0, got {workers}")
     t0 = time.perf_counter()
-    restored = study.n_finished
+    restored, here = study.n_finished, study.n_here
     failed = 0
 
     def store(cand: Candidate, result: TrialResult | None, error: str) -> None:
         nonlocal failed
         rec = study.tell(cand, result, error)
+        if rec is None:
+            return  # the claim was lost to another process, which runs it
         failed += rec.outcome == "error"
         if on_trial is not None:
             on_trial(rec)
 
     with _Signals(handle_signals) as sig:
-        if n_workers == 0:
-            while not sig.stop and study.n_finished < budget:
-                cand = study.ask()
-                if cand is None:
-                    break
-                store(cand, *evaluate(objective, study.params_of(cand)))
-        else:
-            _run_pool(study, objective, budget, n_workers, sig, store, mp_context)
+        try:
+            if n_workers == 0:
+                while not sig.stop:
+                    cand = study.ask(budget)
+                    if cand is None:
+                        if study.settled(budget):
+                            break
+                        time.sleep(POLL_S)  # others run trials this learner waits for
+                        continue
+                    store(cand, *evaluate(objective, study.params_of(cand)))
+            else:
+                _run_pool(study, objective, budget, n_workers, sig, store, mp_context)
+        except BaseException:
+            study.abandon()  # other processes may run our unfinished trials at once
+            raise
         interrupted = sig.stop
     return RunReport(
         restored=restored,
-        finished=study.n_finished - restored,
+        finished=study.n_here - here,
         failed=failed,
         interrupted=interrupted,
         wall_s=time.perf_counter() - t0,
@@ -171,9 +215,13 @@ def _run_pool(
     mp_context: str | None,
 ) -> None:
     ctx = multiprocessing.get_context(mp_context) if mp_context else None
+    method = (ctx or multiprocessing).get_start_method()
+    parent = os.getpid() if method in ("fork", "spawn") else None  # forkserver: not us
 
     def new_pool() -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(n_workers, mp_context=ctx, initializer=_worker_init)
+        return ProcessPoolExecutor(
+            n_workers, mp_context=ctx, initializer=_worker_init, initargs=(parent,)
+        )
 
     pool = new_pool()
     pending: dict[Future[tuple[TrialResult | None, str]], Candidate] = {}
@@ -181,7 +229,7 @@ def _run_pool(
     retry: list[Candidate] = []  # asked but never started (submitted to a broken pool)
     try:
         while True:
-            while not sig.stop and study.n_finished + len(pending) < budget:
+            while not sig.stop:
                 if suspects:
                     if pending:
                         break
@@ -189,7 +237,10 @@ def _run_pool(
                 elif retry:
                     cand = retry.pop(0)
                 else:
-                    cand = study.ask()  # None: a population waits for its tells, or exhausted
+                    if len(pending) >= n_workers:
+                        break
+                    # None: a population waits for its tells, the budget is taken, or exhausted
+                    cand = study.ask(budget)
                     if cand is None:
                         break
                 try:
@@ -201,9 +252,14 @@ def _run_pool(
                 if suspects or len(pending) >= n_workers:
                     break
             if not pending:
-                if (suspects or retry) and not sig.stop and study.n_finished < budget:
+                if sig.stop:
+                    break
+                if suspects or retry:
                     continue
-                break  # stopped, budget used, or the learner has nothing more to ask
+                if study.settled(budget):
+                    break  # budget used, or the learner has nothing more to ask
+                time.sleep(POLL_S)  # other processes run trials this learner waits for
+                continue
             done, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
             broken: list[Candidate] = []
             for fut in done:

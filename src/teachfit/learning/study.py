@@ -12,27 +12,57 @@ Opening a study rebuilds a fresh learner with the stored seed and options and re
 stored trials into it (:meth:`~teachfit.learning.base.Learner.restore`): a killed run resumes
 where it stopped, finished trials are neither lost nor asked again, and trials that were running
 when it was killed are asked anew.
+
+Any number of processes, on one machine or several, may work on one study at once (SQLite on a
+local disk, or a database server such as PostgreSQL). Each key a learner asks is *claimed*
+(:mod:`teachfit.learning.claims`) before it runs, within the trial budget: a key runs in one
+process only, keys of a process that died are taken over by the others, and trials finished
+elsewhere are told to this process's learner (:meth:`~teachfit.learning.base.Learner.adopt`)
+when it syncs -- so a CMA-ES generation is shared out among the processes, and all of them
+together finish exactly the budget, each key once.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+import time
+import weakref
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import optuna
 from optuna.distributions import FloatDistribution
+from optuna.exceptions import StorageInternalError
+from sqlalchemy.exc import DBAPIError
 
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
+from teachfit.learning.claims import Claim, Claims, Verdict, engine_kwargs, serialise_sqlite
 from teachfit.learning.cmaes import CMAES
 from teachfit.learning.lhs import LatinHypercube
 from teachfit.learning.pso import PSO
 
 METHODS = ("cmaes", "pso", "bo", "lhs")
+
+#: seconds between reads of what other processes sharing a study have finished
+SYNC_S = 1.0
+
+T = TypeVar("T")
+
+
+def _retry(fn: Callable[[], T], attempts: int = 8) -> T:
+    """``fn()``, retried on database errors: processes creating one study's tables race."""
+    for i in range(attempts):
+        try:
+            return fn()
+        except (DBAPIError, StorageInternalError):
+            if i == attempts - 1:
+                raise
+            time.sleep(0.05 * 2**i)
+    raise AssertionError("unreachable")
 
 
 class StudyMismatchError(LearningError):
@@ -121,6 +151,9 @@ class Study:
         Allow opening a study that already has trials (else :class:`LearningError`).
     context : mapping or None
         More JSON-able tags that must match on resume (e.g. controller, set-up seed).
+    claim_timeout : float
+        Seconds without a heartbeat after which another process's claim counts as dead (a
+        process on this machine counts as dead at once when its PID is gone).
     """
 
     def __init__(
@@ -137,9 +170,12 @@ class Study:
         name: str = "teachfit",
         resume: bool = True,
         context: Mapping[str, Any] | None = None,
+        claim_timeout: float = 60.0,
     ) -> None:
         if not math.isfinite(penalty):
             raise LearningError(f"penalty must be finite, got {penalty}")
+        if not claim_timeout > 0:
+            raise LearningError(f"claim_timeout must be > 0 s, got {claim_timeout}")
         self.url = storage_url(storage)
         self.space = space
         self.penalty = float(penalty)
@@ -157,53 +193,144 @@ class Study:
         self.tags = tags
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self.learner = make_learner(method, space, seed, options)
-        self._optuna = optuna.create_study(
-            storage=self.url, study_name=name, direction="minimize", load_if_exists=True
+        rdb = _retry(
+            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url))
         )
-        stored = self._optuna.user_attrs
-        if not stored:
-            for k, v in tags.items():
-                self._optuna.set_user_attr(k, v)
-        else:
-            diff = [k for k in tags if stored.get(k) != tags[k]]
-            if diff:
-                what = "; ".join(f"{k}: stored {stored.get(k)!r}, asked {tags[k]!r}" for k in diff)
-                raise StudyMismatchError(f"study {name!r} in {self.url} differs: {what}")
+        serialise_sqlite(rdb.engine)
+        self._rdb = rdb
+        self._optuna = _retry(
+            lambda: optuna.create_study(
+                storage=rdb, study_name=name, direction="minimize", load_if_exists=True
+            )
+        )
         self._dists = {
             n: FloatDistribution(d.low, d.high, log=d.log) for n, d in space.domains.items()
         }
         finished = self._finished_trials()
+        stored = self._optuna.user_attrs
+        if not finished:
+            # a new study, maybe being tagged by another process at this moment: add the
+            # tags it lacks (one at a time, like that process), then compare them all
+            for k, v in tags.items():
+                if k not in stored:
+                    self._optuna.set_user_attr(k, v)
+            stored = self._optuna.user_attrs
+        diff = [k for k in tags if stored.get(k) != tags[k]]
+        if diff:
+            what = "; ".join(f"{k}: stored {stored.get(k)!r}, asked {tags[k]!r}" for k in diff)
+            raise StudyMismatchError(f"study {name!r} in {self.url} differs: {what}")
         if finished and not resume:
             raise LearningError(
                 f"study {name!r} in {self.url} already has {len(finished)} trials: resume it "
                 "(--resume) or choose another study"
             )
-        self.learner.restore(
-            [
-                Finished(
-                    Candidate(t.user_attrs["key"], tuple(t.user_attrs["u"])),
-                    float(t.value),  # type: ignore[arg-type]
-                    bool(t.user_attrs["feasible"]),
-                )
-                for t in finished
-            ]
-        )
+        self.learner.restore([_finished(t) for t in finished])
         self.n_restored = len(finished)
-        self._n = len(finished)
+        #: finished trials this object stored (the others: restored, or stored elsewhere)
+        self.n_here = 0
+        self._seen = {str(t.user_attrs["key"]) for t in finished}
+        self._claims = Claims(self.url, name, claim_timeout)
+        weakref.finalize(self, self._claims.close)
+        self._running: dict[str, tuple[Candidate, bool]] = {}  # claimed here: (cand, own)
+        self._retry: list[tuple[Candidate, bool]] = []  # to claim (again)
+        self._elsewhere: dict[str, Candidate] = {}  # claimed by other processes
+        self._others = 0  # live claims of other processes, unfinished
+        self._synced = time.monotonic()
 
     def _finished_trials(self) -> list[optuna.trial.FrozenTrial]:
-        trials = self._optuna.get_trials(deepcopy=False, states=(optuna.trial.TrialState.COMPLETE,))
-        return sorted(trials, key=lambda t: t.number)
+        # read the database itself, not Optuna's cache of it: the cache skips trials that
+        # other processes commit out of id order (concurrent writers of a database server)
+        sid = self._optuna._study_id
+        done = (optuna.trial.TrialState.COMPLETE,)
+        trials = _retry(lambda: self._rdb.get_all_trials(sid, deepcopy=False, states=done))
+        return sorted(trials, key=lambda t: (t.number, t._trial_id))
 
     # ------------------------------------------------------------------------- trials
     @property
     def n_finished(self) -> int:
-        """Finished trials stored so far (restored ones included)."""
-        return self._n
+        """Finished trials in the study as last seen (restored, stored here or elsewhere)."""
+        return len(self._seen)
 
-    def ask(self) -> Candidate | None:
-        """The learner's next candidate (``None``: wait for pending tells, or exhausted)."""
-        return self.learner.ask()
+    def ask(self, budget: int | None = None) -> Candidate | None:
+        """Claim and return the next candidate, or ``None`` if none can be claimed now: the
+        learner waits for trials running (here or elsewhere), the budget is taken by finished
+        and running trials, or the learner is exhausted (:meth:`settled` tells which)."""
+        if time.monotonic() - self._synced > SYNC_S:
+            self.sync()
+        cand = self._next(budget)
+        if cand is None and (self._elsewhere or not self._running):
+            self.sync()  # trials finished elsewhere may let the learner go on
+            cand = self._next(budget)
+        return cand
+
+    def _next(self, budget: int | None) -> Candidate | None:
+        while True:
+            if self._retry:
+                cand, own = self._retry.pop(0)
+            else:
+                asked = self.learner.ask()
+                if asked is None:
+                    return None
+                cand, own = asked, True
+            verdict, dead = self._claims.claim(cand.key, cand.u, budget, self._seen)
+            if verdict is Verdict.MINE:
+                if dead is not None and not own:
+                    cand = Candidate(cand.key, dead.u)  # the point the dead process ran
+                self._running[cand.key] = (cand, own)
+                return cand
+            if verdict is Verdict.BUDGET:
+                self._retry.insert(0, (cand, own))
+                return None
+            other = self.learner.release(cand) if own else None
+            if other is not None:
+                self._retry.insert(0, (other, True))
+            else:
+                self._elsewhere[cand.key] = cand
+
+    def sync(self) -> None:
+        """Read what other processes finished (told to the learner) and which of their
+        claims died (their keys are claimed again by :meth:`ask`)."""
+        self._synced = time.monotonic()
+        me, timeout, now = self._claims.owner, self._claims.timeout, time.time()
+        claims = {c.key: c for c in _retry(self._claims.all)}
+        dead: dict[str, Claim] = {
+            k: c for k, c in claims.items() if c.owner != me and not c.alive(timeout, now)
+        }
+        finished = self._finished_trials()  # read after the owners were seen dead
+        stored = {str(t.user_attrs["key"]) for t in finished}
+        storing = [c for c in dead.values() if c.state == "storing"]
+        if storing:
+            self._claims.resolve(storing, stored)
+        for t in finished:
+            key = str(t.user_attrs["key"])
+            if key in self._seen:
+                continue
+            self._seen.add(key)
+            self._elsewhere.pop(key, None)
+            if key not in self._running:
+                self.learner.adopt(_finished(t))
+        for key, cand in list(self._elsewhere.items()):
+            c = claims.get(key)
+            if c is None or (key in dead and key not in stored):
+                del self._elsewhere[key]  # released, or its process died: claim it again
+                self._retry.append((cand, False))
+        self._others = sum(
+            1
+            for k, c in claims.items()
+            if c.owner != me and c.state != "done" and k not in dead and k not in stored
+        )
+
+    def settled(self, budget: int | None = None) -> bool:
+        """Right after :meth:`ask` returned ``None`` with nothing running here (it has just
+        synced and asked again): ``True`` if this process has nothing more to do (the study
+        holds ``budget`` trials, or the learner is exhausted and no other process runs a
+        trial), ``False`` if it should wait for other processes (their trials may let the
+        learner go on, or their process may die) and ask again."""
+        if budget is not None and self.n_finished >= budget:
+            return True
+        if self._retry:
+            return False
+        return self._others == 0
 
     def params_of(self, candidate: Candidate) -> dict[str, float]:
         """Physical parameter values of a candidate."""
@@ -211,10 +338,12 @@ class Study:
 
     def tell(
         self, candidate: Candidate, result: TrialResult | None, error: str = ""
-    ) -> TrialRecord:
+    ) -> TrialRecord | None:
         """Store a finished trial at once, then tell the learner.
 
         ``result=None`` (or a non-finite cost) records a failed trial at the study's penalty.
+        Returns ``None`` (and stores nothing) if this process lost the candidate's claim to
+        another one (after missing heartbeats for ``claim_timeout``).
         """
         if result is None or not math.isfinite(result.cost):
             cost, feasible = self.penalty, False
@@ -225,13 +354,22 @@ class Study:
             cost, feasible = float(result.cost), bool(result.feasible)
             outcome = "ok" if feasible else "infeasible"
             info = {k: float(v) for k, v in result.info.items()}
+        key = candidate.key
+        _, own = self._running.pop(key, (candidate, True))
+        if not self._claims.begin_store(key):
+            other = self.learner.release(candidate) if own else None
+            if other is not None:
+                self._retry.append((other, True))
+            else:
+                self._elsewhere[key] = candidate
+            return None
         params = self.params_of(candidate)
         frozen = optuna.trial.create_trial(
             params=params,
             distributions=self._dists,
             value=cost,
             user_attrs={
-                "key": candidate.key,
+                "key": key,
                 "u": list(candidate.u),
                 "feasible": feasible,
                 "outcome": outcome,
@@ -239,10 +377,25 @@ class Study:
                 "info": info,
             },
         )
-        self._optuna.add_trial(frozen)  # committed before the learner hears of it
-        self._n += 1
-        self.learner.tell(candidate, cost, feasible)
-        return TrialRecord(self._n - 1, candidate.key, params, cost, feasible, outcome, error, info)
+        _retry(lambda: self._optuna.add_trial(frozen))  # committed before the learner hears
+        self._claims.end_store(key)
+        self._seen.add(key)
+        self.n_here += 1
+        if own:
+            self.learner.tell(candidate, cost, feasible)
+        else:
+            self.learner.adopt(Finished(candidate, cost, feasible))
+        return TrialRecord(self.n_finished - 1, key, params, cost, feasible, outcome, error, info)
+
+    def abandon(self) -> None:
+        """Give up the trials running here (an aborted run): other processes may claim them."""
+        self._running.clear()
+        self._claims.release()
+
+    def close(self) -> None:
+        """Release this process's unfinished claims and its database connections."""
+        self._running.clear()
+        self._claims.close()
 
     def trials(self) -> list[TrialRecord]:
         """All stored finished trials, in the order they finished."""
@@ -267,3 +420,11 @@ class Study:
             raise LearningError("the study has no finished trial yet")
         feasible = [r for r in recs if r.feasible] or recs
         return min(feasible, key=lambda r: r.cost)
+
+
+def _finished(t: optuna.trial.FrozenTrial) -> Finished:
+    return Finished(
+        Candidate(str(t.user_attrs["key"]), tuple(float(x) for x in t.user_attrs["u"])),
+        float(t.value),  # type: ignore[arg-type]
+        bool(t.user_attrs["feasible"]),
+    )
