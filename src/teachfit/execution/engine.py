@@ -36,7 +36,15 @@ from teachfit.core.outcome import Outcome
 from teachfit.core.state import ImpedanceCommand
 from teachfit.execution.log import ExecutionLog, LogBuffer
 from teachfit.robot.interface import Robot
-from teachfit.skills.conditions import All, Any_, Condition, ForceAbove, TimeAbove
+from teachfit.skills.conditions import (
+    All,
+    Any_,
+    Condition,
+    Detected,
+    ForceAbove,
+    Not,
+    TimeAbove,
+)
 from teachfit.skills.graph import Skill
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.tasks.base import Task
@@ -114,7 +122,19 @@ class ExecutionResult:
 def _leaves(cond: Condition) -> tuple[Condition, ...]:
     if isinstance(cond, All):  # Any_ derives from All
         return tuple(c for part in cond.parts for c in _leaves(part))
+    if isinstance(cond, Not):
+        return _leaves(cond.part)
     return (cond,)
+
+
+def _uses_detected(skill: Skill) -> bool:
+    """Whether any condition of ``skill`` asks for the task's detector (checked per tick then;
+    otherwise only at the end: it costs a pose transform per command period)."""
+    conds = [skill.success, skill.error, skill.pre]
+    conds += [n.error for n in skill.nodes] + [t.condition for t in skill.transitions]
+    if skill.recovery is not None:
+        conds.append(skill.recovery.error)
+    return any(isinstance(c, Detected) for cond in conds if cond for c in _leaves(cond))
 
 
 def _classify(fired: list[Condition]) -> Outcome:
@@ -183,7 +203,7 @@ def execute(
     sp_pos, sp_ff = np.zeros(3), np.zeros(6)
     dq, qtmp = np.zeros(4), np.zeros(4)
     last_pos = np.zeros(3)  # the last finite TCP position (world)
-    detect = task.detect_success if task is not None else None
+    detect = task.detect_success if task is not None and _uses_detected(skill) else None
     wall0 = time.perf_counter()
 
     state = robot.reset(start, controller)
