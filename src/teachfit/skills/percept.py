@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from teachfit.core.geometry import Pose, quat_conj_into, quat_mul_into
+from teachfit.core.geometry import Pose, quat_conj_into, quat_mul_into, quat_to_matrix_into
 from teachfit.core.state import RobotState
 
 
@@ -59,6 +59,7 @@ class Percept:
         self.done = False
         self.detected = False
         self._tmp = np.zeros(3)
+        self._mat = np.zeros(9)
 
     def update(self, state: RobotState, t: float) -> None:
         """Adopt a measured state at skill time ``t`` (s)."""
@@ -100,8 +101,8 @@ class Percept:
     @property
     def tilt(self) -> float:
         """Angle between the tool's z-axis and the task frame's z-axis (rad)."""
-        w, x, y, z = self.q
-        cz = 1.0 - 2.0 * (x * x + y * y)  # z-component of the tool z-axis
+        quat_to_matrix_into(self._mat, self.q)
+        cz = float(self._mat[8])  # z-component of the tool z-axis
         return math.acos(min(1.0, max(-1.0, cz)))
 
     def to_world_pose(self, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
