@@ -37,3 +37,25 @@ def test_a_search_trajectory_runs_on_the_franka_through_the_engine(franka_sim: o
     assert np.all(np.diff(res.log.t) > 0)
     moved = res.log.pos[-1] - res.log.pos[0]
     assert 0.008 < moved[0] < 0.02 and abs(moved[1]) < 0.004  # joint friction: mm short
+
+
+def test_a_skill_trial_runs_on_the_franka(franka_sim: object) -> None:
+    """Seed B's peg-in-hole skill with the adaptive law, as a learning trial would run it, on
+    the Franka through the protocol. franky-sim has no cell, so the contact never comes: the
+    skill descends through the approach into free space and stops on its time limit, the
+    workspace box or its own error exit; whatever ends it, the engine reports it as data."""
+    from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
+
+    task = get_task("peg2d")
+    setup = peg_in_hole_setup(task, seed=0, n_starts=1, controller="adaptive")
+    trial = SkillTrial(setup, "adaptive", robot="franka", host="127.0.0.1", realtime=False)
+    try:
+        out = trial()
+    finally:
+        trial.robot.close()
+    (res,) = out.traces
+    assert res.visits[0].node == "approach"
+    assert res.outcome in (Outcome.TIMEOUT, Outcome.ERROR_CONDITION, Outcome.FAULT)
+    assert not out.successes[0] and res.log.n_samples > 10
+    depth = res.log.pos[0, 2] - res.log.pos[:, 2].min()
+    assert depth > 0.005  # it moved down towards the (absent) hole under the skill's command
