@@ -41,9 +41,10 @@ def test_a_search_trajectory_runs_on_the_franka_through_the_engine(franka_sim: o
 
 def test_a_skill_trial_runs_on_the_franka(franka_sim: object) -> None:
     """Seed B's peg-in-hole skill with the adaptive law, as a learning trial would run it, on
-    the Franka through the protocol. franky-sim has no cell, so the contact never comes: the
-    skill descends through the approach into free space and stops on its time limit, the
-    workspace box or its own error exit; whatever ends it, the engine reports it as data."""
+    the Franka through the protocol. franky-sim has no cell: the skill descends through its
+    approach into free space, and what ends it depends on the real loop's timing (its time
+    limit or error exit, or its depth condition once the part is below the entry height, which
+    a pose-based detector cannot tell from an insertion without the cell)."""
     from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
 
     task = get_task("peg2d")
@@ -55,7 +56,7 @@ def test_a_skill_trial_runs_on_the_franka(franka_sim: object) -> None:
         trial.robot.close()
     (res,) = out.traces
     assert res.visits[0].node == "approach"
-    assert res.outcome in (Outcome.TIMEOUT, Outcome.ERROR_CONDITION, Outcome.FAULT)
-    assert not out.successes[0] and res.log.n_samples > 10
+    assert res.outcome in (Outcome.SUCCESS, Outcome.TIMEOUT, Outcome.ERROR_CONDITION)
+    assert res.log.n_samples > 10 and len(out.successes) == 1
     depth = res.log.pos[0, 2] - res.log.pos[:, 2].min()
     assert depth > 0.005  # it moved down towards the (absent) hole under the skill's command
