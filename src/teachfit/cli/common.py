@@ -26,9 +26,17 @@ HostOpt = Annotated[
 ]
 
 
-def robot_options(host: str | None) -> dict[str, object]:
-    """The ``make_robot`` options the CLI's ``--host`` gives (none for simulated robots)."""
-    return {} if host is None else {"host": host}
+#: ``--realtime/--no-realtime``: a real robot's control loop needs a real-time kernel; the
+#: protocol simulator (127.0.0.1) runs without one
+RealtimeOpt = Annotated[
+    bool, typer.Option(help="real robot: require a real-time kernel (off for the simulator)")
+]
+
+
+def robot_options(host: str | None, realtime: bool = True) -> dict[str, object]:
+    """The ``make_robot`` options the CLI's ``--host``/``--no-realtime`` give (none for
+    simulated robots)."""
+    return {} if host is None else {"host": host, "realtime": realtime}
 
 
 P = ParamSpec("P")

@@ -10,7 +10,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.core.errors import DatasetError, TeachfitError
 from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
@@ -46,6 +46,7 @@ def record(
     overwrite: Annotated[bool, typer.Option(help="replace an existing file")] = False,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
+    realtime: RealtimeOpt = True,
     duration: Annotated[
         float | None, typer.Option(help="real robot: seconds to record (default: until Ctrl-C)")
     ] = None,
@@ -58,7 +59,7 @@ def record(
     if robot in ROBOTS and not ROBOTS[robot].simulated:
         from teachfit.demonstrations.kinesthetic import record_demonstration
 
-        arm = make_robot(robot, the_task, **robot_options(host))
+        arm = make_robot(robot, the_task, **robot_options(host, realtime))
         try:
             console.print("guide the arm; Ctrl-C ends the recording")
             demos, discarded = [record_demonstration(arm, the_task.name, duration)], []

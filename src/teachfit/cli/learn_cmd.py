@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RobotOpt, console, guarded
+from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.core.params import LearningError
 
@@ -61,6 +61,7 @@ def learn_skill(
     ] = None,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
+    realtime: RealtimeOpt = True,
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.bench.learning import method_options
@@ -75,7 +76,7 @@ def learn_skill(
         raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
     get_task(task)  # an unknown task fails here, before any study file is created
     obj = SkillObjective(
-        task, skill, controller, seed, starts, _overrides(task_param), robot, host or ""
+        task, skill, controller, seed, starts, _overrides(task_param), robot, host or "", realtime
     )
     tags = stored_tags(study)  # resuming keeps the stored options (e.g. the LHS design size)
     same = tags is not None and tags.get("method") == method

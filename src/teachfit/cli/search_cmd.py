@@ -10,7 +10,7 @@ import typer
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
@@ -125,6 +125,7 @@ def run(
     plot: Annotated[Path | None, typer.Option(help="figure of the executed paths")] = None,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
+    realtime: RealtimeOpt = True,
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
@@ -154,7 +155,7 @@ def run(
             "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
             "the hole; without --demo a nominal demonstration start is assumed"
         )
-    the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host))
+    the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime))
     try:
         with Progress(console=console, transient=True) as bar:
             job = bar.add_task(f"{method} from {starts} starts", total=starts)

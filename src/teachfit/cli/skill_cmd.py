@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 
 skill_app = typer.Typer(
     help="Manipulation skills (seed B): show a skill's graph, run it on a task.",
@@ -96,6 +96,7 @@ def run(
     height: int = 480,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
+    realtime: RealtimeOpt = True,
 ) -> None:
     """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
     from teachfit.core.errors import SkillError
@@ -123,7 +124,7 @@ def run(
                 f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
                 "their defaults are used"
             )
-    trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host))
+    trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host, realtime))
     est = setup.task2world.inverse().compose(the_task.hole2world)
     console.print(
         f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate off by "

@@ -16,6 +16,7 @@ def _demo(rec: KinestheticRecording, task: str, robot: Robot) -> Demonstration:
         wrench=rec.wrench,
         task=task,
         source="kinesthetic",
+        name=f"{task}-kinesthetic",
         frame="world",
         child_frame="tcp",
         meta={"robot": robot.name, "interrupted": bool(rec.interrupted), "fault": rec.fault},

@@ -59,6 +59,7 @@ class SkillObjective:
     task_overrides: tuple[tuple[str, float], ...] = ()
     robot: str = "floating"
     host: str = ""
+    realtime: bool = True
 
     def __post_init__(self) -> None:
         if self.n_starts < 1:
@@ -77,7 +78,7 @@ class SkillObjective:
             task = get_task(self.task, **dict(self.task_overrides))
             skill = get_skill(self.skill, self.controller)
             setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
-            options = {"host": self.host} if self.host else {}
+            options = {"host": self.host, "realtime": self.realtime} if self.host else {}
             found = SkillTrial(setup, self.controller, robot=self.robot, seed=self.seed, **options)
             _CACHE.clear()  # one experiment per worker at a time: keep memory flat
             _CACHE[self] = found
