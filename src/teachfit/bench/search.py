@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
@@ -110,10 +111,17 @@ def _jobs(
 
 
 def _peg_setup(seed: int, clearance: float) -> tuple[dict[str, float], Demonstration, SearchModel]:
-    overrides = {"clearance": clearance}
-    task = get_task("peg2d", **overrides)
-    demos, _ = BlindTeacher(task, seed=seed, robot=ROBOT[0]).record(1)
-    return overrides, demos[0], SearchModel.fit(demos, task.name)
+    demo, model = _peg_demo(seed, clearance, ROBOT[0])
+    return {"clearance": clearance}, demo, model
+
+
+@cache
+def _peg_demo(seed: int, clearance: float, robot: str) -> tuple[Demonstration, SearchModel]:
+    """The seeded teacher's demonstration and its model (recorded once per process: Tables I,
+    II and the ablation share them; both are immutable)."""
+    task = get_task("peg2d", clearance=clearance)
+    demos, _ = BlindTeacher(task, seed=seed, robot=robot).record(1)
+    return demos[0], SearchModel.fit(demos, task.name)
 
 
 def table1(
