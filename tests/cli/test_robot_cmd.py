@@ -26,3 +26,11 @@ def test_check_needs_a_real_robot_and_its_address() -> None:
     assert res.exit_code == 2 and "--host" in res.output
     res = runner.invoke(app, ["bench", "robot", "--host", "127.0.0.1", "--seconds", "0"])
     assert res.exit_code == 2 and "--seconds" in res.output
+
+
+def test_learning_on_a_real_robot_is_not_parallel(tmp_path) -> None:
+    study = tmp_path / "s.db"
+    args = ["learn", "skill", "--robot", "franka", "--ray", "local", "--study", str(study)]
+    res = runner.invoke(app, [*args, "--trials", "1"])
+    assert res.exit_code == 2 and "real franka" in res.output
+    assert not study.exists()

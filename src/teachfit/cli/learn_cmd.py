@@ -75,6 +75,14 @@ def learn_skill(
     if method not in METHODS:
         raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
     get_task(task)  # an unknown task fails here, before any study file is created
+    from teachfit.robot.registry import ROBOTS
+
+    if robot in ROBOTS and not ROBOTS[robot].simulated:
+        if ray:
+            raise LearningError(f"--ray runs trials in parallel: not on the one real {robot}")
+        if workers != 0:
+            console.print(f"note: trials on the real {robot} run one at a time, in this process")
+        workers = 0  # one arm: trials cannot run in parallel worker processes
     obj = SkillObjective(
         task, skill, controller, seed, starts, _overrides(task_param), robot, host or "", realtime
     )
