@@ -90,9 +90,11 @@ def test_four_processes_share_one_study_and_one_is_killed(shared_url: str, tmp_p
         wait_for("a claim of the others", lambda: bool(_claim_pids(shared_url) & others))
         n = begun()
         wait_for("the victim beginning a trial", lambda: begun() > n)  # 3 s before it ends
+        # what it holds as it dies (read before the kill: a survivor on this host takes a dead
+        # owner's claim over at once, so afterwards the claim may already be another's)
+        held = _running_claims(shared_url, victim.pid)
         victim.send_signal(signal.SIGKILL)
         victim.wait(timeout=10)
-        held = _running_claims(shared_url, victim.pid)  # what it held when it died
         outs = [p.communicate(timeout=300)[0] for p in procs[1:]]
     finally:
         for p in procs:
