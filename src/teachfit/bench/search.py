@@ -27,7 +27,8 @@ from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.execution.batch import episode_seed
-from teachfit.execution.teacher import BlindTeacher
+from teachfit.execution.teacher import BlindTeacher, TeacherStyle
+from teachfit.execution.teacher_cache import cache_key, cached
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
 from teachfit.tasks.registry import get_task
@@ -196,8 +197,16 @@ def _socket_demos(task: object, seed: int) -> list[Demonstration]:
 
     Opposite ends in position (left and right of the upper half, against the wall) and in yaw
     (turned by 60-100 % of ``start_rz`` one way, then the other), so that together they span
-    the start variability as seed A asks of demonstrations.
+    the start variability as seed A asks of demonstrations. Cached like the teacher's own
+    recordings (:mod:`teachfit.execution.teacher_cache`).
     """
+    key = cache_key(
+        task=task, style=TeacherStyle(), seed=seed, robot=ROBOT[0], n=2, limit=6, kind="socket"
+    )
+    return cached(key, lambda: (_record_socket_demos(task, seed), []))[0]
+
+
+def _record_socket_demos(task: object, seed: int) -> list[Demonstration]:
     rng = np.random.default_rng(seed)
     dist = task.play - task.params.start_wall_gap  # type: ignore[attr-defined]
     teacher = BlindTeacher(task, seed=seed, robot=ROBOT[0])  # type: ignore[arg-type]
