@@ -22,8 +22,12 @@ def learn_search(
     out: Annotated[Path, typer.Option(help="model file to write (JSON)")] = Path("search.model"),
     components: Annotated[str, typer.Option(help="GMM components: a number or 'bic'")] = "1",
     covariance: Annotated[
-        str, typer.Option(help="p_e covariance: 'full' (seed A) or 'diag' (per-DOF variances)")
-    ] = "full",
+        str,
+        typer.Option(
+            help="p_e covariance: 'auto' (chosen by leave-one-demonstration-out likelihood), "
+            "'full' (seed A) or 'diag' (per-DOF variances)"
+        ),
+    ] = "auto",
     seed: int = 0,
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
@@ -48,7 +52,12 @@ def learn_search(
         f"learned from {len(demo_list)} demonstration(s) of [bold]{model.task}[/]: "
         f"dims {', '.join(model.dims)}, {e.n_components} component(s), "
         f"mean {np.round(e.mean * 1e3, 1)} (mm/mrad), teacher speed {model.speed * 1e3:.1f} mm/s"
-        f"\nmodel -> {out}"
+        + (
+            f"\ncovariance: {model.covariance_choice.describe()}"
+            if model.covariance_choice is not None
+            else ""
+        )
+        + f"\nmodel -> {out}"
     )
 
 
