@@ -11,6 +11,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
@@ -126,6 +127,8 @@ def run(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    log: LogOpt = None,
+    rrd: RrdOpt = None,
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
@@ -138,6 +141,7 @@ def run(
     from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
 
+    check_recording_targets(log, rrd)
     the_task = load_task(task)
     model = SearchModel.load(model_file, task=the_task.name)
     demo_start = None
@@ -184,6 +188,7 @@ def run(
         ", ".join(f"{k} {v}" for k, v in reasons.items()),
     )
     console.print(table)
+    write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method))
     if plot is not None:
         from teachfit.viz.figures import plot_executions
 

@@ -59,6 +59,7 @@ from teachfit.core.geometry import Pose
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult
 from teachfit.execution.recording_io import read_episode, write_episode
+from teachfit.execution.skill_trial import SkillSetup, TrialOutcome
 from teachfit.skills.graph import Skill
 from teachfit.tasks.base import Task
 
@@ -131,6 +132,13 @@ class RunLog:
     created: str = ""
     version: str = ""
 
+    @classmethod
+    def of(
+        cls, episodes: Iterable[Episode | ExecutionResult | Any], info: RunInfo, path: Path
+    ) -> RunLog:
+        """A run of episodes, engine results or search runs (``path`` names errors)."""
+        return cls(info, tuple(_as_episode(e, i, path) for i, e in enumerate(episodes)))
+
     def depth(self, index: int) -> np.ndarray:
         """(T,) m of episode ``index``: the measured TCP below the task's nominal hole entry (as
         the success detector sees it), or, without an entry height, below the engine's task
@@ -139,6 +147,14 @@ class RunLog:
         if math.isfinite(self.info.entry_height):
             return self.info.entry_height - log.pos[:, 2]
         return log.depth
+
+
+def skill_episodes(outcome: TrialOutcome, setup: SkillSetup) -> list[Episode]:
+    """The episodes of one skill trial (one per start of ``setup``)."""
+    return [
+        Episode.of_skill(tr, setup.skill, st)
+        for tr, st in zip(outcome.traces, setup.starts, strict=True)
+    ]
 
 
 def _as_episode(item: Episode | ExecutionResult | Any, i: int, path: Path) -> Episode:
@@ -188,7 +204,7 @@ def write_run_log(
         a folder that cannot be created or written.
     """
     path = check_run_log_target(path)
-    items = [_as_episode(e, i, path) for i, e in enumerate(episodes)]
+    items = RunLog.of(episodes, info, path).episodes
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
