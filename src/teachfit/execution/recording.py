@@ -262,7 +262,8 @@ def read_run_log(path: str | Path) -> RunLog:
         raise DatasetError(what, path=str(path))
     with h5py.File(path, "r") as f:
         version = f.attrs.get("format_version")
-        if int(version) != FORMAT_VERSION:  # type: ignore[arg-type]
+        version = version.item() if isinstance(version, np.generic) else version
+        if version != FORMAT_VERSION:
             raise DatasetError(
                 f"unsupported format_version {version!r} (this teachfit reads {FORMAT_VERSION})",
                 path=str(path),

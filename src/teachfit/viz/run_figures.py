@@ -35,7 +35,6 @@ def plot_run(run: RunLog, path: str | Path, episodes: Sequence[int] | None = Non
         1,
         figsize=(9, 1.7 * len(labels) + 0.3 * len(nodes)),
         sharex=True,
-        constrained_layout=True,
         height_ratios=[1.0] * (len(labels) - 1) + [0.3 + 0.25 * len(nodes)],
     )
     for k, (i, ep) in enumerate(zip(chosen, eps, strict=True)):
@@ -76,6 +75,9 @@ def plot_run(run: RunLog, path: str | Path, episodes: Sequence[int] | None = Non
         + "\nmotion from each start: measured solid, set-point dotted; |F| solid, F_z dashed",
         fontsize=10,
     )
+    # fixed margins: a layout engine would draw the figure twice
+    fig.subplots_adjust(left=0.11, right=0.98, bottom=0.5 / fig.get_figheight(), hspace=0.12)
+    fig.subplots_adjust(top=1 - 0.55 / fig.get_figheight())
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
     plt.close(fig)
