@@ -38,7 +38,7 @@ def real_run() -> tuple[tuple[Episode, ...], RunInfo]:
         planned = _straight(start, goal, task.surface_z, s)
         result = run_trajectory(robot, task, planned, start, FollowConfig(settle_time=0.2 + s))
         episodes.append(Episode(result, start=start, planned=planned, name=f"to {goal}"))
-    info = RunInfo.here("search", task, "floating", 3, "straight", n=20, out=task.name)
+    info = RunInfo.here("search", task, "floating", 3, "straight", {"n": 20, "out": task.name})
     return tuple(episodes), info
 
 

@@ -133,6 +133,6 @@ def test_reading_bad_files_names_them(tmp_path: Path) -> None:
 
 
 def test_run_info_here_is_json_safe() -> None:
-    info = RunInfo.here("assemble", "tenon", "fr3", 5, "rrt", out=Path("a/b.h5"), n=3)
+    info = RunInfo.here("assemble", "tenon", "fr3", 5, "rrt", {"out": Path("a/b.h5"), "n": 3})
     assert info.options == {"out": "a/b.h5", "n": 3}
     assert info.task == "tenon" and math.isnan(info.entry_height) and info.command

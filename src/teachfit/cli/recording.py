@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Annotated, Any
 
-import click
 import typer
 
 from teachfit.cli.common import console
@@ -44,16 +43,15 @@ def write_recordings(
     rrd: Path | None,
     episodes: Iterable[Any],
     info: tuple[str, Task | str, str, int, str],
+    options: Mapping[str, Any],
 ) -> None:
     """Write the run log and/or the Rerun recording of ``episodes``; ``info`` is
-    ``(kind, task, robot, seed, method)``, the command's parsed options are added."""
+    ``(kind, task, robot, seed, method)``, ``options`` the command's parsed options."""
     if log is None and rrd is None:
         return
     from teachfit.execution.recording import RunInfo, write_run_log
 
-    ctx = click.get_current_context(silent=True)
-    options = dict(ctx.params) if ctx is not None else {}
-    run_info = RunInfo.here(*info, **options)
+    run_info = RunInfo.here(*info, options)
     items = list(episodes)
     if log is not None:
         console.print(f"run log -> {write_run_log(log, items, run_info)}")

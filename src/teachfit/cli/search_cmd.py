@@ -105,6 +105,7 @@ def plan(
 @search_app.command("run")
 @guarded
 def run(
+    ctx: typer.Context,
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     model_file: Annotated[Path, typer.Option("--model", help="learned model")] = Path(
         "search.model"
@@ -188,7 +189,7 @@ def run(
         ", ".join(f"{k} {v}" for k, v in reasons.items()),
     )
     console.print(table)
-    write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method))
+    write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method), ctx.params)
     if plot is not None:
         from teachfit.viz.figures import plot_executions
 

@@ -83,6 +83,7 @@ def show(
 @skill_app.command("run")
 @guarded
 def run(
+    ctx: typer.Context,
     skill: Annotated[str, _SKILL] = "peg-in-hole",
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
@@ -159,7 +160,8 @@ def run(
         f"{wall / len(out.traces):.3f} s wall per execution, {steps / wall:,.0f} sim steps/s"
     )
     episodes = skill_episodes(out, setup)
-    write_recordings(log, rrd, episodes, ("skill", the_task, robot, seed, f"{skill} {controller}"))
+    info = ("skill", the_task, robot, seed, f"{skill} {controller}")
+    write_recordings(log, rrd, episodes, info, ctx.params)
     if plot is not None:
         from teachfit.viz.skill_figures import plot_traces
 

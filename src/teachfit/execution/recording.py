@@ -94,12 +94,18 @@ class RunInfo:
 
     @classmethod
     def here(
-        cls, kind: str, task: Task | str, robot: str, seed: int, method: str, **options: Any
+        cls,
+        kind: str,
+        task: Task | str,
+        robot: str,
+        seed: int,
+        method: str,
+        options: Mapping[str, Any] | None = None,
     ) -> RunInfo:
         """A :class:`RunInfo` with this process's command line and ``options`` made JSON-safe
         (paths and other values as text); a :class:`Task` gives its name and entry height."""
         argv = [Path(sys.argv[0]).name, *sys.argv[1:]] if sys.argv else []
-        safe = json.loads(json.dumps(options, default=str))
+        safe = json.loads(json.dumps(dict(options or {}), default=str))
         name, entry = (task, math.nan) if isinstance(task, str) else (task.name, task.entry_height)
         return cls(kind, name, robot, int(seed), method, shlex.join(argv), safe, float(entry))
 
