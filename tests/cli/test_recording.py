@@ -1,4 +1,5 @@
-"""``--log`` / ``--rrd`` on ``search run`` and ``skill run``, read back by ``demo show``."""
+"""``--log`` / ``--rrd`` on ``search run`` and ``skill run``, read back by ``demo show`` (its
+``--plot`` is the test of :mod:`teachfit.viz.run_figures`)."""
 
 from __future__ import annotations
 
@@ -32,7 +33,7 @@ def model_file(tmp_path_factory) -> Path:
     """A peg2d search model from a made-up 2 s demonstration (no teacher run: it is slow)."""
     rng = np.random.default_rng(0)
     n = 200
-    t = np.arange(n) / 100.0
+    t = np.arange(n) / 250.0  # a brisk teacher: short searches
     xy = np.cumsum(rng.normal(size=(n, 2)) * 2e-4 + [1e-4, 0.5e-4], axis=0)
     pos = np.column_stack([xy, np.zeros(n)])
     vel = np.gradient(xy, t, axis=0)

@@ -48,7 +48,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import h5py
 import numpy as np
@@ -62,6 +62,9 @@ from teachfit.execution.recording_io import read_episode, write_episode
 from teachfit.execution.skill_trial import SkillSetup, TrialOutcome
 from teachfit.skills.graph import Skill
 from teachfit.tasks.base import Task
+
+if TYPE_CHECKING:
+    from teachfit.execution.search import SearchRun
 
 FORMAT = "teachfit-run"
 FORMAT_VERSION = 1
@@ -140,10 +143,13 @@ class RunLog:
 
     @classmethod
     def of(
-        cls, episodes: Iterable[Episode | ExecutionResult | Any], info: RunInfo, path: Path
+        cls,
+        episodes: Iterable[Episode | ExecutionResult | SearchRun],
+        info: RunInfo,
+        path: str | Path = "run log",
     ) -> RunLog:
         """A run of episodes, engine results or search runs (``path`` names errors)."""
-        return cls(info, tuple(_as_episode(e, i, path) for i, e in enumerate(episodes)))
+        return cls(info, tuple(_as_episode(e, i, Path(path)) for i, e in enumerate(episodes)))
 
     def depth(self, index: int) -> np.ndarray:
         """(T,) m of episode ``index``: the measured TCP below the task's nominal hole entry (as
@@ -163,18 +169,20 @@ def skill_episodes(outcome: TrialOutcome, setup: SkillSetup) -> list[Episode]:
     ]
 
 
-def _as_episode(item: Episode | ExecutionResult | Any, i: int, path: Path) -> Episode:
-    """An :class:`Episode` from an episode, an engine result or a search run (``.result``,
-    ``.setpoints``)."""
+def _as_episode(item: Episode | ExecutionResult | SearchRun, i: int, path: Path) -> Episode:
+    """An :class:`Episode` from an episode, an engine result or a search run (its planned
+    set-points kept)."""
     if isinstance(item, Episode):
         return item
     if isinstance(item, ExecutionResult):
         return Episode(item)
-    result, planned = getattr(item, "result", None), getattr(item, "setpoints", None)
-    if isinstance(result, ExecutionResult) and isinstance(planned, SetpointTrajectory):
-        return Episode(result, planned=planned)
+    from teachfit.execution.search import SearchRun  # planners and models: imported on use
+
+    if isinstance(item, SearchRun):
+        return Episode(item.result, planned=item.setpoints)
     raise DatasetError(
-        f"episode {i} is a {type(item).__name__}, not an Episode or ExecutionResult", path=str(path)
+        f"episode {i} is a {type(item).__name__}, not an Episode, ExecutionResult or SearchRun",
+        path=str(path),
     )
 
 
@@ -197,7 +205,7 @@ def check_run_log_target(path: str | Path) -> Path:
 
 def write_run_log(
     path: str | Path,
-    episodes: Iterable[Episode | ExecutionResult | Any],
+    episodes: Iterable[Episode | ExecutionResult | SearchRun],
     info: RunInfo,
 ) -> Path:
     """Write a run's episodes (:class:`Episode`, engine results or search runs) to ``path``

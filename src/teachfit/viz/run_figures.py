@@ -63,7 +63,7 @@ def plot_run(run: RunLog, path: str | Path, episodes: Sequence[int] | None = Non
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     axes[-1].set_yticks(range(len(nodes)), nodes)
-    axes[-1].set_ylim(len(nodes) - 0.4, -0.4)
+    axes[-1].set_ylim(max(len(nodes), 1) - 0.4, -0.4)
     axes[-1].set_xlabel("time since the episode started (s)")
     if eps:
         axes[0].legend(fontsize=7, ncol=2, loc="best")
