@@ -63,6 +63,7 @@ def write_recordings(
 
 def show_run_log(path: Path, plot: Path | None) -> None:
     """``teachfit demo show RUN.h5``: the run's metadata, a table of its episodes, a figure."""
+    from rich.markup import escape
     from rich.table import Table
 
     from teachfit.execution.recording import read_run_log, run_summary
@@ -70,11 +71,16 @@ def show_run_log(path: Path, plot: Path | None) -> None:
     run = read_run_log(path)
     info = run.info
     console.print(
-        f"run log of {info.kind} [bold]{info.method}[/] on {info.task} ({info.robot}, seed "
-        f"{info.seed}), written {run.created} by teachfit {run.version}\ncommand: {info.command}",
+        escape(
+            f"run log of {info.kind} {info.method} on {info.task} ({info.robot}, seed "
+            f"{info.seed}), written {run.created} by teachfit {run.version}\n"
+            f"command: {info.command}"
+        ),
         highlight=False,
     )
-    table = Table(title=str(path), caption="duration, time to success: s; depth: mm; force: N")
+    table = Table(
+        title=escape(str(path)), caption="duration, time to success: s; depth: mm; force: N"
+    )
     for col in ("#", "outcome", "duration", "to success", "final depth", "max force", "nodes"):
         table.add_column(col, justify="left" if col in ("outcome", "nodes") else "right")
     for r in run_summary(run):
