@@ -58,25 +58,20 @@ from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import Pose
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult
-from teachfit.execution.recording_io import read_episode, write_episode
+from teachfit.execution.recording_io import (
+    FORMAT,
+    FORMAT_VERSION,
+    UNITS,
+    is_run_log,
+    read_episode,
+    write_episode,
+)
 from teachfit.execution.skill_trial import SkillSetup, TrialOutcome
 from teachfit.skills.graph import Skill
 from teachfit.tasks.base import Task
 
 if TYPE_CHECKING:
     from teachfit.execution.search import SearchRun
-
-FORMAT = "teachfit-run"
-FORMAT_VERSION = 1
-UNITS: dict[str, str] = {
-    "t": "s",
-    "pos": "m",
-    "quat": "1 (w,x,y,z)",
-    "wrench": "N, N*m",
-    "depth": "m",
-    "path_length": "m",
-    "peak_force": "N",
-}
 
 
 @dataclass(frozen=True)
@@ -242,23 +237,6 @@ def write_run_log(
             raise DatasetError(f"cannot write ({exc})", path=str(path)) from exc
         raise
     return path
-
-
-def _format(f: h5py.File) -> str | None:
-    fmt = f.attrs.get("format")
-    return fmt.decode() if isinstance(fmt, bytes) else fmt
-
-
-def is_run_log(path: str | Path) -> bool:
-    """Whether ``path`` is an HDF5 file whose ``format`` attribute says run log."""
-    path = Path(path)
-    if not path.is_file() or not h5py.is_hdf5(path):
-        return False
-    try:
-        with h5py.File(path, "r") as f:
-            return _format(f) == FORMAT
-    except OSError:
-        return False
 
 
 def read_run_log(path: str | Path) -> RunLog:

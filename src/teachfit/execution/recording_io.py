@@ -1,8 +1,10 @@
-"""One episode of a run log <-> one HDF5 group (the layout is in :mod:`.recording`)."""
+"""The run-log file format: its marks, and one episode <-> one HDF5 group (the layout is
+in :mod:`.recording`)."""
 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import h5py
@@ -30,6 +32,35 @@ NUMBERS: tuple[str, ...] = (
     "wall_s",
 )
 _STR = h5py.string_dtype()
+
+FORMAT = "teachfit-run"
+FORMAT_VERSION = 1
+UNITS: dict[str, str] = {
+    "t": "s",
+    "pos": "m",
+    "quat": "1 (w,x,y,z)",
+    "wrench": "N, N*m",
+    "depth": "m",
+    "path_length": "m",
+    "peak_force": "N",
+}
+
+
+def _format(f: h5py.File) -> str | None:
+    fmt = f.attrs.get("format")
+    return fmt.decode() if isinstance(fmt, bytes) else fmt
+
+
+def is_run_log(path: str | Path) -> bool:
+    """Whether ``path`` is an HDF5 file whose ``format`` attribute says run log."""
+    path = Path(path)
+    if not path.is_file() or not h5py.is_hdf5(path):
+        return False
+    try:
+        with h5py.File(path, "r") as f:
+            return _format(f) == FORMAT
+    except OSError:
+        return False
 
 
 def _tri(value: bool | None) -> int:
