@@ -11,6 +11,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
@@ -113,6 +114,7 @@ def plan(
 @search_app.command("run")
 @guarded
 def run(
+    ctx: typer.Context,
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     model_file: Annotated[Path, typer.Option("--model", help="learned model")] = Path(
         "search.model"
@@ -135,6 +137,8 @@ def run(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    log: LogOpt = None,
+    rrd: RrdOpt = None,
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
@@ -147,6 +151,7 @@ def run(
     from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
 
+    check_recording_targets(log, rrd)
     the_task = load_task(task)
     model = SearchModel.load(model_file, task=the_task.name)
     demo_start = None
@@ -193,6 +198,7 @@ def run(
         ", ".join(f"{k} {v}" for k, v in reasons.items()),
     )
     console.print(table)
+    write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method), ctx.params)
     if plot is not None:
         from teachfit.viz.figures import plot_executions
 
