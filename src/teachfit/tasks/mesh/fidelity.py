@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 import trimesh
+from scipy.spatial import ConvexHull
 
 from teachfit.core.errors import TaskError
 from teachfit.tasks.mesh.sections import ENTRY_EPS, footprint, section
@@ -55,13 +56,26 @@ def decomposition_fidelity(
 ) -> Fidelity:
     """The :class:`Fidelity` of ``pieces`` (vertex arrays, hole frame, m) of the fixed part
     ``fixed`` (hole frame) for the held part's pieces ``held_pieces`` (TCP frame)."""
-    hulls = [trimesh.Trimesh(v).convex_hull for v in pieces]
     held_hulls = [trimesh.Trimesh(v).convex_hull for v in held_pieces]
     foot = shapely.unary_union([footprint(h, success_depth) for h in held_hulls])
+    x0, y0, x1, y1 = foot.bounds
+    near = [  # only pieces by the hole can narrow it
+        v
+        for v in pieces
+        if v[:, 0].min() < x1 + 1e-3
+        and v[:, 0].max() > x0 - 1e-3
+        and v[:, 1].min() < y1 + 1e-3
+        and v[:, 1].max() > y0 - 1e-3
+        and v[:, 2].max() > -success_depth
+        and v[:, 2].min() < 0.0
+    ]
+    hulls = [trimesh.Trimesh(v).convex_hull for v in near]
     zs = -np.linspace(ENTRY_EPS, success_depth, max(4, int(np.ceil(success_depth / 5e-4)) + 1))
     walls = shapely.unary_union([section(h, z) for h in hulls for z in zs])
     gap = 0.0 if walls.intersects(foot) else float(walls.distance(foot))
-    ratio = sum(float(h.volume) for h in hulls) / float(fixed.volume)
+    if walls.is_empty:
+        gap = float("inf")
+    ratio = sum(float(ConvexHull(v).volume) for v in pieces) / float(fixed.volume)
     return Fidelity(mesh_clearance, gap, ratio)
 
 

@@ -30,8 +30,8 @@ def section(mesh: trimesh.Trimesh, z: float) -> BaseGeometry:
     segs = trimesh.intersections.mesh_plane(mesh, [0.0, 0.0, 1.0], [0.0, 0.0, z])
     if len(segs) == 0:
         return shapely.Polygon()
-    lines = [shapely.LineString(s[:, :2]) for s in np.round(segs, 10)]
-    merged = shapely.ops.linemerge(lines)
+    lines = shapely.linestrings(np.round(segs[:, :, :2], 10))
+    merged = shapely.line_merge(shapely.multilinestrings(lines))
     rings = [g for g in getattr(merged, "geoms", [merged]) if g.is_ring and len(g.coords) >= 4]
     polys = [shapely.Polygon(r.coords) for r in rings]
     polys = [p if p.is_valid else p.buffer(0) for p in polys]
@@ -72,7 +72,7 @@ def hole_depth_of(fixed: trimesh.Trimesh) -> float:
     """Depth (m) below the entry at which material closes the hole axis (its bottom)."""
     bottom = -float(fixed.vertices[:, 2].min())
     origin = shapely.Point(0.0, 0.0)
-    step = 2.5e-4
+    step = 5e-4
     for d in np.arange(ENTRY_EPS, bottom, step):
         if section(fixed, -d).contains(origin):
             lo, hi = max(d - step, ENTRY_EPS), float(d)
