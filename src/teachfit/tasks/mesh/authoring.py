@@ -18,7 +18,7 @@ from teachfit.tasks.mesh.cell import MeshCell, build_cell, grasp_of
 from teachfit.tasks.mesh.loading import load_mesh, write_atomic
 from teachfit.tasks.mesh.sections import infer_hole
 from teachfit.tasks.mesh.spec import SEARCH_DIMS, UNITS, MeshTaskSpec, spec_to_toml
-from teachfit.tasks.mesh.task import MeshTask
+from teachfit.tasks.mesh.task import MeshTask, remember_cell
 
 
 def new_task_file(
@@ -70,6 +70,7 @@ def new_task_file(
         spec = dataclasses.replace(spec, hole_pos=tuple(float(round(v, 6)) + 0.0 for v in pos))
     cell = build_cell(spec)
     write_atomic(out, spec_to_toml(spec).encode())
+    remember_cell(out, cell)
     return out, cell
 
 

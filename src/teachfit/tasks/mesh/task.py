@@ -15,7 +15,6 @@ import dataclasses
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
-from functools import cache
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -170,10 +169,20 @@ def task_name_of(path: str | Path) -> str:
     return rel if not rel.startswith("..") else str(Path(path).resolve())
 
 
-@cache
-def _cell(path: str, mtime: float) -> MeshCell:
-    del mtime  # part of the cache key: an edited file is re-read
-    return build_cell(read_spec(path))
+#: cells built in this process, by (resolved task file, modification time)
+_CELLS: dict[tuple[str, float], MeshCell] = {}
+
+
+def _key(path: Path) -> tuple[str, float]:
+    try:
+        return str(path.resolve()), path.stat().st_mtime
+    except OSError as exc:
+        raise TaskError(f"cannot read task file {path}: {exc.strerror or exc}") from exc
+
+
+def remember_cell(path: str | Path, cell: MeshCell) -> None:
+    """Keep ``cell``, just built from the file ``path``, for :func:`load_mesh_task`."""
+    _CELLS[_key(Path(path))] = cell
 
 
 def _params_of(cell: MeshCell, overrides: dict[str, Any]) -> MeshParams:
@@ -198,9 +207,8 @@ def load_mesh_task(path: str | Path, **overrides: float) -> MeshTask:
     Cells are cached per process by the file's path and modification time.
     """
     p = Path(path)
-    try:
-        mtime = p.stat().st_mtime
-    except OSError as exc:
-        raise TaskError(f"cannot read task file {p}: {exc.strerror or exc}") from exc
-    cell = _cell(str(p.resolve()), mtime)
+    key = _key(p)
+    if key not in _CELLS:  # an edited file has a new key and is re-read
+        _CELLS[key] = build_cell(read_spec(p))
+    cell = _CELLS[key]
     return MeshTask(cell, _params_of(cell, overrides), task_name_of(p))
