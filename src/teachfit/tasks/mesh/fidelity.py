@@ -83,6 +83,7 @@ def require_fidelity(fid: Fidelity, where: str) -> None:
     """Raise :class:`TaskError` where the decomposition closes (or nearly closes) the hole."""
     if fid.kept < MIN_KEPT:
         raise TaskError(
-            f"{where}: the convex decomposition narrows the hole: {fid.summary()}; lower "
-            "[decomposition] threshold (e.g. 0.01) or raise max_pieces"
+            f"{where}: the convex decomposition narrows the hole: {fid.summary()}; for a "
+            'rectilinear part use [decomposition] method = "auto" (exact boxes), else lower '
+            "threshold (e.g. 0.01) and raise max_pieces"
         )
