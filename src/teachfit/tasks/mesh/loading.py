@@ -68,7 +68,7 @@ def check_solid(mesh: trimesh.Trimesh, where: str) -> None:
     if not np.all(np.isfinite(mesh.vertices)):
         raise TaskError(f"{where}: non-finite vertex coordinates; re-export the part")
     if not mesh.is_watertight:
-        open_edges = int(np.sum(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1)))
+        open_edges = len(trimesh.grouping.group_rows(mesh.edges_sorted, require_count=1))
         raise TaskError(
             f"{where}: not watertight ({max(open_edges, 1)} open edge(s)); export the part as a "
             "closed solid (or repair it, e.g. in CAD or with trimesh.repair)"
