@@ -61,3 +61,5 @@ def test_bad_input_is_one_line_and_exit_2(mesh_examples, tmp_path: Path) -> None
         assert not out.exists()  # nothing half-written
     res = invoke("tasks", "example", "nope", tmp_path)
     assert res.exit_code == 2 and "examples" in res.output
+    res = invoke("bench", "search", "--task", tmp_path / "nope.toml", "--demo", tmp_path / "d.h5")
+    assert res.exit_code == 2 and "nope.toml" in res.output

@@ -142,7 +142,9 @@ def _task_table(
 ) -> None:
     from teachfit.bench.search_task import task_demos, task_table
     from teachfit.demonstrations.dataset import read_dataset
+    from teachfit.tasks.registry import load_task
 
+    load_task(task)  # a bad task file fails first, before any demonstration is read
     if demo is None:
         with console.status(f"the blind teacher demonstrates {task}"):
             demos = task_demos(task, seed)
