@@ -11,6 +11,16 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("COLUMNS", "200")
 
 
+@pytest.fixture(scope="session")
+def mesh_examples(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
+    """The shipped mesh task examples written once per session: name -> task file path (their
+    decompositions are cached beside them)."""
+    from teachfit.tasks.mesh.examples import EXAMPLES, write_example
+
+    folder = tmp_path_factory.mktemp("mesh_examples")
+    return {name: str(write_example(name, folder / name)) for name in EXAMPLES}
+
+
 @functools.cache
 def _gl_context_error() -> str | None:
     """Why MuJoCo cannot render offscreen here (None: it can)."""
