@@ -175,7 +175,11 @@ def test_export_round_trip(tmp_path: Path) -> None:
     out, the_map = tmp_path / "out" / "x.csv", tmp_path / "out" / "x.toml"
     res = invoke("demo", "export", f"{h5}:0", "--out", out, "--columns", the_map)
     assert res.exit_code == 0, res.output
-    assert invoke("demo", "import", out, "--columns", the_map, "--out", h5).exit_code == 0
+    res = invoke("demo", "import", out, "--columns", the_map, "--out", h5)
+    assert res.exit_code == 2 and shows(res, "pass --append to add to it")  # no silent pooling
+    assert (
+        invoke("demo", "import", out, "--columns", the_map, "--out", h5, "--append").exit_code == 0
+    )
     first, again = read_dataset(h5)
     for label in ("t", "pos", "quat", "wrench"):
         np.testing.assert_array_equal(getattr(again, label), getattr(first, label))

@@ -100,8 +100,8 @@ class PlanningBenchConfig:
         """The ``teachfit bench planning`` command line that runs this configuration."""
         checks = "" if self.max_checks is None else f" --max-checks {self.max_checks}"
         return (
-            f"teachfit bench planning --tasks {','.join(self.tasks)} --seeds {self.seeds} "
-            f"--te {self.te:g}{checks} --planner {self.planner} --no-demo-seeds "
+            f"teachfit bench planning --tasks {','.join(self.tasks)} --runs {self.seeds} "
+            f"--te {self.te:g}{checks} --planner {self.planner} --no-demo-runs "
             f"{self.no_demo_seeds} --no-demo-budget {self.no_demo_budget:g}"
         )
 

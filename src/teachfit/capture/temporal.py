@@ -31,7 +31,16 @@ from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import CaptureError
 
-__all__ = ["FilterConfig", "PoseFilter"]
+__all__ = ["FilterConfig", "PoseFilter", "adaptive_alpha"]
+
+
+def adaptive_alpha(accel: float, dt: float, sigma: float) -> float:
+    """The adaptive position gain (Kalata's steady state): the weight a measurement with
+    predicted error ``sigma`` (m) gets ``dt`` s after the last one, for hand accelerations of
+    ``accel`` (m/s^2). Near 1 when ``sigma`` is far below ``accel dt^2``."""
+    lam = accel * dt * dt / max(sigma, 1e-12)
+    r = (4.0 + lam - np.sqrt(8.0 * lam + lam * lam)) / 4.0
+    return float(1.0 - r * r)
 
 
 @dataclass(frozen=True)
@@ -81,9 +90,7 @@ class PoseFilter:
     def _gains(self, dt: float, sigma: float | None, accel: float) -> tuple[float, float]:
         if self.cfg.accel is None or sigma is None:
             return self.cfg.alpha, self.cfg.beta
-        lam = accel * dt * dt / max(sigma, 1e-12)
-        r = (4.0 + lam - np.sqrt(8.0 * lam + lam * lam)) / 4.0
-        alpha = 1.0 - r * r
+        alpha = adaptive_alpha(accel, dt, sigma)
         return alpha, 2.0 * (2.0 - alpha) - 4.0 * np.sqrt(1.0 - alpha)
 
     def update(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+from typing import Annotated
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -20,6 +21,30 @@ app = typer.Typer(
     no_args_is_help=True,
     pretty_exceptions_enable=False,
 )
+
+
+def _version(value: bool) -> None:
+    if value:
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            text = version("teachfit")
+        except PackageNotFoundError:  # run from a source tree that was never installed
+            text = "unknown (not installed)"
+        typer.echo(f"teachfit {text}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option("--version", is_eager=True, callback=_version, help="print the version"),
+    ] = False,
+) -> None:
+    """Teach robots tight-fit assembly from a few demonstrations and a few trials."""
+
+
 bench_app = typer.Typer(help="Benchmarks that print figures (speed, success rates).")
 app.add_typer(demo_app, name="demo")
 app.add_typer(bench_app, name="bench")

@@ -7,10 +7,12 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli import options as o
+from teachfit.cli.common import RobotOpt, append_markdown, console, guarded
+from teachfit.cli.progress import progress_bar
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
 
 TABLES = ("1", "2", "ablation", "3", "all")
@@ -48,35 +50,40 @@ def _emit(title: str, rows: Sequence[object], markdown: Path | None) -> None:
         table.add_column(col, justify="right")
     for r in rows:
         table.add_row(*_cells(r))
-    console.print(table)
+    print_table(table)
     if markdown is not None:
         lines = [f"\n**{title}**\n", "| " + " | ".join(_COLS) + " |", "|" + " --- |" * len(_COLS)]
         lines += ["| " + " | ".join(_cells(r)) + " |" for r in rows]
-        with markdown.open("a", encoding="utf-8") as fh:
-            fh.write("\n".join(lines) + "\n")
+        append_markdown(markdown, "\n".join(lines))
 
 
 @guarded
 def bench_search(
     table: Annotated[str, typer.Option(help="paper table: 1, 2, ablation, 3 or all")] = "1",
-    seed: int = 0,
-    starts: Annotated[int | None, typer.Option(help="starts (paper: 30 / 15)")] = None,
-    points: Annotated[int | None, typer.Option(help="TSHIX points (paper: 300 / 600)")] = None,
+    seed: Annotated[int, o.seed("the starts and the TSHIX samples")] = 0,
+    starts: Annotated[
+        int | None, o.starts("per table (default: the paper's, 30 for I, 15 for III)")
+    ] = None,
+    points: Annotated[
+        int | None,
+        typer.Option(min=1, help="TSHIX points (default: the paper's, 300 for I, 600 for III)"),
+    ] = None,
     trajectories: Annotated[int, typer.Option(help="Table II trajectories per N")] = 20,
-    workers: Annotated[int | None, typer.Option(help="processes (default: all cores)")] = None,
-    markdown: Annotated[Path | None, typer.Option(help="append the tables as markdown")] = None,
+    workers: o.Workers = None,
+    markdown: o.Markdown = None,
     robot: RobotOpt = "floating",
     task: Annotated[
-        str | None, typer.Option(help="Table I's protocol on this task (name or .toml) instead")
+        str | None, o.task("run Table I's protocol on this one (name or .toml) instead")
     ] = None,
     demo: Annotated[
-        Path | None, typer.Option(help="--task: its demonstrations (default: record one)")
+        str | None,
+        typer.Option(help="demonstrations of --task, FILE.h5 (default: the teacher records one)"),
     ] = None,
 ) -> None:
-    """Seed A's search experiments in simulation, beside the paper's numbers.
+    """The search paper's experiments (Ehlers et al. 2019) in simulation, beside its numbers.
 
-    Success rates carry a Wilson 95 % interval; ``plan`` is the median trajectory-planning wall
-    time, ``length`` the mean planned path length (x, y), ``E`` the mean ergodic metric.
+    Success rates carry a Wilson 95 % interval; 'plan' is the median trajectory-planning wall
+    time, 'length' the mean planned path length (x, y), 'E' the mean ergodic metric.
     """
     from teachfit.bench import search as bs
 
@@ -87,7 +94,7 @@ def bench_search(
     if task is not None:
         _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
         return
-    with Progress(console=console, transient=True) as bar:
+    with progress_bar() as bar:
         if "1" in todo:
             n = starts or 30
             job = bar.add_task("Table I: TSHIX (QMC, i.i.d.) and ergodic", total=3 * n)
@@ -150,7 +157,7 @@ def _task_table(
             demos = task_demos(task, seed)
     else:
         demos = read_dataset(demo)
-    with Progress(console=console, transient=True) as bar:
+    with progress_bar() as bar:
         job = bar.add_task(f"Table I protocol on {task}", total=2 * starts)
         rows = task_table(task, demos, seed, starts, points, workers, lambda: bar.advance(job))
     title = f"Table I protocol ({task}, {len(demos)} demo(s), {starts} starts, seed {seed})"

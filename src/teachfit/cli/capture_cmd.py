@@ -11,8 +11,10 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli import options as o
+from teachfit.cli.common import append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import CaptureError
 
 __all__ = ["bench_capture_cmd", "capture_app"]
@@ -60,7 +62,7 @@ def calibrate(
             f"{report.stereo_rms[cam.name]:.3f}" if cam.name in report.stereo_rms else "-",
             str(report.stereo_views.get(cam.name, "-")),
         )
-    console.print(table)
+    print_table(table)
     console.print(f"wrote {write_rig(rig, out)} (rig frame = camera {rig.cameras[0].name})")
 
 
@@ -80,13 +82,13 @@ def markers(
         list[int] | None, typer.Option(help="live camera index per rig camera")
     ] = None,
     frames: Annotated[int, typer.Option(help="live: stop after this many frames")] = 300,
-    task: Annotated[str, typer.Option(help="task of the demonstration")] = "l-groove",
-    plot: Annotated[Path | None, typer.Option(help="write the track figure (png)")] = None,
+    task: Annotated[str, o.task("the task the parts belong to: l-groove or tenon")] = "l-groove",
+    plot: Annotated[Path | None, o.plot("the tracked pose over time")] = None,
     truth: Annotated[
         Path | None, typer.Option(help="ground truth HDF5 (capture synth) to score against")
     ] = None,
     no_filter: Annotated[bool, typer.Option("--no-filter", help="no temporal filter")] = False,
-    overwrite: Annotated[bool, typer.Option(help="replace an existing output file")] = False,
+    overwrite: o.Overwrite = False,
 ) -> None:
     """Track the parts' markers in videos (or live cameras) and write the L2G demonstration."""
     from teachfit.capture.markers import read_markers
@@ -152,13 +154,13 @@ def _synth_config(cameras: int, resolution: list[str] | None, **kw: object):
 @capture_app.command("synth")
 @guarded
 def synth(
-    out: Annotated[Path, typer.Option(help="output folder")],
-    task: Annotated[str, typer.Option(help="l-groove or tenon")] = "l-groove",
+    out: Annotated[Path, typer.Option(help="folder to write videos, rig, markers, truth into")],
+    task: Annotated[str, o.task("l-groove or tenon")] = "l-groove",
     cameras: Annotated[int, typer.Option(min=1, max=3, help="number of cameras")] = 3,
     resolution: Annotated[
         list[str] | None, typer.Option(help="WxH, once for all or once per camera")
     ] = None,
-    seed: Annotated[int, typer.Option(help="seed of the demonstration and the noise")] = 0,
+    seed: Annotated[int, o.seed("the demonstration and the noise")] = 0,
     distance: Annotated[float, typer.Option(help="camera distance (m)")] = 0.6,
     noise: Annotated[float, typer.Option(help="pixel noise (grey levels)")] = 0.0,
     blur: Annotated[float, typer.Option(help="Gaussian blur (px)")] = 0.0,
@@ -199,16 +201,39 @@ def synth(
         console.print(f"{key:8s} {path}")
 
 
+def _filter_note(rows: list, stride: int) -> None:
+    """Say why the rows with and without the temporal filter agree, where they do."""
+    from teachfit.capture.temporal import FilterConfig, adaptive_alpha
+
+    with_f = [r for r in rows if r.filtered and r.cameras == rows[-1].cameras]
+    without = [r for r in rows if not r.filtered]
+    if not (with_f and without):
+        return
+    a, b = with_f[-1], without[-1]
+    accel, dt = FilterConfig().accel or 0.0, stride / 30.0
+    alpha = adaptive_alpha(accel, dt, 1e-3 * b.med_mm) if accel else float("nan")
+    same = abs(a.med_mm - b.med_mm) < 5e-4 and abs(a.p95_mm - b.p95_mm) < 5e-4
+    outliers = "none here: all frames valid" if a.valid == a.frames else "see 'valid'"
+    console.print(
+        f"temporal filter: {'no change at this precision' if same else 'see the rows above'}. "
+        f"It weighs each frame by its predicted error: at {b.med_mm:.3f} mm, with hand "
+        f"accelerations up to {accel:g} m/s² over {dt * 1e3:.0f} ms between frames, a frame "
+        f"keeps alpha = {alpha:.4f} of its own pose, so the filter smooths only noisy frames "
+        f"and rejects outliers beyond its 10 mm / 10° gate ({outliers})"
+    )
+
+
 @guarded
 def bench_capture_cmd(
     stride: Annotated[int, typer.Option(min=1, help="keep every n-th 30 Hz sample")] = 2,
     noise: Annotated[float, typer.Option(help="pixel noise (grey levels)")] = 2.0,
     blur: Annotated[float, typer.Option(help="Gaussian blur (px)")] = 0.5,
-    lighting: Annotated[float, typer.Option(help="light variation amplitude")] = 0.3,
+    lighting: Annotated[float, typer.Option(help="light variation amplitude [0, 1)")] = 0.3,
     crf: Annotated[int, typer.Option(help="x264 quality of the videos (lower = better)")] = 20,
-    seed: Annotated[int, typer.Option(help="seed")] = 0,
+    seed: Annotated[int, o.seed("the demonstration and the noise")] = 0,
     workdir: Annotated[Path | None, typer.Option(help="keep the rendered capture here")] = None,
-    write: Annotated[bool, typer.Option("--write", help="append to BENCHMARKS.md")] = False,
+    markdown: o.Markdown = None,
+    write: o.WriteOld = False,
 ) -> None:
     """Capture accuracy (1, 2, 3 cameras) against ground truth, and fps per 1080p stream."""
     from teachfit.bench.capture import (
@@ -244,7 +269,8 @@ def bench_capture_cmd(
             f"{r.med_deg:.3f}",
             f"{r.p95_deg:.3f}",
         )
-    console.print(table)
+    print_table(table)
+    _filter_note(b.rows, stride)
     three = [r for r in b.rows if r.filtered][-1] if b.rows[0].filtered else b.rows[-1]
     console.print(
         f"{three.cameras} cameras: median {three.med_mm:.3f} mm = {three.med_mm / TARGET_MM:.2f}x "
@@ -255,8 +281,6 @@ def bench_capture_cmd(
         f"{b.ms_track:.1f} ms per frame) = {b.fps / TARGET_FPS:.2f}x the "
         f"{TARGET_FPS:.0f} fps target"
     )
-    if write:
-        path = Path("BENCHMARKS.md")
-        with path.open("a") as f:
-            f.write("\n" + to_markdown(b))
-        console.print(f"appended to {path}")
+    markdown = markdown or (Path("BENCHMARKS.md") if write else None)
+    if markdown is not None:
+        console.print(f"markdown appended to {append_markdown(markdown, to_markdown(b))}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from pathlib import Path
 from typing import Annotated, ParamSpec, TypeVar
 
 import typer
@@ -57,3 +58,12 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
             raise typer.Exit(2) from exc
 
     return wrapper
+
+
+def append_markdown(path: Path, text: str) -> Path:
+    """Append ``text`` to the markdown file ``path`` (created with its folder if missing): every
+    ``--markdown FILE`` appends, so one file can collect several benchmark runs."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("a", encoding="utf-8") as fh:
+        fh.write(("\n" if path.stat().st_size else "") + text.rstrip("\n") + "\n")
+    return path

@@ -10,8 +10,10 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
+from teachfit.cli import options as o
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.cli.recording import show_run_log
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import DatasetError, TeachfitError
 from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
@@ -39,25 +41,28 @@ app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_
 @app.command("record")
 @guarded
 def record(
-    task: Annotated[str, typer.Option(help="built-in task name or task .toml")] = "peg2d",
-    n: Annotated[int, typer.Option("-n", help="demonstrations to keep")] = 3,
-    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    task: Annotated[str, o.task()] = "peg2d",
+    count: o.Count = 3,
+    seed: Annotated[int, o.seed("the simulated teacher's starts and search")] = 0,
     out: Annotated[Path, typer.Option(help="HDF5 file to write")] = Path("demos.h5"),
     pattern: Annotated[str, typer.Option(help=f"search pattern: {', '.join(PATTERNS)}")] = "sweep",
-    append: Annotated[bool, typer.Option(help="append to an existing file")] = False,
-    overwrite: Annotated[bool, typer.Option(help="replace an existing file")] = False,
+    append: o.Append = False,
+    overwrite: o.Overwrite = False,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     duration: Annotated[
         float | None, typer.Option(help="real robot: seconds to record (default: until Ctrl-C)")
     ] = None,
+    n: o.CountOld = None,
 ) -> None:
     """Record demonstrations: the simulated blind teacher on a simulated robot, or a person
     guiding a real robot (--robot franka --host ADDRESS; Ctrl-C ends it, every sample kept)."""
     from teachfit.robot.registry import ROBOTS, make_robot
 
+    count = o.pick(count, n)
     the_task = load_task(task)
+    _check_target(out, append, overwrite)
     if robot in ROBOTS and not ROBOTS[robot].simulated:
         from teachfit.demonstrations.kinesthetic import record_demonstration
 
@@ -69,15 +74,37 @@ def record(
             arm.close()
     else:
         teacher = BlindTeacher(the_task, TeacherStyle(pattern=pattern), seed=seed, robot=robot)
-        demos, discarded = teacher.record(n, progress=True)
-    if append:
-        append_dataset(out, demos)
-    else:
-        write_dataset(out, demos, overwrite=overwrite)
+        demos, discarded = teacher.record(count, progress=True)
+    _store(out, demos, append, overwrite)
     console.print(
         f"recorded {len(demos)} demonstration(s) of [bold]{the_task.name}[/] -> {out}"
         + (f" (discarded {len(discarded)}: {'; '.join(discarded)})" if discarded else "")
     )
+
+
+def _check_target(out: Path, append: bool, overwrite: bool) -> None:
+    """Refuse, before any work, an existing ``out`` that neither --append nor --overwrite names:
+    ``demo record`` and ``demo import`` follow the same policy."""
+    if append and overwrite:
+        raise TeachfitError("give one of --append and --overwrite, not both")
+    if out.is_dir():
+        raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
+    if out.exists() and not (append or overwrite):
+        raise TeachfitError(
+            f"{out} exists: pass --append to add to it or --overwrite to replace it"
+        )
+
+
+def _store(out: Path, demos: list[Any], append: bool, overwrite: bool) -> None:
+    """Write ``demos`` to ``out`` (atomically) by the --append/--overwrite policy."""
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise TeachfitError(f"--out {out}: cannot create its folder ({exc.strerror})") from exc
+    if append:
+        append_dataset(out, demos)
+    else:
+        write_dataset(out, demos, overwrite=overwrite)
 
 
 def _option(flag: str, build: Callable[..., T], *args: Any) -> T:
@@ -97,9 +124,13 @@ def import_(
     log: Annotated[
         Path, typer.Argument(help="robot log: CSV, ROS 1 .bag, ROS 2 bag folder, .db3 or .mcap")
     ],
-    task: Annotated[str, typer.Option(help="task the log demonstrates")] = "peg2d",
-    columns: Annotated[Path, typer.Option(help="CSV column map (TOML)")] = Path("columns.toml"),
-    out: Annotated[Path, typer.Option(help="HDF5 file to write or append to")] = Path("demos.h5"),
+    task: Annotated[str, o.task("the task the log demonstrates (teachfit tasks)")] = "peg2d",
+    columns: Annotated[
+        Path, typer.Option(help="CSV column map (TOML) to read the log with")
+    ] = Path("columns.toml"),
+    out: Annotated[Path, typer.Option(help="HDF5 file to write")] = Path("demos.h5"),
+    append: o.Append = False,
+    overwrite: o.Overwrite = False,
     name: Annotated[
         str | None, typer.Option(help="demonstration name (default: file stem)")
     ] = None,
@@ -135,7 +166,8 @@ def import_(
     ] = None,
     accept_implausible: Annotated[bool, typer.Option(help="accept every failed check")] = False,
 ) -> None:
-    """Import a real robot log (CSV or ROS bag) as demonstrations, appending to --out."""
+    """Import a real robot log (CSV or ROS bag) as demonstrations into --out (an existing file
+    needs --append or --overwrite)."""
     load_task(task)
     if out.is_dir():
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
@@ -181,11 +213,8 @@ def import_(
     result = build_demos(raw, task=task, name=name or log.stem, options=options)
     for note in result.notes:
         console.print(f"[yellow]note:[/] {escape(note)}")
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)  # like learn/search/skill outputs
-    except OSError as exc:
-        raise TeachfitError(f"--out {out}: cannot create its folder ({exc.strerror})") from exc
-    append_dataset(out, list(result.demos))
+    _check_target(out, append, overwrite)
+    _store(out, list(result.demos), append, overwrite)
     table = Table(
         title=f"{log} -> {out}", caption="start, duration: s; rate: Hz; extent: mm; |F|: N"
     )
@@ -202,7 +231,7 @@ def import_(
             f"{piece.extent_mm[0]:.1f} x {piece.extent_mm[1]:.1f}",
             "-" if piece.peak_force_n is None else f"{piece.peak_force_n:.1f}",
         )
-    console.print(table)
+    print_table(table)
     console.print(
         f"imported {len(result.demos)} demonstration(s) in frame {result.demos[0].frame!r} "
         f"from {log} -> {out}"
@@ -212,12 +241,12 @@ def import_(
 @app.command("export")
 @guarded
 def export(
-    demo: Annotated[str, typer.Argument(help="FILE.h5:INDEX (or FILE.h5 for the first)")],
+    demo: Annotated[str, typer.Argument(help="demonstration FILE.h5:INDEX (FILE.h5: its first)")],
     out: Annotated[Path, typer.Option(help="CSV file to write")] = Path("demo.csv"),
     columns: Annotated[
-        Path | None, typer.Option(help="also write the column map that reads it back")
+        Path | None, typer.Option(help="CSV column map (TOML) to write that reads the CSV back")
     ] = None,
-    overwrite: Annotated[bool, typer.Option(help="replace existing files")] = False,
+    overwrite: Annotated[bool, typer.Option(help="replace an existing file (CSV and map)")] = False,
 ) -> None:
     """Export one demonstration as a CSV log (s, m, w-x-y-z, N, N*m)."""
     the_demo = read_demo(demo)
@@ -235,7 +264,7 @@ def export(
 @guarded
 def show(
     dataset: Annotated[Path, typer.Argument(help="HDF5 demonstration file or run log (--log)")],
-    plot: Annotated[Path | None, typer.Option(help="write a figure (PNG/PDF) here")] = None,
+    plot: Annotated[Path | None, o.plot("paths over the hole, force over time")] = None,
 ) -> None:
     """List the demonstrations in a file (or a run log's episodes); optionally plot paths and
     wrenches (a run log: pose, wrench and active node over time)."""
@@ -256,7 +285,7 @@ def show(
             f"{r['duration']:.2f} s",
             f"{r['rate']:.0f} Hz",
         )
-    console.print(table)
+    print_table(table)
     if plot is not None:
         from teachfit.viz.figures import plot_demonstrations
 

@@ -9,8 +9,17 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded
+from teachfit.cli import options as o
+from teachfit.cli.common import (
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    append_markdown,
+    console,
+    guarded,
+)
 from teachfit.cli.progress import progress_bar
+from teachfit.cli.tables import print_markdown, print_table
 from teachfit.core.params import LearningError
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
@@ -32,29 +41,31 @@ def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
 
 @guarded
 def learn_skill(
-    task: Annotated[str, typer.Option(help="task: puzzle, key, peg, ...")] = "puzzle",
+    task: Annotated[str, o.task("puzzle, key, peg, ... (teachfit tasks)")] = "puzzle",
     skill: Annotated[str, typer.Option(help="built-in skill or skill .toml")] = "peg-in-hole",
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
-    trials: Annotated[int, typer.Option(help="trial budget (restored trials count)")] = 130,
+    trials: Annotated[int, typer.Option(help="trials in all (restored trials count)")] = 130,
     study: Annotated[
         str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")
     ] = "runs/study.db",
     resume: Annotated[bool, typer.Option(help="continue a stored study")] = False,
-    workers: Annotated[
-        int | None, typer.Option(help="worker processes (default: all cores; 0: in this process)")
-    ] = None,
+    workers: o.Workers = None,
     ray: Annotated[
-        str | None, typer.Option(help="run trials on Ray: 'local' or an address")
+        str | None, typer.Option(help="run trials on Ray: 'local' or the address of a cluster")
     ] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
-    seed: Annotated[
-        int, typer.Option(help="seed of the set-up (hole estimate, starts) and of the learner")
-    ] = 0,
-    starts: Annotated[int, typer.Option(help="executions (start poses) per trial")] = 4,
+    seed: Annotated[int, o.seed("the set-up (hole estimate, starts) and of the learner")] = 0,
+    starts: Annotated[int, o.starts("per trial (one execution each)")] = 4,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
-    out: Annotated[Path | None, typer.Option(help="write the best parameters (TOML)")] = None,
-    plot: Annotated[Path | None, typer.Option(help="learning curve figure")] = None,
-    traces: Annotated[Path | None, typer.Option(help="parameter traces figure")] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            help="best parameters (TOML) for 'skill run --params' "
+            "(default: beside a study file, STUDY.params.toml)"
+        ),
+    ] = None,
+    plot: Annotated[Path | None, o.plot("the learning curve")] = None,
+    traces: Annotated[Path | None, typer.Option(help="figure (PNG/PDF) of the parameters")] = None,
     best_plot: Annotated[
         Path | None,
         typer.Option(help="re-run the best parameters once and plot force and pose over time"),
@@ -157,8 +168,18 @@ def learn_skill(
             f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
             f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials"
         )
+    if out is None and "://" not in study:
+        out = Path(study).with_suffix(".params.toml")
     if st.n_finished:
-        _report_best(st, obj, out, plot, traces, best_plot, f"{method} on {task}")
+        _report_best(
+            st,
+            obj,
+            out,
+            plot,
+            traces,
+            best_plot,
+            f"{method} on {task}, seed {seed}, {starts} start(s) per trial",
+        )
     if rep.interrupted:
         console.print(
             f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
@@ -195,16 +216,23 @@ def _report_best(
     for name, v in best.params.items():
         d = space.domains[name]
         table.add_row(name, f"{v:.4g}", f"{d.low:.4g}", f"{d.high:.4g}")
-    console.print(table)
+    print_table(table)
     if out is not None:
         from teachfit.skills.params import write_params_toml
 
         head = f"best of {title}: cost {best.cost:.4f} s, trial {best.number + 1}"
-        console.print(f"parameters -> {write_params_toml(out, best.params, head)}")
+        path = write_params_toml(out, best.params, head)
+        task = obj.task  # type: ignore[attr-defined]
+        console.print(
+            f"parameters -> {path} (run them: teachfit skill run --task {task} --params {path})"
+        )
     if plot is not None:
         console.print(f"learning curve -> {lf.plot_study_curve(recs, plot, title)}")
     if traces is not None:
-        console.print(f"parameter traces -> {lf.plot_param_traces(recs, space, traces, title)}")
+        learned = obj.trial().setup.skill.params.learned  # type: ignore[attr-defined]
+        units = {name: p.unit for name, p in learned.items()}
+        path = lf.plot_param_traces(recs, space, traces, title, units)
+        console.print(f"parameter traces -> {path}")
     if best_plot is not None:
         outcome = obj.outcome(best.params)  # type: ignore[attr-defined]
         k = next((i for i, s in enumerate(outcome.successes) if s), 0)
@@ -215,17 +243,17 @@ def _report_best(
 @guarded
 def bench_learning(
     tasks: Annotated[
-        str, typer.Option("--tasks", "--task", help="comma-separated tasks (names or .toml)")
+        str, typer.Option("--tasks", "--task", help="tasks, comma-separated (names or .toml)")
     ] = "puzzle,key,peg",
     methods: Annotated[str, typer.Option(help="comma-separated methods")] = "cmaes,pso,bo,lhs",
     experiments: Annotated[int, typer.Option(help="learning runs per task and method")] = 2,
     trials: Annotated[int, typer.Option(help="trials per experiment")] = 60,
-    workers: Annotated[int | None, typer.Option(help="worker processes (default: all)")] = None,
-    starts: Annotated[int, typer.Option(help="executions per trial")] = 4,
+    workers: o.Workers = None,
+    starts: Annotated[int, o.starts("per trial (one execution each)")] = 4,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
-    seed: int = 0,
+    seed: Annotated[int, o.seed("the first experiment (experiment e uses seed + e)")] = 0,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
-    plot: Annotated[Path | None, typer.Option(help="Fig. 6-like learning curves")] = Path(
+    plot: Annotated[Path | None, o.plot("learning curves like the paper's Fig. 6")] = Path(
         "out/bench_learning/curves.png"
     ),
     target: Annotated[
@@ -237,7 +265,7 @@ def bench_learning(
     speedup_trials: Annotated[
         int, typer.Option(help="trials of the 1-vs-N-worker speed-up study (0: skip)")
     ] = 24,
-    markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")] = None,
+    markdown: o.Markdown = None,
     robot: RobotOpt = "floating",
     ray: Annotated[
         str | None, typer.Option(help="run trials on Ray: 'local' or the address of a cluster")
@@ -315,9 +343,7 @@ def bench_learning(
             f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
             f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n"
         )
-    from rich.markdown import Markdown
-
-    console.print(Markdown(text))  # tables drawn for the terminal; --markdown keeps the source
+    print_markdown(text)  # tables drawn for the terminal; --markdown keeps the source
     if plot is not None:
         from teachfit.viz.learning_figures import plot_learning_curves
 
@@ -327,9 +353,7 @@ def bench_learning(
         )
         console.print(f"learning curves -> {path}")
     if markdown is not None:
-        markdown.parent.mkdir(parents=True, exist_ok=True)
-        markdown.write_text(text)
-        console.print(f"markdown -> {markdown}")
+        console.print(f"markdown appended to {append_markdown(markdown, text)}")
 
 
 def _bench_scaling(
@@ -343,8 +367,6 @@ def _bench_scaling(
 ) -> None:
     """``bench learning --scaling``: trials/s with 1, 2, 4, ... workers, in one run."""
     import os
-
-    from rich.markdown import Markdown
 
     from teachfit.bench import learning as bl
 
@@ -364,8 +386,6 @@ def _bench_scaling(
         f"Latin hypercube trials on {where}; this machine has {os.cpu_count()} cores, "
         f"1-min load average {os.getloadavg()[0]:.1f}\n\n" + bl.scaling_markdown(rows)
     )
-    console.print(Markdown(text))
+    print_markdown(text)
     if markdown is not None:
-        markdown.parent.mkdir(parents=True, exist_ok=True)
-        markdown.write_text(text)
-        console.print(f"markdown -> {markdown}")
+        console.print(f"markdown appended to {append_markdown(markdown, text)}")

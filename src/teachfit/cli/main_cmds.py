@@ -8,34 +8,64 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
+from teachfit.cli import options as o
 from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.progress import progress_bar
+from teachfit.cli.tables import print_table
 from teachfit.tasks.registry import load_task
 
 
 @guarded
 def render(
-    task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
-    demo: Annotated[str, typer.Option(help="demonstration, e.g. demos.h5:0")] = "demos.h5:0",
-    out: Annotated[Path, typer.Option(help="mp4 to write")] = Path("demo.mp4"),
-    fps: Annotated[int, typer.Option(help="frames per second")] = 25,
-    width: int = 640,
-    height: int = 480,
+    task: Annotated[str, o.task()] = "peg2d",
+    demo: Annotated[str, typer.Option(help="demonstration FILE.h5:INDEX")] = "demos.h5:0",
+    render: Annotated[Path, typer.Option("--render", help="video (mp4) to write")] = Path(
+        "demo.mp4"
+    ),
+    fps: o.Fps = 25,
+    width: o.Width = 640,
+    height: o.Height = 480,
     robot: RobotOpt = "floating",
+    out: Annotated[Path | None, o.old("--out", "--render")] = None,
 ) -> None:
     """Render a recorded demonstration with MuJoCo's offscreen renderer to an mp4."""
     from teachfit.core.errors import DatasetError
     from teachfit.demonstrations.dataset import read_demo
     from teachfit.viz.video import render_motion
 
+    render = o.pick(render, out)
     the_task = load_task(task)
     d = read_demo(demo)
     if d.task != the_task.name:
         raise DatasetError(f"demonstration is of task {d.task!r}, not {the_task.name!r}")
-    with console.status(f"rendering {d.duration:.1f} s at {fps} fps"):
+    with progress_bar() as bar:
+        job = bar.add_task(f"rendering {d.duration:.1f} s at {fps} fps", total=None)
         path = render_motion(
-            the_task, d.t, d.pos, d.quat, out, fps=fps, width=width, height=height, robot=robot
-        )
+            the_task, d.t, d.pos, d.quat, render, fps=fps, width=width, height=height,
+            robot=robot, progress=lambda k, n: bar.update(job, completed=k, total=n),
+        )  # fmt: skip
     console.print(f"video -> {path}")
+
+
+@guarded
+def view(
+    task: Annotated[str, o.task()] = "peg2d",
+    demo: Annotated[str, typer.Option(help="demonstration FILE.h5:INDEX")] = "demos.h5:0",
+    speed: Annotated[float, typer.Option(help="playback speed (1: real time)")] = 1.0,
+) -> None:
+    """Replay a demonstration in MuJoCo's interactive viewer (needs a display; exit status 2
+    and one line without one)."""
+    from teachfit.core.errors import DatasetError
+    from teachfit.demonstrations.dataset import read_demo
+    from teachfit.robot.viewer import require_display, view_motion
+
+    require_display()
+    the_task = load_task(task)
+    d = read_demo(demo)
+    if d.task != the_task.name:
+        raise DatasetError(f"demonstration is of task {d.task!r}, not {the_task.name!r}")
+    console.print(f"viewing {d.name or demo} ({d.duration:.1f} s); close the window to end")
+    view_motion(the_task, d.t, d.pos, d.quat, speed=speed)
 
 
 @guarded
@@ -43,23 +73,24 @@ def quickstart(
     out: Annotated[Path, typer.Option(help="folder for files and figures")] = Path(
         "out/quickstart"
     ),
-    task: Annotated[str, typer.Option(help="built-in task")] = "peg2d",
-    demos: Annotated[int, typer.Option(help="demonstrations to record")] = 3,
-    starts: Annotated[int, typer.Option(help="new start poses")] = 10,
-    seed: int = 0,
+    task: Annotated[str, o.task("a built-in name (teachfit tasks)")] = "peg2d",
+    count: o.Count = 3,
+    starts: Annotated[int, o.starts("new to the demonstration")] = 10,
+    seed: Annotated[int, o.seed("the teacher, the starts and the searches")] = 0,
     robot: RobotOpt = "floating",
+    demos: Annotated[int | None, o.old("--demos", "--count")] = None,
 ) -> None:
     """The main job on the default task: demonstrations -> execution -> success table."""
     from teachfit.quickstart import run_quickstart
 
-    run_quickstart(out, task, demos, starts, seed, console, robot_name=robot)
+    run_quickstart(out, task, o.pick(count, demos), starts, seed, console, robot_name=robot)
 
 
 @guarded
 def bench_sim(
-    task: Annotated[str, typer.Option(help="task name")] = "peg2d",
+    task: Annotated[str, o.task()] = "peg2d",
     steps: Annotated[int, typer.Option(help="steps per measurement")] = 5000,
-    repeats: int = 3,
+    repeats: Annotated[int, typer.Option(help="measurements (the fastest counts)")] = 3,
     robot: RobotOpt = "floating",
 ) -> None:
     """Raw mj_step steps/s vs. steps/s with the controller in the loop, in contact."""
@@ -76,7 +107,7 @@ def bench_sim(
     table.add_row("with controller", f"{s.controlled_steps_per_s:,.0f} steps/s", "")
     table.add_row("ratio", f"{s.ratio:.2f}", ">= 0.70")
     table.add_row("real-time factor", f"{s.real_time_factor:.1f}x", ">= 10")
-    console.print(table)
+    print_table(table)
 
 
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
@@ -84,5 +115,6 @@ def register(app: typer.Typer, bench_app: typer.Typer) -> None:
 
     app.add_typer(tasks_app, name="tasks")
     app.command("render")(render)
+    app.command("view")(view)
     app.command("quickstart")(quickstart)
     bench_app.command("sim")(bench_sim)

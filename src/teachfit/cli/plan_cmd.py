@@ -14,8 +14,10 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli import options as o
+from teachfit.cli.common import append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import PlanningError, TeachfitError
 
 __all__ = [
@@ -42,7 +44,7 @@ app.add_typer(bench_app, name="bench")
 @guarded
 def parts_show(
     task: Annotated[str, typer.Argument(help="l-groove or tenon")],
-    plot: Annotated[Path | None, typer.Option(help="write a figure of the parts (png)")] = None,
+    plot: Annotated[Path | None, o.plot("the parts at their start and goal poses")] = None,
 ) -> None:
     """Print the parts' dimensions, start and goal poses; optionally plot them."""
     from teachfit.plans.parts import build_assembly
@@ -53,7 +55,7 @@ def parts_show(
     table.add_column("mm", justify="right")
     for key, value in asm.dimensions.items():
         table.add_row(key, f"{1e3 * value:.1f}")
-    console.print(table)
+    print_table(table)
     console.print(f"moving part: {len(asm.moving.faces)} triangles, fixed: {len(asm.fixed.faces)}")
     console.print(f"start L2G position (mm): {(1e3 * asm.start[:3, 3]).round(1)}")
     console.print(f"goal  L2G position (mm): {(1e3 * asm.goal[:3, 3]).round(1)}")
@@ -68,12 +70,10 @@ def parts_show(
 @guarded
 def demo_synth(
     out: Annotated[Path, typer.Option(help="HDF5 file to write")],
-    task: Annotated[str, typer.Option(help="l-groove or tenon")] = "l-groove",
-    seed: Annotated[int, typer.Option(help="seed of the tremor and contacts")] = 0,
-    count: Annotated[
-        int, typer.Option(min=1, help="number of demonstrations (seeds seed, seed+1, ...)")
-    ] = 1,
-    overwrite: Annotated[bool, typer.Option(help="replace an existing file")] = False,
+    task: Annotated[str, o.task("l-groove or tenon")] = "l-groove",
+    seed: Annotated[int, o.seed("the tremor and contacts (demonstration i: seed + i)")] = 0,
+    count: Annotated[int, typer.Option(min=1, help="number of demonstrations to write")] = 1,
+    overwrite: o.Overwrite = False,
 ) -> None:
     """Write synthetic human demonstrations of the pose sequence to HDF5."""
     from teachfit.demonstrations.dataset import write_dataset
@@ -105,19 +105,19 @@ def _load_demo(spec: str) -> object:
 @app.command("plan")
 @guarded
 def plan(
-    task: Annotated[str, typer.Option(help="l-groove or tenon")] = "l-groove",
+    task: Annotated[str, o.task("l-groove or tenon")] = "l-groove",
     demo: Annotated[
-        str | None, typer.Option(help="demonstration: file.h5 (first) or file.h5:INDEX")
+        str | None, typer.Option(help="demonstration FILE.h5:INDEX (FILE.h5: its first)")
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
     te: Annotated[float, typer.Option(help="budget per attempt (s)")] = 0.02,
     max_checks: Annotated[
         int | None,
-        typer.Option(help="budget per attempt in collision checks instead of --te (repeatable)"),
+        typer.Option(help="budget per attempt in collision checks instead of --te (any machine)"),
     ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
-    seed: Annotated[int, typer.Option(help="seed of the key-pose repair and of OMPL")] = 0,
-    render: Annotated[Path | None, typer.Option(help="write an mp4 of the path")] = None,
+    seed: Annotated[int, o.seed("the key-pose repair and of OMPL")] = 0,
+    render: o.Render = None,
     strip: Annotated[
         Path | None, typer.Option(help="write the path as a strip of poses (png)")
     ] = None,
@@ -165,40 +165,49 @@ def plan(
     if render is not None:
         from teachfit.viz.plan_video import render_path_video
 
-        render_path_video(asm, mp.dense_poses(result.poses, 0.002), render)
+        with console.status(f"rendering the path to {render}"):
+            render_path_video(asm, mp.dense_poses(result.poses, 0.002), render)
         console.print(f"wrote {render}")
 
 
 @bench_app.command("planning")
 @guarded
 def bench_planning_cmd(
-    tasks: Annotated[str, typer.Option(help="comma-separated task names")] = "l-groove,tenon",
-    seeds: Annotated[int, typer.Option(min=1, help="seeds per task")] = 50,
+    tasks: Annotated[str, typer.Option(help="tasks, comma-separated")] = "l-groove,tenon",
+    runs: Annotated[
+        int, typer.Option(min=1, help="planning runs per task (seeds 0, 1, ..., runs - 1)")
+    ] = 50,
     te: Annotated[float, typer.Option(help="budget per attempt (s) with demonstration")] = 0.01,
     max_checks: Annotated[
         int | None,
-        typer.Option(help="budget per attempt with demonstration in collision checks, not --te"),
+        typer.Option(help="budget per attempt in collision checks instead of --te (with demo)"),
     ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
-    no_demo_seeds: Annotated[int, typer.Option(min=0, help="seeds run without demonstration")] = 5,
+    no_demo_runs: Annotated[
+        int, typer.Option(min=0, help="planning runs without demonstration, per task")
+    ] = 5,
     no_demo_budget: Annotated[float, typer.Option(help="budget (s) without demonstration")] = 30.0,
-    write: Annotated[
-        bool, typer.Option("--write", help="append the table to --benchmarks")
-    ] = False,
-    benchmarks: Annotated[Path, typer.Option(help="markdown file --write appends to")] = Path(
-        "BENCHMARKS.md"
-    ),
+    markdown: o.Markdown = None,
+    seeds: Annotated[int | None, o.old("--seeds", "--runs")] = None,
+    no_demo_seeds: Annotated[int | None, o.old("--no-demo-seeds", "--no-demo-runs")] = None,
+    write: o.WriteOld = False,
+    benchmarks: Annotated[Path | None, o.old("--benchmarks", "--markdown")] = None,
 ) -> None:
-    """Table I of the paper over many seeds, with and without demonstration."""
+    """Table I of the planning paper (Wang et al. 2019) over many seeds, with and without
+    demonstration."""
     from teachfit.bench import planning as bp
+
+    runs, no_demo_runs = o.pick(runs, seeds), o.pick(no_demo_runs, no_demo_seeds)
+    if write or benchmarks is not None:
+        markdown = markdown or benchmarks or Path("BENCHMARKS.md")
 
     cfg = bp.PlanningBenchConfig(
         tasks=tuple(t.strip() for t in tasks.split(",") if t.strip()),
-        seeds=seeds,
+        seeds=runs,
         te=te,
         max_checks=max_checks,
         planner=planner,
-        no_demo_seeds=no_demo_seeds,
+        no_demo_seeds=no_demo_runs,
         no_demo_budget=no_demo_budget,
     )
     with progress_bar() as bar:
@@ -211,9 +220,9 @@ def bench_planning_cmd(
         table.add_column(col)
     for row in bp.report_table(results):
         table.add_row(*row)
-    console.print(table)
+    print_table(table)
     for line in bp.report_notes(results):
         console.print(line)
-    if write:
-        path = bp.append_markdown(bp.to_markdown(results, command=cfg.command()), benchmarks)
-        console.print(f"appended to {path}")
+    if markdown is not None:
+        path = append_markdown(markdown, bp.to_markdown(results, command=cfg.command()))
+        console.print(f"markdown appended to {path}")

@@ -9,13 +9,14 @@ from rich.markup import escape
 from rich.table import Table
 
 from teachfit.cli.common import HostOpt, RobotOpt, console, guarded
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
 
 robot_app = typer.Typer(
     help="The robots teachfit drives: list them, check one.", no_args_is_help=True
 )
 
-_REALTIME = typer.Option(help="require a real-time kernel (off for the protocol simulator)")
+_REALTIME = typer.Option(help="real robot: require a real-time kernel (off for the simulator)")
 
 
 @robot_app.command("list")
@@ -30,7 +31,7 @@ def list_robots() -> None:
     for entry in ROBOTS.values():
         kind = "simulated" if entry.simulated else "real"
         table.add_row(entry.name, kind, escape(entry.description))
-    console.print(table)
+    print_table(table)
 
 
 def _real(robot: str, host: str | None) -> str:
@@ -46,7 +47,7 @@ def _real(robot: str, host: str | None) -> str:
 def check(
     robot: RobotOpt = "franka",
     host: HostOpt = None,
-    seconds: Annotated[float, typer.Option(help="seconds of the control loop to time")] = 1.0,
+    seconds: Annotated[float, typer.Option(help="seconds of the 1 kHz control loop to time")] = 1.0,
     realtime: Annotated[bool, _REALTIME] = True,
 ) -> None:
     """Connect, read the state, print the safety limits and the loop timing."""
@@ -61,7 +62,9 @@ def check(
 def bench_robot(
     robot: RobotOpt = "franka",
     host: HostOpt = None,
-    seconds: Annotated[float, typer.Option(help="seconds of the 1 kHz loop")] = 10.0,
+    seconds: Annotated[
+        float, typer.Option(help="seconds of the 1 kHz control loop to time")
+    ] = 10.0,
     realtime: Annotated[bool, _REALTIME] = True,
 ) -> None:
     """Tick compute time p50/p99/max and missed deadlines of the 1 kHz loop, through the

@@ -7,35 +7,45 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.progress import Progress
 from rich.table import Table
 
+from teachfit.cli import options as o
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
 
-search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
+search_app = typer.Typer(
+    help="Plan and run search trajectories learned from blind demonstrations (Ehlers et al. 2019).",
+    no_args_is_help=True,
+)
+_METHOD = typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
 
 
 @guarded
 def learn_search(
-    demos: Annotated[Path, typer.Argument(help="HDF5 demonstrations of one task")],
-    out: Annotated[Path, typer.Option(help="model file to write (JSON)")] = Path("search.model"),
+    demos: Annotated[
+        str, typer.Argument(help="demonstrations of one task: FILE.h5 (all) or FILE.h5:0,2")
+    ],
+    out: Annotated[Path, typer.Option(help="search model file to write (JSON)")] = Path(
+        "search.model"
+    ),
     components: Annotated[str, typer.Option(help="GMM components: a number or 'bic'")] = "1",
     covariance: Annotated[
         str,
         typer.Option(
-            help="p_e covariance: 'auto' (chosen by leave-one-demonstration-out likelihood), "
-            "'full' (seed A) or 'diag' (per-DOF variances)"
+            help="covariance of the exploration density: 'auto' (chosen by "
+            "leave-one-demonstration-out likelihood), 'full' (the paper) or 'diag'"
         ),
     ] = "auto",
-    seed: int = 0,
+    seed: Annotated[int, o.seed("the mixture fit")] = 0,
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
-    from teachfit.demonstrations.dataset import read_dataset
+    from teachfit.demonstrations.dataset import read_demos
     from teachfit.models.search_model import SearchModel
 
-    demo_list = read_dataset(demos)
+    demo_list = read_demos(demos)
     tasks = {d.task for d in demo_list}
     if len(tasks) != 1:
         raise TeachfitError(f"{demos} mixes tasks {sorted(tasks)}; learn one task at a time")
@@ -49,10 +59,14 @@ def learn_search(
     )
     model.save(out)
     e = model.exploration
+    mean = ", ".join(
+        f"{d} {1e3 * v:.1f} {'mrad' if d.startswith('r') else 'mm'}"
+        for d, v in zip(model.dims, e.mean, strict=True)
+    )
     console.print(
         f"learned from {len(demo_list)} demonstration(s) of [bold]{model.task}[/]: "
-        f"dims {', '.join(model.dims)}, {e.n_components} component(s), "
-        f"mean {np.round(e.mean * 1e3, 1)} (mm/mrad), teacher speed {model.speed * 1e3:.1f} mm/s"
+        f"{e.n_components} component(s), mean {mean} from the first pose, teacher speed "
+        f"{model.speed * 1e3:.1f} mm/s"
         + (
             f"\ncovariance: {model.covariance_choice.describe()}"
             if model.covariance_choice is not None
@@ -65,24 +79,25 @@ def learn_search(
 @search_app.command("plan")
 @guarded
 def plan(
-    model_file: Annotated[Path, typer.Argument(help="model from 'teachfit learn search'")],
-    method: Annotated[
-        str, typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
-    ] = "tshix",
-    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
-    seed: int = 0,
-    plot: Annotated[Path | None, typer.Option(help="figure to write")] = None,
+    model_arg: o.ModelArgOld = None,
+    model_file: o.Model = Path("search.model"),
+    method: Annotated[str, _METHOD] = "tshix",
+    points: o.Points = 300,
+    seed: Annotated[int, o.seed("the TSHIX samples")] = 0,
+    plot: Annotated[Path | None, o.plot("the planned trajectory")] = None,
+    n: o.PointsOld = None,
 ) -> None:
     """Plan one search trajectory in the search frame and report its figures of merit."""
     import time
 
+    model_file, points = o.pick(model_file, model_arg), o.pick(points, n)
     from teachfit.execution.search import plan_search
     from teachfit.models.search_model import SearchModel
     from teachfit.trajectories.ergodic import ergodic_metric
 
     model = SearchModel.load(model_file)
     t0 = time.perf_counter()
-    traj = plan_search(model, method, n, np.random.default_rng(seed))
+    traj = plan_search(model, method, points, np.random.default_rng(seed))
     wall = time.perf_counter() - t0
     metric = ergodic_metric(traj.states, model.exploration, t=traj.t)
     xy = float(np.linalg.norm(np.diff(traj.states[:, :2], axis=0), axis=1).sum())
@@ -98,14 +113,14 @@ def plan(
         from teachfit.viz import search_figures as sf
 
         if traj.itinerary is not None and traj.states.shape[1] == 2:
-            fig = sf.tshix_stages(traj, model.exploration)
+            fig = sf.tshix_stages(traj, model.exploration, seed=seed)
         elif traj.states.shape[1] == 3:
             fig = sf.trajectory_3d(traj)
         else:
             fig = sf.planned_vs_executed(traj.states, traj.states, (method, method))
             fig.axes[0].lines[1].remove()  # one path: draw it once
             fig.axes[0].legend()
-            fig.axes[0].set_title(f"{method} search trajectory (search frame)")
+            fig.axes[0].set_title(f"{method} search trajectory, seed {seed} (search frame)")
             fig.tight_layout()
         sf.save(fig, plot)
         console.print(f"figure -> {plot}")
@@ -115,36 +130,36 @@ def plan(
 @guarded
 def run(
     ctx: typer.Context,
-    task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
-    model_file: Annotated[Path, typer.Option("--model", help="learned model")] = Path(
-        "search.model"
-    ),
-    method: Annotated[
-        str, typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
-    ] = "tshix",
-    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
-    starts: Annotated[int, typer.Option(help="number of start poses")] = 30,
+    task: Annotated[str, o.task()] = "peg2d",
+    model_file: o.Model = Path("search.model"),
+    method: Annotated[str, _METHOD] = "tshix",
+    points: o.Points = 300,
+    starts: Annotated[int, o.starts("drawn by --protocol")] = 30,
     protocol: Annotated[str, typer.Option(help="start protocol of the task")] = "table1",
     feedforward: Annotated[bool, typer.Option(help="superpose the GMR feed-forward")] = True,
     passes: Annotated[
         int, typer.Option(help="TSHIX passes: re-sample and continue after a failed pass")
     ] = 1,
     demo: Annotated[
-        str | None, typer.Option(help="demonstration whose start anchors the protocol (f.h5:0)")
+        str | None,
+        typer.Option(help="demonstration FILE.h5:INDEX whose start anchors the protocol"),
     ] = None,
-    seed: int = 0,
-    plot: Annotated[Path | None, typer.Option(help="figure of the executed paths")] = None,
+    seed: Annotated[int, o.seed("the starts and the TSHIX samples")] = 0,
+    plot: Annotated[Path | None, o.plot("the executed paths over the hole")] = None,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     log: LogOpt = None,
     rrd: RrdOpt = None,
+    n: o.PointsOld = None,
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
-    Seed A's Table I starts lie in a 3 cm circle halfway between the demonstration's start and
-    the hole: pass the demonstration the model was learned from with ``--demo``.
+    Table I's starts (Ehlers et al. 2019) lie in a 3 cm circle halfway between the
+    demonstration's start and the hole: pass the demonstration the model was learned from
+    with --demo.
     """
+    points = o.pick(points, n)
     from teachfit.execution.search import run_protocol
     from teachfit.metrics.stats import summarize
     from teachfit.models.search_model import SearchModel
@@ -171,10 +186,10 @@ def run(
         )
     the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime))
     try:
-        with Progress(console=console, transient=True) as bar:
+        with progress_bar() as bar:
             job = bar.add_task(f"{method} from {starts} starts", total=starts)
             runs = run_protocol(
-                the_robot, the_task, model, method, n, starts, protocol, seed,
+                the_robot, the_task, model, method, points, starts, protocol, seed,
                 passes=passes, feedforward=feedforward, demo_start=demo_start,
                 on_done=lambda _run: bar.advance(job),
             )  # fmt: skip
@@ -183,12 +198,13 @@ def run(
     outcomes = [r.result for r in runs]
     paths = [(o.log.pos, o.success) for o in outcomes]
     s = summarize([o.success for o in outcomes], [o.time_to_success for o in outcomes])
-    table = Table(title=f"{method} on {the_task.name} ({protocol}, seed {seed})")
+    n_pts = f", N = {points}" if method == "tshix" else ""
+    table = Table(title=f"{method}{n_pts} on {the_task.name} ({protocol} starts, seed {seed})")
     for col in ("starts", "successes", "rate [95 % CI]", "median time", "reasons"):
         table.add_column(col, justify="right")
     reasons = {}
-    for o in outcomes:
-        reasons[o.outcome.value] = reasons.get(o.outcome.value, 0) + 1
+    for res in outcomes:
+        reasons[res.outcome.value] = reasons.get(res.outcome.value, 0) + 1
     t_med = "n/a" if np.isnan(s.median_time) else f"{s.median_time:.2f} s"
     table.add_row(
         str(s.trials),
@@ -197,27 +213,33 @@ def run(
         t_med,
         ", ".join(f"{k} {v}" for k, v in reasons.items()),
     )
-    console.print(table)
+    print_table(table)
     write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method), ctx.params)
     if plot is not None:
         from teachfit.viz.figures import plot_executions
 
-        plot_executions(paths, plot, the_task, title=method)
+        n = f", N = {points}" if method == "tshix" else ""
+        title = f"{method}{n}, seed {seed}, {protocol} starts"
+        plot_executions(paths, plot, the_task, title=title)
         console.print(f"figure -> {plot}")
 
 
 @search_app.command("figures")
 @guarded
 def figures(
-    model_file: Annotated[Path, typer.Argument(help="model from 'teachfit learn search'")],
+    model_arg: o.ModelArgOld = None,
+    model_file: o.Model = Path("search.model"),
     out: Annotated[Path, typer.Option(help="folder for the figures")] = Path("search_figures"),
-    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
-    seed: int = 0,
+    points: o.Points = 300,
+    seed: Annotated[int, o.seed("the samples and the start")] = 0,
     robot: RobotOpt = "floating",
+    n: o.PointsOld = None,
 ) -> None:
-    """Seed A's figures for a model: samples over p_e for N = 100...500, samples -> itinerary ->
-    smoothed trajectory, feed-forward arrows, the 3D trajectory (x, y, rz tasks), and a
-    planned vs. executed path from the task's first protocol start."""
+    """The search paper's figures for a model (Ehlers et al. 2019): samples over the
+    exploration density for N = 100...500, samples -> itinerary -> smoothed trajectory,
+    feed-forward arrows, the 3D trajectory (x, y, rz tasks), and a planned vs. executed path
+    from the task's first protocol start."""
+    model_file, points = o.pick(model_file, model_arg), o.pick(points, n)
     from teachfit.execution.search import plan_search, run_search
     from teachfit.models.search_model import SearchModel
     from teachfit.robot.registry import make_robot
@@ -228,10 +250,12 @@ def figures(
     task = get_task(model.task)
     out.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(seed)
-    written = [sf.save(sf.samples_over_distribution(model.exploration, rng), out / "samples.png")]
-    traj = plan_search(model, "tshix", n, np.random.default_rng(seed))
+    samples = sf.samples_over_distribution(model.exploration, rng, seed=seed)
+    written = [sf.save(samples, out / "samples.png")]
+    traj = plan_search(model, "tshix", points, np.random.default_rng(seed))
     if model.exploration.dim == 2:
-        written.append(sf.save(sf.tshix_stages(traj, model.exploration), out / "tshix_stages.png"))
+        stages = sf.tshix_stages(traj, model.exploration, seed=seed)
+        written.append(sf.save(stages, out / "tshix_stages.png"))
     else:
         written.append(sf.save(sf.trajectory_3d(traj), out / "trajectory_3d.png"))
     ff = np.zeros((traj.t.size, 6))
@@ -242,10 +266,14 @@ def figures(
         "table1" if task.name == "peg2d" else "table3" if task.name == "socket3d" else "teacher"
     )
     start = task.protocol.protocol_starts(protocol, 1, np.random.default_rng(seed))[0]
-    run = run_search(make_robot(robot, task, seed=seed), task, model, start, traj)
+    with console.status(f"running the TSHIX search from a {protocol} start"):
+        run = run_search(make_robot(robot, task, seed=seed), task, model, start, traj)
     executed = run.result.log.pos[:, :2] - start.pos[:2]
     fig = sf.planned_vs_executed(traj.states[:, :2], executed)
-    fig.axes[0].set_title(f"from a {protocol} start: {run.result.outcome.value}")
+    fig.axes[0].set_title(
+        f"TSHIX, N = {points}, seed {seed}, from a {protocol} start: {run.result.outcome.value}",
+        fontsize=9,
+    )
     written.append(sf.save(fig, out / "planned_vs_executed.png"))
     for path in written:
         console.print(f"figure -> {path}")

@@ -8,16 +8,18 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
+from teachfit.cli import options as o
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.tables import print_table
 
 skill_app = typer.Typer(
-    help="Manipulation skills (seed B): show a skill's graph, run it on a task.",
+    help="Manipulation skills (Johannsmeier et al. 2019): show a skill's graph, run it on a task.",
     no_args_is_help=True,
 )
 
 _SKILL = typer.Argument(help="built-in skill name or a skill .toml")
-_CONTROLLER = typer.Option(help="controller: adaptive (seed B) or impedance")
+_CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
 
 
 def _num(v: float) -> str:
@@ -28,7 +30,7 @@ def _num(v: float) -> str:
 @guarded
 def show(
     skill: Annotated[str, _SKILL] = "peg-in-hole",
-    plot: Annotated[Path | None, typer.Option(help="draw the graph to this image")] = None,
+    plot: Annotated[Path | None, o.plot("the skill graph")] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
     toml: Annotated[Path | None, typer.Option(help="write the skill as TOML here")] = None,
 ) -> None:
@@ -46,13 +48,13 @@ def show(
         nodes.add_row(
             node.name + tag, node.primitive.describe(), node.error.describe() if node.error else "-"
         )
-    console.print(nodes)
+    print_table(nodes)
     trs = Table(title="transitions", title_justify="left")
     for col in ("from", "to", "when"):
         trs.add_column(col)
     for tr in sk.transitions:
         trs.add_row(tr.source, tr.target, tr.condition.describe())
-    console.print(trs)
+    print_table(trs)
     console.print(f"pre: {sk.pre.describe() if sk.pre else 'always'}")
     console.print(f"success: {sk.success.describe()}\nerror: {sk.error.describe()}")
     ctx = Table(title="context parameters (set by the task)", title_justify="left")
@@ -60,7 +62,7 @@ def show(
         ctx.add_column(col)
     for name, p in sk.params.context.items():
         ctx.add_row(name, _num(p.value), p.unit, p.doc)
-    console.print(ctx)
+    print_table(ctx)
     lrn = Table(title="learned parameters", title_justify="left")
     for col in ("name", "default", "low", "high", "unit", "meaning"):
         lrn.add_column(col)
@@ -69,7 +71,7 @@ def show(
         lrn.add_row(
             name, _num(p.default), _num(p.domain.low), _num(p.domain.high) + scale, p.unit, p.doc
         )
-    console.print(lrn)
+    print_table(lrn)
     if toml is not None:
         toml.parent.mkdir(parents=True, exist_ok=True)
         toml.write_text(skill_to_toml(sk))
@@ -85,24 +87,27 @@ def show(
 def run(
     ctx: typer.Context,
     skill: Annotated[str, _SKILL] = "peg-in-hole",
-    task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
-    params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
+    task: Annotated[str, o.task()] = "peg2d",
+    params: Annotated[
+        Path | None, typer.Option(help="skill parameters (TOML) written by 'teachfit learn skill'")
+    ] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
-    seed: Annotated[int, typer.Option(help="seed of the hole estimate, starts, noise")] = 0,
-    starts: Annotated[int, typer.Option(help="number of start poses")] = 4,
-    render: Annotated[Path | None, typer.Option(help="render one execution to this mp4")] = None,
-    render_start: Annotated[int, typer.Option(help="which execution to render")] = 0,
-    plot: Annotated[Path | None, typer.Option(help="plot the traces to this image")] = None,
-    fps: int = 25,
-    width: int = 640,
-    height: int = 480,
+    seed: Annotated[int, o.seed("the hole estimate, the starts and the sensor noise")] = 0,
+    starts: Annotated[int, o.starts("(one execution each)")] = 4,
+    render: o.Render = None,
+    render_start: Annotated[int, typer.Option(help="which execution --render draws")] = 0,
+    plot: Annotated[Path | None, o.plot("force and pose over time of each execution")] = None,
+    fps: o.Fps = 25,
+    width: o.Width = 640,
+    height: o.Height = 480,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
-    """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
+    """Run a skill on a task from several start poses: one trial of the skill-learning paper
+    (Johannsmeier et al. 2019), its successes and cost."""
     from teachfit.core.errors import SkillError
     from teachfit.execution.recording import skill_episodes
     from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
@@ -152,7 +157,7 @@ def run(
             f"{tr.t_end:.2f}",
             path,
         )
-    console.print(table)
+    print_table(table)
     steps = sum(tr.steps for tr in out.traces)
     wall = sum(tr.wall_s for tr in out.traces)
     console.print(
@@ -165,7 +170,8 @@ def run(
     if plot is not None:
         from teachfit.viz.skill_figures import plot_traces
 
-        console.print(f"traces -> {plot_traces(out.traces, plot)}")
+        title = f"{setup.skill.name} on {the_task.name}, {controller} controller, seed {seed}"
+        console.print(f"traces -> {plot_traces(out.traces, plot, title)}")
     if render is not None:
         from teachfit.viz.video import render_motion
 

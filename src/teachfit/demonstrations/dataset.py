@@ -478,6 +478,32 @@ def read_demo(spec: str | Path) -> Demonstration:
         return _read_group(group[keys[index]], path)
 
 
+def read_demos(spec: str | Path) -> list[Demonstration]:
+    """Every demonstration of ``"file.h5"``, or those picked by ``"file.h5:INDEX[,INDEX...]"``
+    (in the order given).
+
+    Raises
+    ------
+    DatasetError
+        For an out-of-range index, a repeated index or an unreadable file.
+    """
+    match = re.fullmatch(r"(.+):(\d+(?:,\d+)*)", str(spec)) if isinstance(spec, str) else None
+    if not match:
+        return read_dataset(spec)
+    path, picks = Path(match.group(1)), [int(i) for i in match.group(2).split(",")]
+    if len(set(picks)) != len(picks):
+        raise DatasetError(f"index repeated in {match.group(2)!r}", path=str(path))
+    demos = read_dataset(path)
+    bad = [i for i in picks if i >= len(demos)]
+    if bad:
+        raise DatasetError(
+            f"index {bad[0]} out of range: the file holds {len(demos)} demos"
+            + (f" (0..{len(demos) - 1})" if demos else ""),
+            path=str(path),
+        )
+    return [demos[i] for i in picks]
+
+
 def dataset_summary(path: str | Path) -> list[dict[str, Any]]:
     """One row per demonstration for a table: index, name, task, source, samples, duration (s),
     rate (Hz)."""

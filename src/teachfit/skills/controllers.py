@@ -30,11 +30,16 @@ from teachfit.skills.params import LearnedParam
 
 CONTROLLERS = ("adaptive", "impedance")
 _META = ("alpha", "beta", "gamma_a", "gamma_b")
+#: units per meta-parameter and group: t (translation: N, m) and r (rotation: N·m, rad)
 _UNITS = {
-    "alpha": "N/(m/s)/tick",
-    "beta": "N/m/(m²/s)/tick",
-    "gamma_a": "(m/s)/N",
-    "gamma_b": "(m²/s)/(N/m)",
+    ("alpha", "t"): "N/(m/s)/tick",
+    ("beta", "t"): "N/m/(m²/s)/tick",
+    ("gamma_a", "t"): "(m/s)/N",
+    ("gamma_b", "t"): "(m²/s)/(N/m)",
+    ("alpha", "r"): "N·m/(rad/s)/tick",
+    ("beta", "r"): "N·m/rad/(rad²/s)/tick",
+    ("gamma_a", "r"): "(rad/s)/(N·m)",
+    ("gamma_b", "r"): "(rad²/s)/(N·m/rad)",
 }
 #: largest tolerated errors behind the meta-parameter bounds (translation, rotation)
 E_MAX = (0.01,) * 3 + (0.1,) * 3
@@ -56,7 +61,7 @@ def controller_params(kind: str, period: float = 0.001) -> dict[str, LearnedPara
             dom = ParamDomain(hi[i] * 1e-3, hi[i], log=True)
             val = float(np.clip(default[i], dom.low, dom.high))
             out[f"{meta}_{g}"] = LearnedParam(
-                val, dom, _UNITS[meta], f"adaptive controller {meta}, group {g}"
+                val, dom, _UNITS[meta, g], f"adaptive controller {meta}, group {g}"
             )
     return out
 

@@ -196,8 +196,8 @@ def build(controller: str = "adaptive") -> Skill:
         error=TimeAbove("t_max", scope="skill") | ForceAbove("f_max", axis="norm"),
         pre=~ForceAbove("f_contact", axis="norm"),
         recovery=recovery,
-        doc="seed B's peg-in-hole: approach, contact, lateral move until constrained, align, "
-        "insert with oscillations",
+        doc="the skill paper's peg-in-hole (Johannsmeier et al. 2019): approach, contact, "
+        "lateral move until constrained, align, insert with oscillations",
     )
 
 

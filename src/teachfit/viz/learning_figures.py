@@ -110,10 +110,17 @@ def plot_study_curve(records: Sequence[TrialRecord], path: str | Path, title: st
 
 
 def plot_param_traces(
-    records: Sequence[TrialRecord], space: ParamSpace, path: str | Path, title: str = ""
+    records: Sequence[TrialRecord],
+    space: ParamSpace,
+    path: str | Path,
+    title: str = "",
+    units: Mapping[str, str] | None = None,
 ) -> Path:
     """Each learned parameter vs trial, unit-scaled to its domain (0 = low, 1 = high);
-    feasible trials blue, failed red, the best trial's values as a dashed line."""
+    feasible trials blue, failed red, the best trial's values as a dashed line. ``units``
+    (name -> unit) labels each panel's domain."""
+    from matplotlib.lines import Line2D
+
     names = space.names
     ncol = 4
     nrow = int(np.ceil(len(names) / ncol))
@@ -123,30 +130,42 @@ def plot_param_traces(
         squeeze=False,
         sharex=True,
         sharey=True,
-        figsize=(3.0 * ncol, 1.9 * nrow),
+        figsize=(3.0 * ncol, 2.1 * nrow),
         constrained_layout=True,
     )
     k = np.arange(1, len(records) + 1)
-    units = np.array([space.to_unit(r.params) for r in records]).reshape(len(records), -1)
+    scaled = np.array([space.to_unit(r.params) for r in records]).reshape(len(records), -1)
     ok = np.array([r.feasible for r in records], dtype=bool)
     best = min((r for r in records if r.feasible), key=lambda r: r.cost, default=None)
     for idx, ax in enumerate(axes.flat):
         if idx >= len(names):
             ax.set_axis_off()
             continue
-        ax.scatter(k[ok], units[ok, idx], s=6, color="tab:blue")
-        ax.scatter(k[~ok], units[~ok, idx], s=8, color="tab:red", marker="x")
+        ax.scatter(k[ok], scaled[ok, idx], s=6, color="tab:blue")
+        ax.scatter(k[~ok], scaled[~ok, idx], s=8, color="tab:red", marker="x")
         if best is not None:
             ax.axhline(space.to_unit(best.params)[idx], color="k", ls="--", lw=0.9)
         dom = space.domains[names[idx]]
-        scale = ", log" if dom.log else ""
-        ax.set_title(f"{names[idx]} [{dom.low:.3g}, {dom.high:.3g}{scale}]", fontsize=7)
+        scale = ", log scale" if dom.log else ""
+        unit = (units or {}).get(names[idx], "")
+        unit = f" {unit}" if unit and unit != "1" else ""
+        ax.set_title(f"{names[idx]}\n{dom.low:.3g} to {dom.high:.3g}{unit}{scale}", fontsize=7)
         ax.set_ylim(-0.05, 1.05)
         ax.grid(alpha=0.3)
     for ax in axes[-1]:
         ax.set_xlabel("trial")
     for ax in axes[:, 0]:
         ax.set_ylabel("in domain (0-1)", fontsize=7)
+    fig.legend(
+        handles=[
+            Line2D([], [], ls="none", marker="o", ms=3, color="tab:blue", label="feasible trial"),
+            Line2D([], [], ls="none", marker="x", color="tab:red", label="failed trial"),
+            Line2D([], [], ls="--", color="k", lw=0.9, label="best trial"),
+        ],
+        loc="outside lower center",
+        ncol=3,
+        fontsize=8,
+    )
     if title:
         fig.suptitle(title, fontsize=10)
     return _save(fig, path)

@@ -68,6 +68,21 @@ def _save(fig: plt.Figure, path: str | Path | None) -> plt.Figure:
     return fig
 
 
+def _parts_legend(fig: plt.Figure) -> None:
+    from matplotlib.patches import Patch
+
+    fig.legend(
+        handles=[
+            Patch(color=MOVING_COLOR, label="moving part L"),
+            Patch(color=FIXED_COLOR, alpha=0.5, label="fixed part G"),
+        ],
+        loc="lower center",
+        ncol=2,
+        fontsize=8,
+        frameon=False,
+    )
+
+
 def parts_figure(asm: Assembly, path: str | Path | None = None) -> plt.Figure:
     """The parts at the goal pose in 3-D, the moving part alone, and a table of dimensions."""
     fig = plt.figure(figsize=(12, 4.5))
@@ -83,7 +98,10 @@ def parts_figure(asm: Assembly, path: str | Path | None = None) -> plt.Figure:
     ax2.set_xlim(c[0] - r, c[0] + r)
     ax2.set_ylim(c[1] - r, c[1] + r)
     ax2.set_zlim(c[2] - r, c[2] + r)
+    for axis, name in zip("xyz", ("x", "y", "z"), strict=True):
+        getattr(ax2, f"set_{axis}label")(f"{name} (mm)")
     ax2.set_title("moving part (frame L)")
+    _parts_legend(fig)
     ax3 = fig.add_subplot(1, 3, 3)
     ax3.axis("off")
     rows = [[k.replace("_", " "), f"{1e3 * v:.1f}"] for k, v in asm.dimensions.items()]
@@ -112,8 +130,14 @@ def path_strip_figure(
         add_mesh(ax, asm.moving, path[i].matrix, color=MOVING_COLOR, alpha=0.85)
         _frame_axes(ax, asm, extra=positions)
         ax.view_init(elev=20, azim=-70)
-        ax.set_title(f"{k + 1}/{len(idx)}", fontsize=9)
+        ax.set_title(f"pose {k + 1}/{len(idx)}", fontsize=9)
         ax.tick_params(labelsize=6)
+    fig.suptitle(
+        f"{asm.task}: the planned path of L in G, {len(idx)} poses evenly spaced along it "
+        "(axes in mm)",
+        fontsize=10,
+    )
+    _parts_legend(fig)
     return _save(fig, out)
 
 

@@ -34,11 +34,23 @@ def _order(skill: Skill) -> list[str]:
     return order
 
 
-def _box(ax: plt.Axes, xy: tuple[float, float], title: str, body: str, color: str) -> None:
+#: distance between node centres, and a node box's half width (data units)
+_STEP, _HALF = 2.0, 0.42
+
+
+def _box(
+    ax: plt.Axes, xy: tuple[float, float], title: str, body: str, color: str, half: float = _HALF
+) -> None:
     x, y = xy
     ax.add_patch(
         FancyBboxPatch(
-            (x - 0.42, y - 0.32), 0.84, 0.64, boxstyle="round,pad=0.02", fc=color, ec="k", lw=1.2
+            (x - half, y - 0.32),
+            2 * half,
+            0.64,
+            boxstyle="round,pad=0.02",
+            fc=color,
+            ec="k",
+            lw=1.2,
         )
     )
     ax.text(x, y + 0.2, title, ha="center", va="center", fontsize=10, weight="bold")
@@ -87,10 +99,10 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
     """Draw ``skill``'s graph to ``path`` (png/pdf/svg by suffix)."""
     path = Path(path)
     order = _order(skill)
-    pos = {name: (1.5 * (i + 1), 0.0) for i, name in enumerate(order)}
+    pos = {name: (_STEP * (i + 1), 0.0) for i, name in enumerate(order)}
     n = len(order)
-    fig, ax = plt.subplots(figsize=(2.4 * (n + 2), 5.2), constrained_layout=True)
-    start, end = (0.0, 0.0), (1.5 * (n + 1), 0.0)
+    fig, ax = plt.subplots(figsize=(1.6 * _STEP * (n + 1.4), 5.4), constrained_layout=True)
+    start, end = (0.0, 0.0), (_STEP * (n + 1), 0.0)
     ax.add_patch(plt.Circle(start, 0.12, color="k"))
     ax.add_patch(plt.Circle(end, 0.15, fc="white", ec="green", lw=3))
     ax.add_patch(plt.Circle(end, 0.09, color="green"))
@@ -128,13 +140,14 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
             f"recovery: {skill.recovery.name}",
             skill.recovery.primitive.describe(),
             "#f6dbdb",
+            half=0.7,
         )
         for node in skill.nodes:
             a = pos[node.name]
             _arrow(
                 ax,
                 (a[0], a[1] - 0.33),
-                (rec[0] + 0.2 * (a[0] - rec[0]) / n, rec[1] + 0.33),
+                (rec[0] + 0.5 * (a[0] - rec[0]) / n, rec[1] + 0.33),
                 node.error.describe() if node.error else "",
                 color="firebrick",
                 style="--",
@@ -150,6 +163,22 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
         transform=ax.transData,
     )
     ax.text(0.0, 0.85, f"task frame: {skill.frame}", fontsize=7, color="0.3")
+    from matplotlib.lines import Line2D
+
+    ax.legend(
+        handles=[
+            Line2D(
+                [], [], ls="none", marker="o", color="k", label="entry (if the precondition holds)"
+            ),
+            Line2D([], [], color="k", label="transition, when its condition holds"),
+            Line2D([], [], color="green", label="success condition"),
+            Line2D([], [], color="firebrick", ls="--", label="error condition -> recovery"),
+        ],
+        loc="upper right",
+        fontsize=7,
+        ncol=2,
+        frameon=False,
+    )
     ax.set_xlim(-0.4, end[0] + 0.4)
     ax.set_ylim(-2.1, 1.25)
     ax.set_aspect("equal")
@@ -160,8 +189,9 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
     return path
 
 
-def plot_traces(traces: Sequence[ExecutionResult], path: str | Path) -> Path:
-    """Executions over time: node timeline, contact force and depth (one column each)."""
+def plot_traces(traces: Sequence[ExecutionResult], path: str | Path, title: str = "") -> Path:
+    """Executions over time: node timeline, contact force and depth (one column each);
+    ``title`` should name the skill, task and seed."""
     path = Path(path)
     k = len(traces)
     fig, axes = plt.subplots(
@@ -187,6 +217,7 @@ def plot_traces(traces: Sequence[ExecutionResult], path: str | Path) -> Path:
             ax0.text(v.t_exit, i, f" {v.node}", va="center", fontsize=7)
         ax0.set_yticks([])
         ax0.invert_yaxis()
+        ax0.set_xlim(0.0, 1.2 * max(v.t_exit for v in tr.visits))  # room for the last name
         ok = "success" if tr.success else tr.outcome
         ax0.set_title(f"execution {j}: {ok}, contact at {tr.t_first_contact:.2f} s", fontsize=9)
         log = tr.log
@@ -202,7 +233,10 @@ def plot_traces(traces: Sequence[ExecutionResult], path: str | Path) -> Path:
             ax.grid(alpha=0.3)
         if np.isfinite(tr.t_first_contact):
             ax1.axvline(tr.t_first_contact, color="r", lw=1.0, label="first contact")
+        ax1.plot([], [], color="0.4", lw=0.8, ls=":", label="a node starts")
         ax1.legend(fontsize=7)
+    if title:
+        fig.suptitle(title, fontsize=10)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -7,7 +7,7 @@ explains what to set instead of failing deep inside MuJoCo.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -42,6 +42,7 @@ def render_motion(
     height: int = 480,
     slowdown: float = 1.0,
     robot: str = "floating",
+    progress: Callable[[int, int], None] | None = None,
 ) -> Path:
     """Render the held part following recorded TCP poses (world frame) to an mp4.
 
@@ -49,11 +50,23 @@ def render_motion(
     ----------
     t : (T,) s;  pos : (T, 3) m;  quat : (T, 4) w-x-y-z
     slowdown : play back this many times slower than real time.
+    progress : called with (frames written, frames in all) after each frame.
     """
+    total = frame_count(t, fps, slowdown)
     frames = motion_frames(
         task, t, pos, quat, fps=fps, width=width, height=height, slowdown=slowdown, robot=robot
     )
     with video_writer(out, fps=fps) as writer:
-        for frame in frames:
+        for k, frame in enumerate(frames, start=1):
             writer.append_data(frame)
+            if progress is not None:
+                progress(k, total)
     return Path(out)
+
+
+def frame_count(t: np.ndarray, fps: int, slowdown: float = 1.0) -> int:
+    """Frames of a video of the motion sampled at times ``t`` (s): one per 1/(fps slowdown) s."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 2 or not fps > 0 or not slowdown > 0:
+        return 0
+    return int(np.arange(t[0], t[-1] + 1e-9, 1.0 / (fps * slowdown)).size)

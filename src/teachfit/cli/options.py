@@ -1,0 +1,146 @@
+"""The command line's vocabulary: one option name, one kind and one help for one thing.
+
+Every command declares the options below instead of spelling its own, so that ``--points`` is
+TSHIX's sample count everywhere and ``--seed`` a seed value everywhere. ``tests/cli/
+test_vocabulary.py`` walks the command tree and checks each option against :data:`CANONICAL`.
+
+Old spellings stay accepted as *hidden* options (not in ``--help``), so that scripts keep
+working: ``-n`` (now ``--points`` or ``--count``), ``--write`` (now ``--markdown FILE``),
+``--benchmarks`` (``--markdown FILE``), ``--seeds``/``--no-demo-seeds`` of ``bench planning``
+(now ``--runs``/``--no-demo-runs``), ``--demos`` of ``quickstart`` (``--count``), ``--out`` of
+``render`` (``--render``), and the model file as the first argument of ``search plan`` and
+``search figures`` (now ``--model``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+import typer
+
+T = TypeVar("T")
+
+#: option name -> (kind, how its help starts); kinds: int, float, text, path, flag
+CANONICAL: dict[str, tuple[str, str]] = {
+    "--seed": ("int", "random seed"),
+    "--points": ("int", "TSHIX points"),
+    "--count": ("int", "number of demonstrations"),
+    "--model": ("path", "search model"),
+    "--render": ("path", "video (mp4)"),
+    "--markdown": ("path", "append the results as markdown"),
+    "--plot": ("path", "figure"),
+    "--starts": ("int", "start poses"),
+    "--task": ("text", "task"),
+    "--tasks": ("text", "tasks"),
+    "--demo": ("text", "demonstration"),
+    "--out": ("path", ""),
+    "--overwrite": ("flag", "replace an existing"),
+    "--append": ("flag", "append to an existing file"),
+    "--workers": ("int", "worker processes"),
+    "--fps": ("int", "video frames per second"),
+    "--width": ("int", "video width"),
+    "--height": ("int", "video height"),
+    "--robot": ("text", "robot to run on"),
+    "--host": ("text", "address of a real robot"),
+    "--realtime": ("flag", "real robot: require a real-time kernel"),
+    "--controller": ("text", "controller"),
+    "--trials": ("int", "trials"),
+    "--method": ("text", ""),
+    "--params": ("path", "skill parameters"),
+    "--runs": ("int", "planning runs"),
+    "--view": ("flag", "watch the run in MuJoCo's viewer"),
+}
+
+
+def old(flag: str, new: str) -> Any:
+    """A hidden option ``flag``: an old spelling of ``new`` kept for scripts."""
+    return typer.Option(flag, hidden=True, help=f"old spelling of {new}")
+
+
+def pick(new: T, old_value: T | None) -> T:
+    """The value of an option, or of its old spelling where that was given."""
+    return new if old_value is None else old_value
+
+
+def seed(what: str = "") -> Any:
+    """``--seed N``: a seed *value* (a count of seeds is never called ``--seed(s)``)."""
+    return typer.Option("--seed", help="random seed" + (f" of {what}" if what else ""))
+
+
+def plot(what: str) -> Any:
+    """``--plot FILE``: a figure (PNG or PDF, by the file's suffix)."""
+    return typer.Option("--plot", help=f"figure (PNG/PDF) to write: {what}")
+
+
+def task(choices: str = "a built-in name (teachfit tasks) or a task .toml") -> Any:
+    """``--task NAME``: the task a command works on."""
+    return typer.Option("--task", help=f"task: {choices}")
+
+
+def starts(what: str = "") -> Any:
+    """``--starts N``: how many start poses."""
+    return typer.Option("--starts", min=1, help="start poses" + (f" {what}" if what else ""))
+
+
+Seed = Annotated[int, seed()]
+Points = Annotated[
+    int, typer.Option("--points", min=1, help="TSHIX points sampled from the exploration density")
+]
+PointsOld = Annotated[int | None, old("-n", "--points")]
+Count = Annotated[int, typer.Option("--count", min=1, help="number of demonstrations to record")]
+CountOld = Annotated[int | None, old("-n", "--count")]
+Model = Annotated[
+    Path, typer.Option("--model", help="search model (JSON) written by 'teachfit learn search'")
+]
+ModelArgOld = Annotated[
+    Path | None,
+    typer.Argument(
+        hidden=True, metavar="MODEL", help="old spelling of --model", show_default=False
+    ),
+]
+Render = Annotated[Path | None, typer.Option("--render", help="video (mp4) to write")]
+Markdown = Annotated[
+    Path | None,
+    typer.Option("--markdown", help="append the results as markdown to this file (BENCHMARKS.md)"),
+]
+WriteOld = Annotated[bool, old("--write", "--markdown BENCHMARKS.md")]
+Overwrite = Annotated[bool, typer.Option(help="replace an existing file")]
+Append = Annotated[bool, typer.Option(help="append to an existing file")]
+Workers = Annotated[
+    int | None,
+    typer.Option(help="worker processes (default: all cores; 0: in this process)"),
+]
+Fps = Annotated[int, typer.Option(min=1, help="video frames per second")]
+Width = Annotated[int, typer.Option(min=16, help="video width (px)")]
+Height = Annotated[int, typer.Option(min=16, help="video height (px)")]
+View = Annotated[
+    bool, typer.Option("--view", help="watch the run in MuJoCo's viewer (needs a display)")
+]
+
+__all__ = [
+    "CANONICAL",
+    "Append",
+    "Count",
+    "CountOld",
+    "Fps",
+    "Height",
+    "Markdown",
+    "Model",
+    "ModelArgOld",
+    "Overwrite",
+    "Points",
+    "PointsOld",
+    "Render",
+    "Seed",
+    "View",
+    "Width",
+    "Workers",
+    "WriteOld",
+    "old",
+    "pick",
+    "plot",
+    "seed",
+    "starts",
+    "task",
+]
