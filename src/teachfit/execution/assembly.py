@@ -9,8 +9,8 @@ truth, recorded beside the measured outcome). Methods (:data:`METHODS`):
 
 - ``"skill"``: seed B's skill alone (its recovery only retracts);
 - ``"search"``: seed A's learned search alone, started on the surface at the taught pose (the
-  same :class:`~teachfit.skills.search.LearnedSearch` node as the joined skill's, then pushed
-  to depth);
+  same :class:`~teachfit.skills.search.LearnedSearch` node as the joined skill's) until the
+  task's success detector fires;
 - ``"open-loop"``: the plan executed open loop: move above the taught hole, then straight down
   to the insertion depth, stiff, whatever the contact says;
 - ``"joined"``: the skill whose recovery is the learned search
@@ -36,7 +36,7 @@ from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
-from teachfit.skills.conditions import DepthAbove, Done, TimeAbove
+from teachfit.skills.conditions import DepthAbove, Detected, Done, TimeAbove
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.library import get_skill
@@ -91,7 +91,8 @@ def open_loop_skill(controller: str = "adaptive") -> Skill:
 
 
 def search_skill(model: SearchModel, controller: str = "adaptive") -> Skill:
-    """Seed A alone: the joined skill's search node, from the start pose, pushed to depth."""
+    """Seed A alone: the joined skill's search node from the start pose until the task's
+    success detector fires (as seed A's runner, :func:`~teachfit.skills.follow.follow_skill`)."""
     joined = peg_in_hole_search.build(model, controller)
     node = joined.node("search")
     return Skill(
@@ -100,7 +101,7 @@ def search_skill(model: SearchModel, controller: str = "adaptive") -> Skill:
         (),
         "search",
         SkillParams(dict(joined.params.context), dict(joined.params.learned)),
-        DepthAbove("depth"),
+        Detected(),
         joined.error,
         doc="learned search alone from the taught pose",
     )

@@ -6,8 +6,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from teachfit.core.errors import ModelError, SkillError
-from teachfit.models.search_model import SearchModel
-from teachfit.skills import peg_in_hole, peg_in_hole_search
+from teachfit.skills import peg_in_hole
 from teachfit.skills.graph import Skill
 from teachfit.skills.loader import load_skill
 
@@ -18,8 +17,12 @@ SKILLS: dict[str, Callable[[str], Skill]] = {peg_in_hole.NAME: peg_in_hole.build
 def get_skill(spec: str, controller: str = "adaptive") -> Skill:
     """A built-in skill by name, one loaded from a ``.toml`` file, or the joined skill
     ``peg-in-hole+search:MODEL`` with the search model file ``MODEL`` as its recovery."""
-    joined = peg_in_hole_search.NAME + ":"
+    joined = "peg-in-hole+search:"
     if spec.startswith(joined):
+        # imported here: the search model pulls in scikit-learn, which plain skills never need
+        from teachfit.models.search_model import SearchModel
+        from teachfit.skills import peg_in_hole_search
+
         try:
             model = SearchModel.load(spec[len(joined) :])
         except ModelError as exc:
