@@ -42,6 +42,9 @@ def assemble(
     demo: Annotated[Path | None, typer.Option(help="l-groove/tenon: demonstration (.h5)")] = None,
     hole_error: Annotated[str, typer.Option(help="taught-hole error, e.g. 3mm")] = "3mm",
     yaw_error: Annotated[str, typer.Option(help="taught yaw error bound, e.g. 2deg")] = "0deg",
+    angle_error: Annotated[
+        str, typer.Option(help="l-groove/tenon: capture rotation error bound")
+    ] = "2deg",
     trials: Annotated[int, typer.Option(help="number of trials")] = 30,
     params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
     controller: Annotated[str, typer.Option(help="adaptive or impedance")] = "adaptive",
@@ -57,9 +60,8 @@ def assemble(
     err = parse_quantity(hole_error)
     yaw = parse_quantity(yaw_error, "deg", "--yaw-error")
     if task in ("l-groove", "tenon"):
-        from teachfit.cli.assemble_plan import assemble_plan
-
-        assemble_plan(task, demo, err, yaw, trials, seed, plot, video)
+        ang = parse_quantity(angle_error, "deg", "--angle-error")
+        _assemble_plan(task, demo, err, ang, trials, seed, plot, video)
         return
     from teachfit.execution.assembly import assembly_jobs, run_assembly
     from teachfit.models.search_model import SearchModel
@@ -159,3 +161,86 @@ def bench_assembly(
 
             path = plot.with_name(f"{plot.stem}-{name}{plot.suffix}")
             console.print(f"figure -> {plot_success_by_error(rows, path, name)}")
+
+
+def _assemble_plan(
+    part: str,
+    demo: Path | None,
+    err: float,
+    ang: float,
+    trials: int,
+    seed: int,
+    plot: Path | None,
+    video: Path | None,
+) -> None:
+    """demonstration -> plan -> path executed in contact -> seating skill, over trials."""
+    import numpy as np
+
+    from teachfit.execution.plan_contact import (
+        PAPER_ROBOT,
+        plan_path,
+        run_plan_trials,
+        timed_path,
+        trial_cell,
+    )
+    from teachfit.metrics.stats import summarize
+
+    if trials < 1:
+        raise TeachfitError(f"--trials must be >= 1, got {trials}")
+    lo_t, lo_r = min(0.0005, err), min(np.radians(0.5), ang)
+    ranges = {"translation": (lo_t, err), "rotation": (lo_r, ang)}
+    d = None
+    if demo is not None:
+        from teachfit.cli.plan_cmd import _load_demo
+
+        d = _load_demo(str(demo))
+        if getattr(d, "task", part) != part:
+            raise TeachfitError(f"{demo}: a demonstration of {d.task!r}, not {part!r}")
+    with console.status("planning"):
+        plan = plan_path(part, d, seed)  # type: ignore[arg-type]
+    if not plan.success:
+        raise TeachfitError(f"no plan for {part}: {plan.message}")
+    path = timed_path(part, plan)
+    console.print(
+        f"{part}: plan in {plan.time_s:.2f} s with {plan.used_key_poses}/{plan.candidates} key "
+        f"poses ({'demo ' + str(demo) if demo else 'synthetic demo'}), {path.duration:.1f} s "
+        f"path; capture error {lo_t * 1e3:g}-{err * 1e3:g} mm, "
+        f"{np.degrees(lo_r):g}-{np.degrees(ang):g} deg"
+    )
+    with progress_bar() as bar:
+        job = bar.add_task("executing in contact", total=trials)
+        out = run_plan_trials(
+            part, path, trials, seed, on_trial=lambda _t: bar.advance(job), **ranges
+        )
+    table = Table(title="trials", title_justify="left")
+    for col in ("#", "error (mm, deg)", "outcome", "time (s)", "truth", "primitives"):
+        table.add_column(col)
+    for tr in out:
+        table.add_row(
+            str(tr.index),
+            f"{tr.error_m * 1e3:.2f}, {np.degrees(tr.error_rad):.2f}",
+            "[green]success[/]" if tr.success else f"[red]{tr.result.reason}[/]",
+            f"{tr.time:.2f}",
+            str(tr.ground_truth),
+            " > ".join(v.node for v in tr.result.visits),
+        )
+    console.print(table)
+    s = summarize([t.success for t in out], [t.time for t in out])
+    truth = sum(bool(t.ground_truth) for t in out)
+    ok, n = PAPER_ROBOT[part]
+    console.print(
+        f"success {s}; ground truth {truth}/{len(out)}; the paper's robot, open loop: {ok}/{n}"
+    )
+    pick = out[0]
+    if plot is not None:
+        from teachfit.viz.assembly_figures import plot_phases
+
+        console.print(f"phases of trial 0 -> {plot_phases(pick.result, plot)}")
+    if video is not None:
+        from teachfit.viz.video import render_motion
+
+        log = pick.result.log
+        cell = trial_cell(part, seed, 0, **ranges)
+        with console.status("rendering"):
+            path_mp4 = render_motion(cell, log.t, log.pos, log.quat, video)
+        console.print(f"video of trial 0 -> {path_mp4}")

@@ -68,8 +68,8 @@ def plot_success_by_error(
     for j, (method, pts) in enumerate(rows.items()):
         e = np.array([p[0] for p in pts]) * 1e3 + 0.04 * (j - len(rows) / 2)
         rate = np.array([p[1].rate for p in pts])
-        lo = rate - np.array([p[1].low for p in pts])
-        hi = np.array([p[1].high for p in pts]) - rate
+        lo = np.clip(rate - np.array([p[1].low for p in pts]), 0.0, None)  # rounding
+        hi = np.clip(np.array([p[1].high for p in pts]) - rate, 0.0, None)
         ax.errorbar(e, rate, yerr=[lo, hi], marker="o", ms=4, capsize=3, lw=1.2, label=method)
     ax.set_xlabel("taught-hole error (mm)")
     ax.set_ylabel("success rate")
