@@ -50,3 +50,8 @@ def test_assemble_bad_input_is_one_line_and_exit_2(peg_model):
     res = invoke("assemble", "--task", "socket3d", "--search", peg_model, "--trials", 1)
     assert res.exit_code == 2 and "learned for task 'peg2d'" in res.output
     assert "Traceback" not in res.output
+
+
+def test_assemble_l_groove_with_a_missing_demo_is_one_line(tmp_path):
+    res = invoke("assemble", "--task", "l-groove", "--demo", tmp_path / "none.h5", "--trials", 1)
+    assert res.exit_code == 2 and "none.h5" in res.output and "Traceback" not in res.output

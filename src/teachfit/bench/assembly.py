@@ -71,6 +71,34 @@ def bench_task(
     return summarise(run_assembly(jobs, workers, progress), methods, errors)
 
 
+def bench_plan_task(
+    part: str,
+    trials: int,
+    seed: int = 0,
+    progress: Callable[[], None] | None = None,
+    max_error: float = 0.003,
+) -> tuple[Rows, dict[str, int]]:
+    """(c) the plan open loop vs (d) joined (compliant tracking + seating skill) on the
+    L-groove or tenon cell, the same capture errors (0.5 mm-``max_error``, 0.5-2 deg) for
+    both; rows keyed by ``max_error``; also the ground-truth successes per method."""
+    from teachfit.execution.plan_contact import plan_path, run_plan_trials, timed_path
+
+    plan = plan_path(part, seed=seed)
+    if not plan.success:
+        raise TeachfitError(f"no plan for {part}: {plan.message}")
+    path = timed_path(part, plan)
+    rows: Rows = {}
+    truth: dict[str, int] = {}
+    for method in ("open-loop", "joined"):
+        out = run_plan_trials(
+            part, path, trials, seed, method, lambda _t: progress() if progress else None,
+            translation=(0.0005, max_error),
+        )  # fmt: skip
+        rows[method] = [(max_error, summarize([t.success for t in out], [t.time for t in out]))]
+        truth[method] = sum(bool(t.ground_truth) for t in out)
+    return rows, truth
+
+
 def losses(rows: Rows, joined: str = "joined") -> list[str]:
     """Where ``joined`` does not beat a single method: a lower success rate, or the same rate
     with a longer median time (one line each)."""

@@ -140,10 +140,22 @@ def bench_assembly(
     ] = None,
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
-    from teachfit.bench.assembly import bench_task, losses
+    from teachfit.bench.assembly import bench_plan_task, bench_task, losses
 
     errs = [parse_quantity(e) for e in errors.split(",") if e.strip()]
     for name in [t.strip() for t in tasks.split(",") if t.strip()]:
+        if name in ("l-groove", "tenon"):
+            with progress_bar() as bar:
+                job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
+                rows, truth = bench_plan_task(name, trials, seed, lambda j=job: bar.advance(j))
+            for m, pts in rows.items():
+                console.print(
+                    f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: "
+                    f"{pts[0][1]}; ground truth {truth[m]}/{trials}"
+                )
+            for line in losses(rows):
+                console.print(f"  [yellow]joined does not beat[/] {line}")
+            continue
         with progress_bar() as bar:
             job = bar.add_task(f"{name}: demonstrations, then trials")
             rows = bench_task(name, errs, trials, seed, workers, lambda j=job: bar.advance(j))
