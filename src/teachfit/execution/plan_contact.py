@@ -97,7 +97,7 @@ def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -
         "seat_depth": ContextParam(-(goal_x + 0.004), "m", "along -G x: goal + capture bound"),
         "v_still": ContextParam(0.002, "m/s", "speed below which the part is stuck"),
         "seat_lateral": ContextParam(
-            float(np.hypot(goal[1], goal[2])) + 0.006, "m", "off the insertion axis: not inside"
+            float(np.hypot(goal[1], goal[2])) + 0.012, "m", "off the insertion axis: not inside"
         ),
         "t_max": ContextParam(float(path.duration) + 8.0, "s", "time limit"),
     }
@@ -118,7 +118,9 @@ def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -
     )
     nodes, transitions = [follow], []
     if method == "joined":
-        seat = Move((0.0, 0.0, -1.0), "v_seat", push=2.0, stiffness=(300, 300, 600, 4, 4, 4))
+        seat = Move(
+            (0.0, 0.0, -1.0), "v_seat", push=2.0, stiffness=(1500, 1500, 600, 150, 150, 150)
+        )
         nodes.append(Node("seat", seat, TimeAbove(6.0), "push along the insertion until seated"))
         transitions.append(Transition("path", "seat", Done()))
     return Skill(
