@@ -34,7 +34,7 @@ from teachfit.execution.batch import episode_rng
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
 from teachfit.plans.cell import G_NOMINAL, PartsCell, PartsCellParams
 from teachfit.plans.parts import build_assembly
-from teachfit.plans.planner import MotionPlanner, PlanResult
+from teachfit.plans.planner import MotionPlanner, PlannerConfig, PlanResult
 from teachfit.plans.synth import synth_demo
 from teachfit.robot.registry import make_robot
 from teachfit.skills.conditions import (
@@ -61,10 +61,16 @@ TRACK = FollowConfig(3000.0, 3000.0, 6000.0, (150.0, 150.0, 150.0), 0.0, False, 
 STIFF = FollowConfig(3000.0, 3000.0, 3000.0, (150.0, 150.0, 150.0), 0.0, False, 0.5, 200.0)
 
 
+#: planning budget per attempt in collision checks: the plan is a function of its inputs and
+#: seed alone, not of the machine's load (a budget in seconds made trials irreproducible)
+MAX_CHECKS = 2000
+
+
 def plan_path(part: str, demo: Demonstration | None = None, seed: int = 0) -> PlanResult:
     """Plan ``L2G`` for ``part`` guided by ``demo`` (default: a synthetic one from ``seed``)."""
     asm = build_assembly(part)
-    return MotionPlanner(asm).plan(demo if demo is not None else synth_demo(asm, seed), seed=seed)
+    planner = MotionPlanner(asm, PlannerConfig(max_checks=MAX_CHECKS))
+    return planner.plan(demo if demo is not None else synth_demo(asm, seed), seed=seed)
 
 
 def timed_path(
