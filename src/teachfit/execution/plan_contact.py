@@ -12,7 +12,7 @@ believes the captured pose:
   the part along the insertion direction; the L is seated when the groove's end wall resists
   within the capture tolerance of the believed goal, the tenon (which nothing stops there) when
   it reaches the believed goal depth; both only when the part is near the insertion axis (not
-  resting on top of the lip or a mortise);
+  resting on top of the lip or a mortise) and level (:data:`SEAT_PITCH`);
 - ``"open-loop"``: the same path tracked stiffly to its end, as seed C did.
 
 Task frame ``T`` of both: the captured fixed-part frame turned so that ``T``'s z is ``G``'s x,
@@ -43,6 +43,7 @@ from teachfit.skills.conditions import (
     ForceAbove,
     LateralAbove,
     SpeedBelow,
+    TiltBelow,
     TimeAbove,
 )
 from teachfit.skills.follow import FollowConfig, FollowSetpoints
@@ -61,6 +62,8 @@ TRACK = FollowConfig(3000.0, 3000.0, 6000.0, (150.0, 150.0, 150.0), 0.0, False, 
 STIFF = FollowConfig(3000.0, 3000.0, 3000.0, (150.0, 150.0, 150.0), 0.0, False, 0.5, 200.0)
 
 
+#: largest pitch (rad) of a seated part
+SEAT_PITCH = np.radians(4.0)
 #: planning budget per attempt in collision checks: the plan is a function of its inputs and
 #: seed alone, not of the machine's load (a budget in seconds made trials irreproducible)
 MAX_CHECKS = 2000
@@ -107,7 +110,10 @@ def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -
         ),
         "t_max": ContextParam(float(path.duration) + 8.0, "s", "time limit"),
     }
-    inside = TimeAbove("t_path", scope="skill") & ~LateralAbove("seat_lateral")  # not on top
+    # near the axis (not on top of the lip or a mortise) and level: the part's z (G's z at the
+    # goal) stays at 90 deg from T's z (G's x) within "seat_pitch" (pitch left from the pivot)
+    level = TiltBelow(np.pi / 2 + SEAT_PITCH) & ~TiltBelow(np.pi / 2 - SEAT_PITCH)
+    inside = TimeAbove("t_path", scope="skill") & ~LateralAbove("seat_lateral") & level
     if part == "tenon":  # nothing stops the bar at its goal: seated = at the believed depth
         ctx["seat_depth"] = ContextParam(-goal_x, "m", "along -G x: the goal")
         seated = inside & DepthAbove("seat_depth")
