@@ -27,7 +27,8 @@ def _save(fig: plt.Figure, path: str | Path) -> Path:
 
 def plot_phases(trace: ExecutionResult, path: str | Path, title: str = "") -> Path:
     """Which primitive was active when (coloured bands), the force on the tool (N) and the
-    depth below the taught hole entry (mm) over time (s since the start)."""
+    depth along the task frame's -z (mm; below the taught hole entry for peg tasks) over time
+    (s since the start)."""
     log = trace.log
     fig, (ax0, ax1, ax2) = plt.subplots(
         3, 1, sharex=True, figsize=(8.0, 6.5), height_ratios=(1, 2, 2), constrained_layout=True
@@ -47,7 +48,7 @@ def plot_phases(trace: ExecutionResult, path: str | Path, title: str = "") -> Pa
     ax1.plot(log.t, np.linalg.norm(log.wrench[:, :3], axis=1), color="k", lw=0.8, label="|F|")
     ax1.set_ylabel("force on tool (N)")
     ax2.plot(log.t, log.depth * 1e3, color="tab:purple", lw=1.2)
-    ax2.set_ylabel("depth below taught entry (mm)")
+    ax2.set_ylabel("depth along task -z (mm)")
     ax2.set_xlabel("time (s)")
     for ax in (ax0, ax1, ax2):
         for v in trace.visits:
