@@ -57,8 +57,8 @@ T2G = Pose(np.zeros(3), rotation_to_wxyz(Rotation.from_euler("y", np.pi / 2)))
 PAPER_ROBOT = {"l-groove": (4, 5), "tenon": (3, 5)}
 #: path tracking of ``"joined"``: as stiff as the open loop's (softer tracking, 300-1500 N/m
 #: and 4-60 N m/rad, let the pivoting L lag and slide onto the lip more often: 5-7 of 10 truly
-#: inserted against 8-9 of 10, BENCHMARKS.md), with the seating skill after it
-TRACK = FollowConfig(3000.0, 3000.0, 6000.0, (150.0, 150.0, 150.0), 0.0, False, 0.0, 200.0)
+#: inserted, BENCHMARKS.md), with the seating skill after it
+TRACK = FollowConfig(3000.0, 3000.0, 3000.0, (150.0, 150.0, 150.0), 0.0, False, 0.0, 200.0)
 STIFF = FollowConfig(3000.0, 3000.0, 3000.0, (150.0, 150.0, 150.0), 0.0, False, 0.5, 200.0)
 
 
