@@ -9,7 +9,14 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import typer  # noqa: E402
 
-from teachfit.cli import capture_cmd, learn_cmd, plan_cmd, robot_cmd, skill_cmd  # noqa: E402
+from teachfit.cli import (  # noqa: E402
+    assemble_cmd,  # noqa: E402
+    capture_cmd,
+    learn_cmd,
+    plan_cmd,
+    robot_cmd,
+    skill_cmd,
+)
 from teachfit.cli.bench_search_cmd import bench_search  # noqa: E402
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
@@ -65,6 +72,7 @@ bench_app.command("search")(bench_search)
 app.add_typer(robot_cmd.robot_app, name="robot")
 bench_app.command("robot")(robot_cmd.bench_robot)
 register(app, bench_app)
+assemble_cmd.register(app, bench_app)
 
 
 def main() -> None:

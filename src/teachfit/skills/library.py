@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from teachfit.core.errors import SkillError
+from teachfit.core.errors import ModelError, SkillError
 from teachfit.skills import peg_in_hole
 from teachfit.skills.graph import Skill
 from teachfit.skills.loader import load_skill
@@ -15,11 +15,26 @@ SKILLS: dict[str, Callable[[str], Skill]] = {peg_in_hole.NAME: peg_in_hole.build
 
 
 def get_skill(spec: str, controller: str = "adaptive") -> Skill:
-    """A built-in skill by name, or one loaded from a ``.toml`` file."""
+    """A built-in skill by name, one loaded from a ``.toml`` file, or the joined skill
+    ``peg-in-hole+search:MODEL`` with the search model file ``MODEL`` as its recovery."""
+    joined = "peg-in-hole+search:"
+    if spec.startswith(joined):
+        # imported here: the search model pulls in scikit-learn, which plain skills never need
+        from teachfit.models.search_model import SearchModel
+        from teachfit.skills import peg_in_hole_search
+
+        try:
+            model = SearchModel.load(spec[len(joined) :])
+        except ModelError as exc:
+            raise SkillError(f"{exc} (the skill {spec!r} needs a search model file)") from exc
+        return peg_in_hole_search.build(model, controller)
     if spec in SKILLS:
         return SKILLS[spec](controller)
     if spec.endswith(".toml"):
         if not Path(spec).exists():
             raise SkillError(f"skill file {spec} does not exist")
         return load_skill(spec)
-    raise SkillError(f"unknown skill {spec!r}; built-in skills: {sorted(SKILLS)} (or a .toml file)")
+    raise SkillError(
+        f"unknown skill {spec!r}; built-in skills: {sorted(SKILLS)}, a .toml file, or "
+        f"{joined}MODEL (a search model file)"
+    )

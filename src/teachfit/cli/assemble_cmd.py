@@ -1,0 +1,258 @@
+"""``teachfit assemble`` and ``teachfit bench assembly``: the three seeds joined."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.progress import progress_bar
+from teachfit.core.errors import TeachfitError
+
+_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "deg": 0.017453292519943295, "rad": 1.0}
+
+
+def parse_quantity(text: str, default_unit: str = "mm", what: str = "--hole-error") -> float:
+    """``"3mm"``, ``"0.5 cm"``, ``"2"`` (``default_unit``) -> SI (m, rad)."""
+    m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:e-?[0-9]+)?)\s*([a-z]*)\s*", text.lower())
+    if m is None or (m.group(2) or default_unit) not in _UNITS:
+        raise TeachfitError(f"{what}: cannot read {text!r}; write e.g. 3mm, 0.5cm, 2deg")
+    return float(m.group(1)) * _UNITS[m.group(2) or default_unit]
+
+
+def register(app: typer.Typer, bench_app: typer.Typer) -> None:
+    """Add ``assemble`` to ``app`` and ``assembly`` to ``bench_app``."""
+    app.command("assemble")(assemble)
+    bench_app.command("assembly")(bench_assembly)
+
+
+@guarded
+def assemble(
+    task: Annotated[
+        str, typer.Option(help="peg2d, socket3d, puzzle, key, peg; l-groove, tenon")
+    ] = "peg2d",
+    search: Annotated[
+        Path | None, typer.Option(help="search model (teachfit learn search)")
+    ] = None,
+    skill: Annotated[str, typer.Option(help="the skill the search recovers")] = "peg-in-hole",
+    demo: Annotated[Path | None, typer.Option(help="l-groove/tenon: demonstration (.h5)")] = None,
+    hole_error: Annotated[str, typer.Option(help="taught-hole error, e.g. 3mm")] = "3mm",
+    yaw_error: Annotated[str, typer.Option(help="taught yaw error bound, e.g. 2deg")] = "0deg",
+    angle_error: Annotated[
+        str, typer.Option(help="l-groove/tenon: capture rotation error bound")
+    ] = "2deg",
+    trials: Annotated[int, typer.Option(help="number of trials")] = 30,
+    params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
+    controller: Annotated[str, typer.Option(help="adaptive or impedance")] = "adaptive",
+    seed: Annotated[int, typer.Option(help="seed of the trials")] = 0,
+    workers: Annotated[int, typer.Option(help="worker processes (0: in this process)")] = 0,
+    plot: Annotated[Path | None, typer.Option(help="phases of one trial over time")] = None,
+    video: Annotated[Path | None, typer.Option(help="render that trial to this mp4")] = None,
+    robot: RobotOpt = "floating",
+) -> None:
+    """Assemble over trials: taught hole -> approach -> skill -> learned search recovery."""
+    from teachfit.metrics.stats import summarize
+
+    err = parse_quantity(hole_error)
+    yaw = parse_quantity(yaw_error, "deg", "--yaw-error")
+    if task in ("l-groove", "tenon"):
+        ang = parse_quantity(angle_error, "deg", "--angle-error")
+        _assemble_plan(task, demo, err, ang, trials, seed, plot, video)
+        return
+    from teachfit.execution.assembly import assembly_jobs, run_assembly
+    from teachfit.models.search_model import SearchModel
+    from teachfit.skills.library import get_skill
+    from teachfit.skills.params import read_params_toml
+
+    if trials < 1:
+        raise TeachfitError(f"--trials must be >= 1, got {trials}")
+    model = SearchModel.load(search, task=task) if search is not None else None
+    if model is not None and skill != "peg-in-hole":
+        raise TeachfitError(f"the learned search recovers the peg-in-hole skill, not {skill!r}")
+    method = "joined" if model is not None else "skill"
+    learned: dict[str, float] = {}
+    if params is not None:
+        from teachfit.execution.assembly import method_skill
+
+        sk = method_skill(method, model, skill, controller)
+        learned = read_params_toml(params, sk.params, sk.users())
+    else:
+        get_skill(skill, controller)  # a bad --skill fails before any trial
+    jobs = assembly_jobs(
+        task, [method], [err], trials, model, seed=seed, yaw_error=yaw, skill=skill,
+        controller=controller, learned=tuple(sorted(learned.items())), robot=robot,
+        keep_log=plot is not None or video is not None,
+    )  # fmt: skip
+    what = "skill with learned-search recovery" if model else f"{skill} alone (no --search)"
+    console.print(f"{task}: {what}; taught hole off by {err * 1e3:g} mm; {trials} trial(s)")
+    with progress_bar() as bar:
+        job = bar.add_task("assembling", total=len(jobs))
+        out = run_assembly(jobs, workers, lambda: bar.advance(job))
+    table = Table(title="trials", title_justify="left")
+    for col in ("#", "taught offset (mm)", "outcome", "time (s)", "truth", "primitives"):
+        table.add_column(col)
+    for tr in out:
+        table.add_row(
+            str(tr.index),
+            f"({tr.offset[0] * 1e3:+.2f}, {tr.offset[1] * 1e3:+.2f})",
+            "[green]success[/]" if tr.success else f"[red]{tr.reason}[/]",
+            f"{tr.time:.2f}",
+            str(tr.ground_truth),
+            " > ".join(tr.nodes),
+        )
+    console.print(table)
+    s = summarize([t.success for t in out], [t.time for t in out])
+    searched = sum("search" in t.nodes for t in out)
+    console.print(f"success {s}; the search ran in {searched}/{len(out)} trial(s)")
+    if plot is None and video is None:
+        return
+    pick = next((t for t in out if "search" in t.nodes and t.success), out[0])
+    assert pick.result is not None
+    if plot is not None:
+        from teachfit.viz.assembly_figures import plot_phases
+
+        console.print(f"phases of trial {pick.index} -> {plot_phases(pick.result, plot)}")
+    if video is not None:
+        from teachfit.tasks.registry import get_task
+        from teachfit.viz.video import render_motion
+
+        log = pick.result.log
+        with console.status("rendering"):
+            path = render_motion(get_task(task), log.t, log.pos, log.quat, video, robot=robot)
+        console.print(f"video of trial {pick.index} -> {path}")
+
+
+@guarded
+def bench_assembly(
+    tasks: Annotated[str, typer.Option(help="comma-separated tasks")] = "peg2d,socket3d",
+    errors: Annotated[
+        str, typer.Option(help="taught-hole errors (mm), comma-separated")
+    ] = "0,1,2,3,4,5",
+    trials: Annotated[int, typer.Option(help="trials per method and error")] = 10,
+    seed: Annotated[int, typer.Option(help="seed of demonstrations and trials")] = 0,
+    workers: Annotated[int | None, typer.Option(help="processes (default: all cores)")] = None,
+    plot: Annotated[
+        Path | None, typer.Option(help="success-vs-error figure (one per task)")
+    ] = None,
+) -> None:
+    """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
+    from teachfit.bench.assembly import bench_plan_task, bench_task, losses
+
+    errs = [parse_quantity(e) for e in errors.split(",") if e.strip()]
+    for name in [t.strip() for t in tasks.split(",") if t.strip()]:
+        if name in ("l-groove", "tenon"):
+            with progress_bar() as bar:
+                job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
+                rows, meas = bench_plan_task(name, trials, seed, lambda j=job: bar.advance(j))
+            for m, pts in rows.items():
+                console.print(
+                    f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
+                    f"inserted {pts[0][1]} (end time); measured success {meas[m]}/{trials}"
+                )
+            for line in losses(rows):
+                console.print(f"  [yellow]joined does not beat[/] {line}")
+            continue
+        with progress_bar() as bar:
+            job = bar.add_task(f"{name}: demonstrations, then trials")
+            rows = bench_task(name, errs, trials, seed, workers, lambda j=job: bar.advance(j))
+        table = Table(title=f"{name}: success [Wilson 95 %], median time", title_justify="left")
+        table.add_column("error (mm)", justify="right")
+        for method in rows:
+            table.add_column(method)
+        for i, e in enumerate(errs):
+            table.add_row(f"{e * 1e3:g}", *(str(rows[m][i][1]) for m in rows))
+        console.print(table)
+        for line in losses(rows):
+            console.print(f"  [yellow]joined does not beat[/] {line}")
+        if plot is not None:
+            from teachfit.viz.assembly_figures import plot_success_by_error
+
+            path = plot.with_name(f"{plot.stem}-{name}{plot.suffix}")
+            console.print(f"figure -> {plot_success_by_error(rows, path, name)}")
+
+
+def _assemble_plan(
+    part: str,
+    demo: Path | None,
+    err: float,
+    ang: float,
+    trials: int,
+    seed: int,
+    plot: Path | None,
+    video: Path | None,
+) -> None:
+    """demonstration -> plan -> path executed in contact -> seating skill, over trials."""
+    import numpy as np
+
+    from teachfit.execution.plan_contact import (
+        PAPER_ROBOT,
+        plan_path,
+        run_plan_trials,
+        timed_path,
+        trial_cell,
+    )
+    from teachfit.metrics.stats import summarize
+
+    if trials < 1:
+        raise TeachfitError(f"--trials must be >= 1, got {trials}")
+    lo_t, lo_r = min(0.0005, err), min(np.radians(0.5), ang)
+    ranges = {"translation": (lo_t, err), "rotation": (lo_r, ang)}
+    d = None
+    if demo is not None:
+        from teachfit.cli.plan_cmd import _load_demo
+
+        d = _load_demo(str(demo))
+        if getattr(d, "task", part) != part:
+            raise TeachfitError(f"{demo}: a demonstration of {d.task!r}, not {part!r}")
+    with console.status("planning"):
+        plan = plan_path(part, d, seed)  # type: ignore[arg-type]
+    if not plan.success:
+        raise TeachfitError(f"no plan for {part}: {plan.message}")
+    path = timed_path(part, plan)
+    console.print(
+        f"{part}: plan in {plan.time_s:.2f} s with {plan.used_key_poses}/{plan.candidates} key "
+        f"poses ({'demo ' + str(demo) if demo else 'synthetic demo'}), {path.duration:.1f} s "
+        f"path; capture error {lo_t * 1e3:g}-{err * 1e3:g} mm, "
+        f"{np.degrees(lo_r):g}-{np.degrees(ang):g} deg"
+    )
+    with progress_bar() as bar:
+        job = bar.add_task("executing in contact", total=trials)
+        out = run_plan_trials(
+            part, path, trials, seed, on_trial=lambda _t: bar.advance(job), **ranges
+        )
+    table = Table(title="trials", title_justify="left")
+    for col in ("#", "error (mm, deg)", "outcome", "time (s)", "truth", "primitives"):
+        table.add_column(col)
+    for tr in out:
+        table.add_row(
+            str(tr.index),
+            f"{tr.error_m * 1e3:.2f}, {np.degrees(tr.error_rad):.2f}",
+            "[green]success[/]" if tr.success else f"[red]{tr.result.reason}[/]",
+            f"{tr.time:.2f}",
+            str(tr.ground_truth),
+            " > ".join(v.node for v in tr.result.visits),
+        )
+    console.print(table)
+    s = summarize([t.success for t in out], [t.time for t in out])
+    truth = sum(bool(t.ground_truth) for t in out)
+    ok, n = PAPER_ROBOT[part]
+    console.print(
+        f"success {s}; ground truth {truth}/{len(out)}; the paper's robot, open loop: {ok}/{n}"
+    )
+    pick = out[0]
+    if plot is not None:
+        from teachfit.viz.assembly_figures import plot_phases
+
+        console.print(f"phases of trial 0 -> {plot_phases(pick.result, plot)}")
+    if video is not None:
+        from teachfit.viz.video import render_motion
+
+        log = pick.result.log
+        cell = trial_cell(part, seed, 0, **ranges)
+        with console.status("rendering"):
+            path_mp4 = render_motion(cell, log.t, log.pos, log.quat, video)
+        console.print(f"video of trial 0 -> {path_mp4}")

@@ -1,0 +1,252 @@
+"""The whole peg-type assembly over trials: taught hole -> approach -> skill -> search recovery.
+
+Each trial draws, from :func:`~teachfit.execution.batch.episode_seed` ``(seed, i)`` only (so
+every method sees the same trials), a *taught* hole pose: the true hole moved by exactly
+``hole_error`` (m) in a uniformly random direction of the surface plane, its yaw by a uniform
+``+-yaw_error`` (rad, tasks whose yaw matters), and a start 25 mm above it (1 mm jitter). The
+skill's task frame is the taught hole; the true hole is known only to the simulator (ground
+truth, recorded beside the measured outcome). Methods (:data:`METHODS`):
+
+- ``"skill"``: seed B's skill alone (its recovery only retracts);
+- ``"search"``: seed A's learned search alone, started on the surface at the taught pose (the
+  same :class:`~teachfit.skills.search.LearnedSearch` node as the joined skill's) until the
+  task's success detector fires;
+- ``"open-loop"``: the plan executed open loop: move above the taught hole, then straight down
+  to the insertion depth, stiff, whatever the contact says;
+- ``"joined"``: the skill whose recovery is the learned search
+  (:mod:`teachfit.skills.peg_in_hole_search`).
+
+Jobs carry plain values (the model as its JSON document) so they run in worker processes.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+
+from teachfit.core.errors import TeachfitError
+from teachfit.core.geometry import Pose
+from teachfit.execution.batch import episode_rng, episode_seed, run_batch
+from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
+from teachfit.models.search_model import SearchModel
+from teachfit.robot.interface import Robot
+from teachfit.robot.registry import make_robot
+from teachfit.skills import peg_in_hole, peg_in_hole_search
+from teachfit.skills.conditions import DepthAbove, Detected, Done, TimeAbove
+from teachfit.skills.controllers import controller_spec
+from teachfit.skills.graph import Node, Skill, Transition
+from teachfit.skills.library import get_skill
+from teachfit.skills.params import SkillParams
+from teachfit.skills.primitive import MoveTo
+from teachfit.tasks.base import Task
+from teachfit.tasks.registry import get_task
+
+METHODS = ("skill", "search", "open-loop", "joined")
+#: start height above the taught hole's surface (m)
+START_HEIGHT = 0.025
+
+
+def taught_hole(task: Task, hole_error: float, yaw_error: float, rng: np.random.Generator) -> Pose:
+    """The true hole moved ``hole_error`` (m) in a random direction, yaw within ``+-yaw_error``
+    (rad, only where the yaw matters)."""
+    if not (np.isfinite(hole_error) and hole_error >= 0 and yaw_error >= 0):
+        raise TeachfitError(f"hole error must be >= 0, got {hole_error} m, {yaw_error} rad")
+    ang = rng.uniform(0.0, 2 * np.pi)
+    yaw = rng.uniform(-yaw_error, yaw_error) if task.has_rz else 0.0
+    err = Pose.from_xyz_rz(hole_error * np.cos(ang), hole_error * np.sin(ang), 0.0, yaw)
+    return task.hole2world.compose(err)
+
+
+def open_loop_skill(controller: str = "adaptive") -> Skill:
+    """The plan executed open loop: above the taught hole, then straight down to depth."""
+    base = peg_in_hole.build(controller)
+    stiff = (2000.0, 2000.0, 2000.0, 80.0, 80.0, 80.0)
+    fast = {k: k for k in ("v_max", "a_max", "w_max", "dw_max", "speed_factor")}
+    nodes = (
+        Node(
+            "approach",
+            MoveTo(goal=(0.0, 0.0, "approach_height"), yaw=0.0, tilt=0.0, stiffness=stiff, **fast),
+            TimeAbove("t_approach"),
+        ),
+        Node(
+            "descend",
+            MoveTo(goal=(0.0, 0.0, "-depth"), stiffness=stiff, **(fast | {"v_max": "v_insert"})),
+            TimeAbove("t_approach"),
+        ),
+    )
+    return Skill(
+        "open-loop",
+        nodes,
+        (Transition("approach", "descend", Done()),),
+        "approach",
+        base.params,
+        DepthAbove("depth"),
+        base.error,
+        doc="the taught hole's plan executed open loop",
+    )
+
+
+def search_skill(model: SearchModel, controller: str = "adaptive") -> Skill:
+    """Seed A alone: the joined skill's search node from the start pose until the task's
+    success detector fires (as seed A's runner, :func:`~teachfit.skills.follow.follow_skill`)."""
+    joined = peg_in_hole_search.build(model, controller)
+    node = joined.node("search")
+    return Skill(
+        "search",
+        (Node("search", node.primitive, TimeAbove("t_search") | Done()),),
+        (),
+        "search",
+        SkillParams(dict(joined.params.context), dict(joined.params.learned)),
+        Detected(),
+        joined.error,
+        doc="learned search alone from the taught pose",
+    )
+
+
+def method_skill(method: str, model: SearchModel | None, skill: str, controller: str) -> Skill:
+    """The skill graph a method runs (``skill``: the base skill spec for ``"skill"``)."""
+    if method == "skill":
+        return get_skill(skill, controller)
+    if method == "open-loop":
+        return open_loop_skill(controller)
+    if model is None:
+        raise TeachfitError(f"method {method!r} needs a search model (--search MODEL)")
+    if method == "search":
+        return search_skill(model, controller)
+    if method == "joined":
+        return peg_in_hole_search.build(model, controller)
+    raise TeachfitError(f"unknown assembly method {method!r}; choose from {METHODS}")
+
+
+@dataclass(frozen=True)
+class AssemblyJob:
+    """One trial of one method (plain values; see the module docstring)."""
+
+    task: str
+    overrides: tuple[tuple[str, float], ...]
+    model_json: str
+    method: str
+    hole_error: float
+    index: int
+    seed: int = 0
+    yaw_error: float = 0.0
+    skill: str = "peg-in-hole"
+    controller: str = "adaptive"
+    learned: tuple[tuple[str, float], ...] = ()
+    robot: str = "floating"
+    keep_log: bool = False
+
+
+@dataclass(frozen=True)
+class AssemblyTrial:
+    """What one trial did: measured success, time to insertion (s, NaN on failure), simulator
+    ground truth, the taught hole's offset (m, world x-y), nodes visited; ``result`` the full
+    execution (with its log) when the job asked to keep it."""
+
+    method: str
+    hole_error: float
+    index: int
+    success: bool
+    time: float
+    ground_truth: bool | None
+    offset: tuple[float, float]
+    nodes: tuple[str, ...]
+    reason: str
+    result: ExecutionResult | None = None
+
+
+@cache
+def _task(name: str, overrides: tuple[tuple[str, float], ...]) -> Task:
+    return get_task(name, **dict(overrides))
+
+
+@cache
+def _robot(name: str, overrides: tuple[tuple[str, float], ...], robot: str) -> Robot:
+    return make_robot(robot, _task(name, overrides), seed=0)
+
+
+@cache
+def _model(doc: str) -> SearchModel | None:
+    return SearchModel.from_dict(json.loads(doc)) if doc else None
+
+
+def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
+    """Run one trial in this process (task, robot and model cached per process)."""
+    task = _task(job.task, job.overrides)
+    robot = _robot(job.task, job.overrides, job.robot)
+    rng = episode_rng(job.seed, job.index)
+    taught = taught_hole(task, job.hole_error, job.yaw_error, rng)
+    ctx = peg_in_hole.hole_context(task, rng)
+    values = dict(ctx.values)
+    if job.method == "search":  # start on the surface at the taught pose
+        start = taught.compose(Pose(np.array([0.0, 0.0, task.surface_z - task.hole2world.pos[2]])))
+    else:
+        jitter = rng.normal(0.0, 0.001, 2)
+        above = task.surface_z - task.hole2world.pos[2] + START_HEIGHT
+        start = taught.compose(Pose.from_xyz_rz(jitter[0], jitter[1], above, 0.0))
+    base = method_skill(job.method, _model(job.model_json), job.skill, job.controller)
+    if "search_seed" in base.params.context:
+        values["search_seed"] = float(episode_seed(job.seed, job.index))
+    sk = base.with_context({k: v for k, v in values.items() if k in base.params.context})
+    learned = {k: v for k, v in job.learned if k in sk.params.learned}
+    t_max = sk.params.context["t_max"].value
+    res = execute(
+        sk,
+        robot,
+        start,
+        taught,
+        learned,
+        task=task,
+        goal2world=ctx.goal2world,
+        config=ExecConfig(max_time=t_max + 1.0, log_rate=100.0 if job.keep_log else 20.0),
+        controller=controller_spec(job.controller, sk.resolve(learned)),
+    )
+    off = taught.pos[:2] - task.hole2world.pos[:2]
+    return AssemblyTrial(
+        job.method,
+        job.hole_error,
+        job.index,
+        res.success,
+        res.time_to_success,
+        res.ground_truth_inserted,
+        (float(off[0]), float(off[1])),
+        tuple(v.node for v in res.visits),
+        f"{res.outcome.value}: {res.reason}",
+        res if job.keep_log else None,
+    )
+
+
+def assembly_jobs(
+    task: str,
+    methods: Sequence[str],
+    hole_errors: Sequence[float],
+    trials: int,
+    model: SearchModel | None = None,
+    **kw: object,
+) -> list[AssemblyJob]:
+    """Jobs for every method x hole error x trial (trial ``i`` is the same for all methods)."""
+    if trials < 1:
+        raise TeachfitError(f"number of trials must be >= 1, got {trials}")
+    for m in methods:
+        method_skill(m, model, str(kw.get("skill", "peg-in-hole")), "impedance")  # fail early
+    doc = "" if model is None else json.dumps(model.to_dict(), sort_keys=True)
+    ov = tuple(sorted(kw.pop("overrides", ()) or ()))  # type: ignore[call-overload]
+    return [
+        AssemblyJob(task, ov, doc, m, float(e), i, **kw)  # type: ignore[arg-type]
+        for m in methods
+        for e in hole_errors
+        for i in range(trials)
+    ]
+
+
+def run_assembly(
+    jobs: Sequence[AssemblyJob],
+    workers: int | None = 0,
+    progress: Callable[[], None] | None = None,
+) -> list[AssemblyTrial]:
+    """Run ``jobs`` in order (``workers``: processes; 0: in this process)."""
+    return run_batch(run_assembly_job, jobs, workers, progress)

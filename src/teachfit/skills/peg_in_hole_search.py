@@ -1,0 +1,88 @@
+"""Seed B's peg-in-hole skill whose recovery is seed A's learned search (the seeds joined).
+
+The graph is :func:`teachfit.skills.peg_in_hole.build`'s with one more node, ``search``
+(:class:`~teachfit.skills.search.LearnedSearch`), and three more transitions::
+
+    approach -> contact -> lateral --constrained--> align -> insert  (success: depth)
+                              |                       ^        |
+                    gave up: t_switch or roi          |   stuck: t_stuck without dropping
+                              v                       |        v
+                              +-----------------> search <-----+
+                                      dropped in: drop_depth -> align
+
+``lateral`` gives up after the learned ``t_switch`` (or on leaving the region of interest)
+instead of failing; ``insert`` gives up after pushing ``t_stuck`` without the part dropping
+below the surface (the lateral move stopped on a false constraint). Both enter the search,
+which ends with the part caught in the hole (``drop_depth`` below the entry) -> ``align`` ->
+``insert``, or with the tour done / ``t_search`` over -> error -> ``retract``.
+
+Learned, besides seed B's: ``t_switch``, ``t_stuck`` (when to switch to search) and the
+search's ``search_points``, ``search_scale``, ``search_speed``, ``search_push``; the meta
+learners tune them with the rest. Context adds ``t_search``, ``search_seed`` and raises the
+skill's ``t_max`` to leave time for a search.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from teachfit.core.params import ParamDomain
+from teachfit.models.search_model import SearchModel
+from teachfit.skills import peg_in_hole
+from teachfit.skills.conditions import DepthAbove, Done, LateralAbove, TimeAbove
+from teachfit.skills.graph import Node, Skill, Transition
+from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
+from teachfit.skills.search import LearnedSearch
+
+NAME = "peg-in-hole+search"
+
+CONTEXT: dict[str, ContextParam] = {
+    "t_max": ContextParam(25.0, "s", "time limit of the skill, search included"),
+    "t_lateral": ContextParam(3.0, "s", "hard time limit of the lateral move"),
+    "t_search": ContextParam(15.0, "s", "time limit of the search"),
+    "search_seed": ContextParam(0.0, "", "seed of the search's samples"),
+}
+
+LEARNED: dict[str, LearnedParam] = {
+    "t_switch": LearnedParam(0.8, ParamDomain(0.2, 2.0), "s", "lateral time before searching"),
+    "t_stuck": LearnedParam(0.6, ParamDomain(0.2, 2.0), "s", "insert time without drop, search"),
+    "search_points": LearnedParam(60.0, ParamDomain(10.0, 200.0), "", "TSHIX samples"),
+    "search_scale": LearnedParam(0.5, ParamDomain(0.1, 1.5), "", "scales the human's spread"),
+    "search_speed": LearnedParam(1.0, ParamDomain(0.5, 2.0), "", "scales the teacher's speed"),
+    "search_push": LearnedParam(6.0, ParamDomain(2.0, 12.0), "N", "push onto the surface"),
+}
+
+
+def build(model: SearchModel, controller: str = "adaptive") -> Skill:
+    """The joined skill with search ``model`` (learned on the same kind of task)."""
+    base = peg_in_hole.build(controller)
+    params = SkillParams(
+        dict(base.params.context) | CONTEXT, dict(base.params.learned) | dict(LEARNED)
+    )
+    dropped = DepthAbove("drop_depth")
+    nodes = tuple(
+        replace(n, error=TimeAbove("t_lateral")) if n.name == "lateral" else n for n in base.nodes
+    )
+    search = Node(
+        "search",
+        LearnedSearch(model),
+        TimeAbove("t_search") | Done(),
+        "learned search (TSHIX + GMR feed-forward) from where the skill is",
+    )
+    transitions = base.transitions + (
+        Transition("lateral", "search", TimeAbove("t_switch") | LateralAbove("roi")),
+        Transition("insert", "search", TimeAbove("t_stuck") & ~dropped),
+        Transition("search", "align", dropped),
+    )
+    return Skill(
+        name=NAME,
+        nodes=nodes + (search,),
+        transitions=transitions,
+        start=base.start,
+        params=params,
+        success=base.success,
+        error=base.error,
+        pre=base.pre,
+        recovery=base.recovery,
+        doc="seed B's peg-in-hole whose recovery is seed A's learned search",
+    )

@@ -1,0 +1,57 @@
+"""``teachfit assemble`` through typer's CliRunner."""
+
+import pytest
+from media_checks import read_png
+from search_models import raster_model
+from typer.testing import CliRunner
+
+from teachfit.cli import app
+from teachfit.cli.assemble_cmd import parse_quantity
+from teachfit.core.errors import TeachfitError
+from teachfit.tasks import get_task
+
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def peg_model(tmp_path_factory):
+    return raster_model(get_task("peg2d")).save(tmp_path_factory.mktemp("models") / "peg.model")
+
+
+def test_parse_quantity_reads_units():
+    assert parse_quantity("3mm") == pytest.approx(0.003)
+    assert parse_quantity("0.5 cm") == pytest.approx(0.005)
+    assert parse_quantity("2") == pytest.approx(0.002)
+    assert parse_quantity("90deg", "deg") == pytest.approx(1.5707963)
+    with pytest.raises(TeachfitError, match="--hole-error"):
+        parse_quantity("3 furlongs")
+
+
+def test_assemble_reports_success_and_plots_the_phases(tmp_path, peg_model):
+    model = peg_model
+    png = tmp_path / "phases.png"
+    res = invoke(
+        "assemble", "--task", "peg2d", "--search", model, "--hole-error", "0mm",
+        "--trials", 1, "--plot", png,
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "success 1/1 = 100 %" in res.output and "[21, 100] %" in res.output
+    assert "lateral" in res.output
+    read_png(png)
+
+
+def test_assemble_bad_input_is_one_line_and_exit_2(peg_model):
+    res = invoke("assemble", "--task", "peg2d", "--hole-error", "3 furlongs")
+    assert res.exit_code == 2 and "cannot read '3 furlongs'" in res.output
+    res = invoke("assemble", "--task", "socket3d", "--search", peg_model, "--trials", 1)
+    assert res.exit_code == 2 and "learned for task 'peg2d'" in res.output
+    assert "Traceback" not in res.output
+
+
+def test_assemble_l_groove_with_a_missing_demo_is_one_line(tmp_path):
+    res = invoke("assemble", "--task", "l-groove", "--demo", tmp_path / "none.h5", "--trials", 1)
+    assert res.exit_code == 2 and "none.h5" in res.output and "Traceback" not in res.output

@@ -1,0 +1,67 @@
+"""Trials of whole assemblies: the same taught holes for every method, each method's graph."""
+
+import numpy as np
+import pytest
+from search_models import raster_model
+
+from teachfit.core.errors import TeachfitError
+from teachfit.execution.assembly import (
+    assembly_jobs,
+    method_skill,
+    run_assembly,
+    taught_hole,
+)
+from teachfit.tasks import get_task
+
+
+@pytest.fixture(scope="module")
+def peg():
+    task = get_task("peg2d")
+    return task, raster_model(task)
+
+
+def test_taught_hole_is_off_by_exactly_the_error():
+    task = get_task("peg2d")
+    for seed in range(3):
+        pose = taught_hole(task, 0.003, 0.1, np.random.default_rng(seed))
+        off = pose.pos - task.hole2world.pos
+        assert np.hypot(off[0], off[1]) == pytest.approx(0.003) and off[2] == 0.0
+        assert pose.rz == 0.0  # peg2d's yaw does not matter
+    sock = get_task("socket3d")
+    yaws = [taught_hole(sock, 0.0, 0.1, np.random.default_rng(s)).rz for s in range(20)]
+    assert 0 < max(abs(y) for y in yaws) <= 0.1
+    with pytest.raises(TeachfitError, match="hole error"):
+        taught_hole(task, -0.001, 0.0, np.random.default_rng(0))
+
+
+def test_every_method_has_its_graph_and_search_needs_a_model(peg):
+    _, model = peg
+    names = {
+        m: method_skill(m, model, "peg-in-hole", "impedance").name
+        for m in ("skill", "search", "open-loop", "joined")
+    }
+    assert names == {
+        "skill": "peg-in-hole",
+        "search": "search",
+        "open-loop": "open-loop",
+        "joined": "peg-in-hole+search",
+    }
+    with pytest.raises(TeachfitError, match="search model"):
+        assembly_jobs("peg2d", ["joined"], [0.0], 1, None)
+    with pytest.raises(TeachfitError, match="unknown assembly method"):
+        assembly_jobs("peg2d", ["magic"], [0.0], 1, model)
+
+
+def test_same_trials_for_every_method_and_open_loop_misses_a_far_hole(peg):
+    _, model = peg
+    learned = (("search_points", 10.0),)  # a short search: the test checks the plumbing
+    jobs = assembly_jobs(
+        "peg2d", ["open-loop", "joined"], [0.004], 1, model, keep_log=True, learned=learned
+    )
+    ol, joined = run_assembly(jobs, workers=0)
+    assert ol.offset == joined.offset  # the same taught hole
+    assert np.hypot(*ol.offset) == pytest.approx(0.004)
+    assert not ol.success and ol.nodes == ("approach", "descend")
+    assert joined.nodes[:3] == ("approach", "contact", "lateral")
+    assert joined.result is not None and joined.result.log.t.size > 10
+    assert joined.success == (joined.result.outcome.value == "success")

@@ -1,0 +1,83 @@
+"""The learned-search primitive and the peg-in-hole skill whose recovery it is."""
+
+import numpy as np
+import pytest
+from search_models import raster_model
+
+from teachfit.core.errors import SkillError
+from teachfit.core.geometry import Pose
+from teachfit.execution.engine import execute
+from teachfit.robot.registry import make_robot
+from teachfit.skills import peg_in_hole, peg_in_hole_search
+from teachfit.skills.controllers import controller_spec
+from teachfit.skills.library import get_skill
+from teachfit.skills.search import recentred, states_to_setpoints
+from teachfit.tasks import get_task
+
+
+@pytest.fixture(scope="module")
+def peg():
+    task = get_task("peg2d")
+    return task, raster_model(task)
+
+
+def test_recentred_keeps_the_shape_and_moves_the_mean(peg):
+    _, model = peg
+    ex = recentred(model.exploration, 0.5)
+    assert np.allclose(ex.mean, 0.0)
+    assert np.allclose(ex.cov, 0.25 * model.exploration.cov, rtol=1e-6)
+    with pytest.raises(SkillError, match="scale"):
+        recentred(model.exploration, 0.0)
+
+
+def test_setpoints_blend_orientation_and_carry_the_feedforward(peg):
+    _, model = peg
+    t = np.linspace(0.0, 1.0, 101)
+    states = np.column_stack([0.01 * t, np.zeros_like(t)])
+    tilted = np.array([np.cos(0.05), 0.0, np.sin(0.05), 0.0])  # 0.1 rad about y
+    sp = states_to_setpoints(t, states, ("x", "y"), 0.002, model, tilted)
+    assert np.allclose(sp.pos[:, 0], states[:, 0]) and np.allclose(sp.pos[:, 2], 0.002)
+    assert np.allclose(np.abs(sp.quat[0]), tilted) and np.allclose(
+        np.abs(sp.quat[-1]), [1, 0, 0, 0]
+    )
+    assert np.allclose(sp.wrench_ff[:, :2], model.feedforward_along(t, states))
+    assert sp.wrench_ff[50, 0] > 0  # the learned action pushes along +x, the motion
+
+
+def test_joined_graph_and_its_learned_switches(peg):
+    _, model = peg
+    sk = peg_in_hole_search.build(model, "impedance")
+    learned = set(sk.params.learned)
+    assert {"t_switch", "t_stuck", "search_scale", "search_points"} <= learned
+    assert set(peg_in_hole.LEARNED) <= learned
+    edges = {(t.source, t.target) for t in sk.transitions}
+    assert {("lateral", "search"), ("insert", "search"), ("search", "align")} <= edges
+    with pytest.raises(SkillError, match="search model"):
+        get_skill("peg-in-hole+search:/nonexistent.model")
+
+
+def test_search_recovers_a_hole_beyond_the_lateral_reach(peg):
+    """5 mm taught-hole error across the lateral move: the plain skill fails; the joined
+    skill searches from where it gave up and inserts."""
+    task, model = peg
+    robot = make_robot("floating", task, seed=0)
+    ctx = peg_in_hole.hole_context(task, np.random.default_rng(0))
+    est = task.hole2world.compose(Pose.from_xyz_rz(0.0031, 0.0039, 0.0, 0.0))
+    start = est.compose(Pose.from_xyz_rz(0.002, 0.001, 0.025, 0.0))
+    learned = {"search_scale": 0.3, "search_points": 30.0}
+    out = {}
+    for name, sk in (
+        ("plain", peg_in_hole.build("adaptive")),
+        ("joined", peg_in_hole_search.build(model, "adaptive")),
+    ):
+        seed = {"search_seed": 1.0} if "search_seed" in sk.params.context else {}
+        sk = sk.with_context(ctx.values | seed)
+        values = {k: v for k, v in learned.items() if k in sk.params.learned}
+        spec = controller_spec("adaptive", sk.resolve(values))
+        out[name] = execute(
+            sk, robot, start, est, values, task=task, goal2world=ctx.goal2world, controller=spec
+        )
+    assert not out["plain"].success
+    joined = out["joined"]
+    assert joined.success and joined.ground_truth_inserted
+    assert [v.node for v in joined.visits][-3:] == ["search", "align", "insert"]
