@@ -33,25 +33,34 @@ def register(app: typer.Typer, bench_app: typer.Typer) -> None:
 @guarded
 def assemble(
     task: Annotated[
-        str, typer.Option(help="peg2d, socket3d, puzzle, key, peg; l-groove, tenon")
+        str, typer.Option(help="task: peg2d, socket3d, puzzle, key, peg; l-groove, tenon")
     ] = "peg2d",
     search: Annotated[
         Path | None, typer.Option(help="search model (teachfit learn search)")
     ] = None,
-    skill: Annotated[str, typer.Option(help="the skill the search recovers")] = "peg-in-hole",
-    demo: Annotated[Path | None, typer.Option(help="l-groove/tenon: demonstration (.h5)")] = None,
+    skill: Annotated[
+        str, typer.Option(help="skill: built-in name or skill .toml (the search recovers it)")
+    ] = "peg-in-hole",
+    demo: Annotated[
+        str | None,
+        typer.Option(help="demonstration FILE.h5:INDEX for l-groove/tenon (default: synthetic)"),
+    ] = None,
     hole_error: Annotated[str, typer.Option(help="taught-hole error, e.g. 3mm")] = "3mm",
     yaw_error: Annotated[str, typer.Option(help="taught yaw error bound, e.g. 2deg")] = "0deg",
     angle_error: Annotated[
         str, typer.Option(help="l-groove/tenon: capture rotation error bound")
     ] = "2deg",
-    trials: Annotated[int, typer.Option(help="number of trials")] = 30,
-    params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
-    controller: Annotated[str, typer.Option(help="adaptive or impedance")] = "adaptive",
-    seed: Annotated[int, typer.Option(help="seed of the trials")] = 0,
+    trials: Annotated[int, typer.Option(help="trials to run")] = 30,
+    params: Annotated[
+        Path | None, typer.Option(help="skill parameters (TOML, e.g. from learn skill)")
+    ] = None,
+    controller: Annotated[str, typer.Option(help="controller: adaptive or impedance")] = "adaptive",
+    seed: Annotated[int, typer.Option(help="random seed of the trials")] = 0,
     workers: Annotated[int, typer.Option(help="worker processes (0: in this process)")] = 0,
-    plot: Annotated[Path | None, typer.Option(help="phases of one trial over time")] = None,
-    video: Annotated[Path | None, typer.Option(help="render that trial to this mp4")] = None,
+    plot: Annotated[Path | None, typer.Option(help="figure: phases of one trial over time")] = None,
+    video: Annotated[
+        Path | None, typer.Option("--render", help="video (mp4) of that trial")
+    ] = None,
     robot: RobotOpt = "floating",
 ) -> None:
     """Assemble over trials: taught hole -> approach -> skill -> learned search recovery."""
@@ -128,15 +137,17 @@ def assemble(
 
 @guarded
 def bench_assembly(
-    tasks: Annotated[str, typer.Option(help="comma-separated tasks")] = "peg2d,socket3d",
+    tasks: Annotated[str, typer.Option(help="tasks, comma-separated")] = "peg2d,socket3d",
     errors: Annotated[
         str, typer.Option(help="taught-hole errors (mm), comma-separated")
     ] = "0,1,2,3,4,5",
     trials: Annotated[int, typer.Option(help="trials per method and error")] = 10,
-    seed: Annotated[int, typer.Option(help="seed of demonstrations and trials")] = 0,
-    workers: Annotated[int | None, typer.Option(help="processes (default: all cores)")] = None,
+    seed: Annotated[int, typer.Option(help="random seed of the demonstrations and trials")] = 0,
+    workers: Annotated[
+        int | None, typer.Option(help="worker processes (default: all cores)")
+    ] = None,
     plot: Annotated[
-        Path | None, typer.Option(help="success-vs-error figure (one per task)")
+        Path | None, typer.Option(help="figure: success against error (one per task)")
     ] = None,
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
@@ -177,7 +188,7 @@ def bench_assembly(
 
 def _assemble_plan(
     part: str,
-    demo: Path | None,
+    demo: str | None,
     err: float,
     ang: float,
     trials: int,

@@ -42,7 +42,7 @@ def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
 @guarded
 def learn_skill(
     task: Annotated[str, o.task("puzzle, key, peg, ... (teachfit tasks)")] = "puzzle",
-    skill: Annotated[str, typer.Option(help="built-in skill or skill .toml")] = "peg-in-hole",
+    skill: Annotated[str, typer.Option(help="skill: built-in name or skill .toml")] = "peg-in-hole",
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
     trials: Annotated[int, typer.Option(help="trials in all (restored trials count)")] = 130,
     study: Annotated[

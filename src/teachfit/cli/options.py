@@ -50,6 +50,7 @@ CANONICAL: dict[str, tuple[str, str]] = {
     "--params": ("path", "skill parameters"),
     "--runs": ("int", "planning runs"),
     "--view": ("flag", "watch the run in MuJoCo's viewer"),
+    "--skill": ("text", "skill: built-in name or skill .toml"),
 }
 
 
