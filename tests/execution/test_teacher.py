@@ -2,8 +2,10 @@ import numpy as np
 import pytest
 
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.teacher import BlindTeacher, TeacherStyle
+from teachfit.core.geometry import Pose
+from teachfit.execution.teacher import BlindTeacher, TeacherStyle, style_for
 from teachfit.tasks import get_task
+from teachfit.tasks.registry import load_task
 
 pytestmark = pytest.mark.usefixtures("no_teacher_cache")
 
@@ -60,3 +62,19 @@ def test_other_patterns_go_straight_towards_the_belief():
     demos, _ = BlindTeacher(task, TeacherStyle(pattern="spiral"), seed=2).record(1)
     xy = demos[0].pos[:, :2]
     assert np.linalg.norm(xy[-1] - task.hole2world.pos[:2]) < task.capture_radius
+
+
+def test_builtin_tasks_keep_the_default_style():
+    assert style_for(get_task("peg2d")) == TeacherStyle()
+    assert style_for(get_task("peg2d"), TeacherStyle(pattern="spiral")).pattern == "spiral"
+
+
+def test_mesh_task_scales_the_teacher_to_its_fit(mesh_examples):
+    task = load_task(mesh_examples["usb"])
+    style = style_for(task, TeacherStyle(speed=0.02))
+    assert style.speed == 0.02  # an explicit choice wins over the task's hints
+    assert style.spiral_pitch <= task.capture_radius  # every raster row can catch the entry
+    assert style.rz_wiggle < task.rz_tolerance and style.rz_belief_sigma < task.rz_tolerance
+    assert task.params.demo_offset + style.sweep_halfwidth < task.detection_radius
+    demos, discarded = BlindTeacher(task, seed=0).record(1, max_attempts=1)
+    assert discarded == [] and task.ground_truth_inserted(Pose(demos[0].pos[-1], demos[0].quat[-1]))

@@ -116,3 +116,16 @@ def test_hole_frame_outside_or_inside_the_part(tmp_path: Path) -> None:
 def test_held_part_larger_than_the_hole(tmp_path: Path) -> None:
     msg = _error(tmp_path, PEG, _block_with_hole(0.0058), hole_pos=(0, 0, 0.01))
     assert "larger than the hole" in msg
+
+
+def test_a_shell_folding_through_itself_is_rejected(tmp_path: Path) -> None:
+    from teachfit.tasks.mesh.loading import crossing_triangles
+
+    box = trimesh.creation.box((0.006, 0.006, 0.02))
+    assert crossing_triangles(box) is None and crossing_triangles(PEG) is None
+    v = box.vertices.copy()
+    v[np.argmax(v @ [1.0, 1.0, 1.0])] = [-0.006, -0.006, -0.015]  # a corner pulled through
+    folded = trimesh.Trimesh(v, box.faces, process=False)
+    assert folded.is_watertight and folded.body_count == 1
+    message = _error(tmp_path, folded, _block_with_hole(0.0062))
+    assert "held.stl" in message and "triangles of one shell cross" in message

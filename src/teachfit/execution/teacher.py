@@ -20,6 +20,7 @@ recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench 
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,6 +72,19 @@ class TeacherStyle:
             raise TeachfitError("teacher min_duration must be below max_duration")
 
 
+def style_for(task: Task, style: TeacherStyle | None = None) -> TeacherStyle:
+    """``style`` (default :class:`TeacherStyle`) with the task's ``teacher_hints()`` (a dict of
+    field overrides scaled to its cell, e.g. a mesh task's) on the fields left at their
+    defaults; built-in tasks have no hints and keep the style as it is."""
+    base = style or TeacherStyle()
+    hints = getattr(task, "teacher_hints", None)
+    if hints is None:
+        return base
+    default = TeacherStyle(pattern=base.pattern)
+    keep = {k: v for k, v in hints().items() if getattr(base, k) == getattr(default, k)}
+    return dataclasses.replace(base, **keep)
+
+
 class BlindTeacher:
     """Records demonstrations of ``task`` with a simulated blind human (seeded)."""
 
@@ -82,7 +96,7 @@ class BlindTeacher:
         robot: str = "floating",
     ) -> None:
         self.task = task
-        self.style = style or TeacherStyle()
+        self.style = style_for(task, style)
         self.seed, self.robot_name = int(seed), robot
         self.rng = np.random.default_rng(seed)
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))

@@ -271,6 +271,22 @@ class MotionPlanner:
             self.config.resolution / self.space.getMaximumExtent()
         )
         self.si.setup()
+        self.approach = self._approach(getattr(asm, "approach", None))
+
+    def _approach(self, T: np.ndarray | None) -> np.ndarray | None:
+        """The assembly's pre-insertion pose (a mesh task's: aligned just above the entry),
+        checked free and joined to the goal by a free straight motion; None without one."""
+        if T is None:
+            return None
+        state = matrix_to_state(T)
+        if self._collides(state) or not self.si.checkMotion(
+            self._to_ompl(state), self._to_ompl(self.goal)
+        ):
+            raise PlanningError(
+                f"{self.asm.task}: the straight insertion from the approach pose to the goal "
+                "collides; check the task's insertion axis and hole frame"
+            )
+        return state
 
     # -- states -------------------------------------------------------------------------------
     def _collides(self, s: np.ndarray) -> bool:
@@ -400,6 +416,9 @@ class MotionPlanner:
                     repaired[i] = self.repair(matrix_to_state(keys.L2G[i]), rng)
             ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
             states = {-1: self.start, n_cand: self.goal} | {i: repaired[i] for i in ids[1:-1]}
+            if self.approach is not None:  # the goal is reached by the straight insertion
+                ids.insert(-1, n_cand + 1)
+                states[n_cand + 1] = self.approach
             attempts += 1
             ta, ca = time.perf_counter(), self.checker.n_checks
             pieces = []

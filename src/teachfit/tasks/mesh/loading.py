@@ -13,6 +13,7 @@ import os
 import tempfile
 from pathlib import Path
 
+import coal
 import manifold3d
 import numpy as np
 import trimesh
@@ -90,6 +91,48 @@ def check_solid(mesh: trimesh.Trimesh, where: str) -> None:
                 f"{where}: self-intersecting ({len(bodies)} shells overlap by "
                 f"{1e9 * (total - union.volume()):.1f} mm^3); export the union of the bodies"
             )
+    for body in bodies:
+        crossing = crossing_triangles(body)
+        if crossing is not None:
+            n, at = crossing
+            raise TaskError(
+                f"{where}: self-intersecting ({n} pair(s) of triangles of one shell cross each "
+                f"other, e.g. at ({', '.join(f'{1e3 * v:.2f}' for v in at)}) mm); repair the "
+                "fold in CAD and re-export the part"
+            )
+
+
+def crossing_triangles(mesh: trimesh.Trimesh) -> tuple[int, np.ndarray] | None:
+    """Pairs of triangles of ``mesh`` that meet without sharing a vertex (a shell folding
+    through itself), their number and one contact point (m); None when there are none.
+
+    coal collides the mesh's BVH with itself (manifold3d accepts such a mesh as manifold:
+    its check is topological); every triangle touches itself and its neighbours, so the
+    contact budget covers those and the pairs that share a vertex are dropped.
+    """
+    model = coal.BVHModelOBBRSS()
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    model.beginModel(len(faces), len(mesh.vertices))
+    verts = coal.StdVec_Vec3s()
+    verts.extend(list(np.asarray(mesh.vertices, dtype=float)))
+    tris = coal.StdVec_Triangle()
+    tris.extend([coal.Triangle(int(a), int(b), int(c)) for a, b, c in faces])
+    model.addSubModel(verts, tris)
+    model.endModel()
+    degree = np.bincount(faces.ravel(), minlength=len(mesh.vertices))
+    request = coal.CollisionRequest()
+    request.num_max_contacts = int(2 * degree[faces].sum() + 2 * len(faces) + 1000)
+    result = coal.CollisionResult()
+    eye = coal.Transform3s()
+    coal.collide(model, eye, model, eye, request, result)
+    contacts = result.getContacts()
+    pairs = np.array([(c.b1, c.b2) for c in contacts], dtype=np.int64).reshape(-1, 2)
+    a, b = faces[pairs[:, 0]], faces[pairs[:, 1]]
+    crossing = ~(a[:, :, None] == b[:, None, :]).any(axis=(1, 2))
+    if not crossing.any():
+        return None
+    first = int(np.flatnonzero(crossing)[0])
+    return int(crossing.sum()) // 2, np.asarray(contacts[first].pos, dtype=float)
 
 
 def to_manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:

@@ -162,6 +162,38 @@ class MeshTask(SkillTask):
     def rz_tolerance(self) -> float:
         return self.cell.fit.rz_tolerance
 
+    def teacher_hints(self) -> dict[str, float]:
+        """The blind teacher's search scaled to this cell (m, rad; TeacherStyle fields).
+
+        The teacher's defaults suit the built-in cells (a 1-2 mm chamfered entry, a 5 mm
+        belief, a 15 mm half-width sweep). A user's part may enter only within a few tenths
+        of a millimetre and a degree or two of yaw, so its raster rows are one capture radius
+        apart (a pass always crosses the entry), its slow wander stays below that, its belief
+        and sweep scale with the start's distance from the hole (and stay over the top
+        surface, inside the detection radius), and its yaw belief and wiggle stay inside the
+        yaw tolerance.
+        """
+        p, pitch = self.params, self.capture_radius
+        sigma = p.demo_offset / 8
+        # a stiffer arm than the default 600 N/m, and the friction lag of the sliding part
+        # (friction times the push plus its weight, over the stiffness) added to the sweep's
+        # half-width: within the lag of a turn the part sticks instead of sliding
+        stiffness, push = 2000.0, 6.0
+        lag = p.friction * (push + HELD_MASS * 9.81) / stiffness
+        room = self.detection_radius - p.demo_offset - 2 * pitch
+        hints = {
+            "belief_sigma": sigma,
+            "spiral_pitch": pitch,
+            "sweep_halfwidth": max(pitch, min(4 * sigma + lag, room)),
+            "wander_amplitude": pitch / 4,
+            "arm_stiffness": stiffness,
+            "push_force": push,
+            "speed": 0.008,
+        }
+        if self.has_rz:
+            hints |= {"rz_belief_sigma": self.rz_tolerance / 6, "rz_wiggle": self.rz_tolerance / 3}
+        return hints
+
 
 def task_name_of(path: str | Path) -> str:
     """The task name of the file ``path``: relative to the working folder if inside it."""
