@@ -37,7 +37,7 @@ def make_demo(
 
 
 def tmp_leftovers(directory: Path) -> list[Path]:
-    return [p for p in directory.iterdir() if p.name.endswith(".tmp")]
+    return [p for p in directory.iterdir() if ".tmp" in p.name]
 
 
 # ---------------------------------------------------------------- Demonstration validation

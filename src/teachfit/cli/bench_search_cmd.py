@@ -11,6 +11,7 @@ from rich.progress import Progress
 from rich.table import Table
 
 from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.core.atomic import atomic_append_text
 from teachfit.core.errors import TeachfitError
 
 TABLES = ("1", "2", "ablation", "3", "all")
@@ -52,8 +53,7 @@ def _emit(title: str, rows: Sequence[object], markdown: Path | None) -> None:
     if markdown is not None:
         lines = [f"\n**{title}**\n", "| " + " | ".join(_COLS) + " |", "|" + " --- |" * len(_COLS)]
         lines += ["| " + " | ".join(_cells(r)) + " |" for r in rows]
-        with markdown.open("a", encoding="utf-8") as fh:
-            fh.write("\n".join(lines) + "\n")
+        atomic_append_text(markdown, "\n".join(lines) + "\n", "markdown file")
 
 
 @guarded

@@ -13,6 +13,7 @@ from rich.table import Table
 
 from teachfit.cli.common import console, guarded
 from teachfit.cli.progress import progress_bar
+from teachfit.core.atomic import atomic_append_text
 from teachfit.core.errors import CaptureError
 
 __all__ = ["bench_capture_cmd", "capture_app"]
@@ -257,6 +258,5 @@ def bench_capture_cmd(
     )
     if write:
         path = Path("BENCHMARKS.md")
-        with path.open("a") as f:
-            f.write("\n" + to_markdown(b))
+        atomic_append_text(path, "\n" + to_markdown(b), "benchmark file")
         console.print(f"appended to {path}")

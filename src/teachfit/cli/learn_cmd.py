@@ -11,6 +11,7 @@ from rich.table import Table
 
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
+from teachfit.core.atomic import atomic_write_text
 from teachfit.core.params import LearningError
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
@@ -325,8 +326,7 @@ def bench_learning(
         )
         console.print(f"learning curves -> {path}")
     if markdown is not None:
-        markdown.parent.mkdir(parents=True, exist_ok=True)
-        markdown.write_text(text)
+        atomic_write_text(markdown, text, "markdown file")
         console.print(f"markdown -> {markdown}")
 
 
@@ -364,6 +364,5 @@ def _bench_scaling(
     )
     console.print(Markdown(text))
     if markdown is not None:
-        markdown.parent.mkdir(parents=True, exist_ok=True)
-        markdown.write_text(text)
+        atomic_write_text(markdown, text, "markdown file")
         console.print(f"markdown -> {markdown}")

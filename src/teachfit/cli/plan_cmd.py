@@ -16,6 +16,7 @@ from rich.table import Table
 
 from teachfit.cli.common import console, guarded
 from teachfit.cli.progress import progress_bar
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import PlanningError, TeachfitError
 
 __all__ = [
@@ -155,7 +156,8 @@ def plan(
     if not result.success:
         raise typer.Exit(code=1)
     if save is not None:
-        np.save(save, poses_to_array(result.poses))
+        with atomic_path(save, "path file") as tmp, open(tmp, "xb") as fh:
+            np.save(fh, poses_to_array(result.poses))
         console.print(f"wrote {save}")
     if strip is not None:
         from teachfit.viz.plan_figures import path_strip_figure

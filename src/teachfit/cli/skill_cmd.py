@@ -9,6 +9,7 @@ import typer
 from rich.table import Table
 
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.core.atomic import atomic_write_text
 
 skill_app = typer.Typer(
     help="Manipulation skills (seed B): show a skill's graph, run it on a task.",
@@ -70,8 +71,7 @@ def show(
         )
     console.print(lrn)
     if toml is not None:
-        toml.parent.mkdir(parents=True, exist_ok=True)
-        toml.write_text(skill_to_toml(sk))
+        atomic_write_text(toml, skill_to_toml(sk), "skill file")
         console.print(f"skill -> {toml}")
     if plot is not None:
         from teachfit.viz.skill_figures import plot_skill_graph

@@ -20,10 +20,8 @@ failed write never leaves a half-written file behind.
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import uuid
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -35,6 +33,7 @@ import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 
@@ -313,13 +312,8 @@ def _checked_demos(demos: Sequence[Demonstration], path: Path) -> list[Demonstra
 
 def _atomic(path: Path, fill: Callable[[Path], None]) -> None:
     """Run ``fill(tmp)`` on a temporary path next to ``path`` and move it into place."""
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
+    with atomic_path(path, "demonstration file") as tmp:
         fill(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def write_dataset(

@@ -14,6 +14,7 @@ from matplotlib.patches import Circle  # noqa: E402
 
 from teachfit.demonstrations.dataset import Demonstration  # noqa: E402
 from teachfit.tasks.base import Task  # noqa: E402
+from teachfit.viz.output import save_figure
 
 
 def _hole_patch(ax: plt.Axes, task: Task | None, scale: float) -> None:
@@ -64,10 +65,7 @@ def plot_demonstrations(
         ax.grid(alpha=0.3)
     axes_w[0].set_title("wrench the environment exerts on the tool (world frame)")
     axes_w[-1].set_xlabel("time (s)")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_executions(
@@ -89,7 +87,4 @@ def plot_executions(
     ax.set_ylabel("y (mm)")
     n_ok = sum(ok for _, ok in paths)
     ax.set_title(f"{title}: {n_ok}/{len(paths)} inserted (green)")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
