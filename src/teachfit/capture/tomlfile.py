@@ -21,7 +21,9 @@ def read_versioned_toml(path: str | Path, what: str, fmt: str, version: int) -> 
     """The parsed document of ``path``, a ``what`` file (e.g. ``"rig"``) of ``fmt``/``version``."""
     path = Path(path)
     try:
-        doc = tomllib.loads(path.read_text())
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise CaptureError(f"{what} file {path}: not a text (TOML) file ({exc.reason})") from exc
     except OSError as exc:
         raise CaptureError(f"{what} file {path}: cannot read ({exc.strerror or exc})") from exc
     except tomllib.TOMLDecodeError as exc:

@@ -10,7 +10,7 @@ import typer
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import RobotOpt, SeedOpt, console, guarded
 from teachfit.core.atomic import atomic_append_text
 from teachfit.core.errors import TeachfitError
 
@@ -59,11 +59,15 @@ def _emit(title: str, rows: Sequence[object], markdown: Path | None) -> None:
 @guarded
 def bench_search(
     table: Annotated[str, typer.Option(help="paper table: 1, 2, ablation, 3 or all")] = "1",
-    seed: int = 0,
-    starts: Annotated[int | None, typer.Option(help="starts (paper: 30 / 15)")] = None,
-    points: Annotated[int | None, typer.Option(help="TSHIX points (paper: 300 / 600)")] = None,
-    trajectories: Annotated[int, typer.Option(help="Table II trajectories per N")] = 20,
-    workers: Annotated[int | None, typer.Option(help="processes (default: all cores)")] = None,
+    seed: SeedOpt = 0,
+    starts: Annotated[int | None, typer.Option(min=1, help="starts (paper: 30 / 15)")] = None,
+    points: Annotated[
+        int | None, typer.Option(min=1, help="TSHIX points (paper: 300 / 600)")
+    ] = None,
+    trajectories: Annotated[int, typer.Option(min=1, help="Table II trajectories per N")] = 20,
+    workers: Annotated[
+        int | None, typer.Option(min=0, help="processes (default: all cores)")
+    ] = None,
     markdown: Annotated[Path | None, typer.Option(help="append the tables as markdown")] = None,
     robot: RobotOpt = "floating",
 ) -> None:

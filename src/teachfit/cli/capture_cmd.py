@@ -11,7 +11,7 @@ import numpy as np
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import console, guarded, seed_option
 from teachfit.cli.progress import progress_bar
 from teachfit.core.atomic import atomic_append_text
 from teachfit.core.errors import CaptureError
@@ -80,7 +80,7 @@ def markers(
     camera: Annotated[
         list[int] | None, typer.Option(help="live camera index per rig camera")
     ] = None,
-    frames: Annotated[int, typer.Option(help="live: stop after this many frames")] = 300,
+    frames: Annotated[int, typer.Option(min=1, help="live: stop after this many frames")] = 300,
     task: Annotated[str, typer.Option(help="task of the demonstration")] = "l-groove",
     plot: Annotated[Path | None, typer.Option(help="write the track figure (png)")] = None,
     truth: Annotated[
@@ -159,14 +159,14 @@ def synth(
     resolution: Annotated[
         list[str] | None, typer.Option(help="WxH, once for all or once per camera")
     ] = None,
-    seed: Annotated[int, typer.Option(help="seed of the demonstration and the noise")] = 0,
+    seed: Annotated[int, seed_option("seed of the demonstration and the noise")] = 0,
     distance: Annotated[float, typer.Option(help="camera distance (m)")] = 0.6,
     noise: Annotated[float, typer.Option(help="pixel noise (grey levels)")] = 0.0,
     blur: Annotated[float, typer.Option(help="Gaussian blur (px)")] = 0.0,
     lighting: Annotated[float, typer.Option(help="light variation amplitude [0, 1)")] = 0.0,
     stride: Annotated[int, typer.Option(min=1, help="keep every n-th 30 Hz sample")] = 1,
-    max_frames: Annotated[int | None, typer.Option(help="cap on the frame count")] = None,
-    calib: Annotated[int, typer.Option(help="also render this many ChArUco shots")] = 0,
+    max_frames: Annotated[int | None, typer.Option(min=1, help="cap on the frame count")] = None,
+    calib: Annotated[int, typer.Option(min=0, help="also render this many ChArUco shots")] = 0,
 ) -> None:
     """Render a scripted demonstration with marker-carrying parts: videos, rig, markers, truth."""
     from teachfit.capture.synth import write_synth_capture
@@ -206,8 +206,10 @@ def bench_capture_cmd(
     noise: Annotated[float, typer.Option(help="pixel noise (grey levels)")] = 2.0,
     blur: Annotated[float, typer.Option(help="Gaussian blur (px)")] = 0.5,
     lighting: Annotated[float, typer.Option(help="light variation amplitude")] = 0.3,
-    crf: Annotated[int, typer.Option(help="x264 quality of the videos (lower = better)")] = 20,
-    seed: Annotated[int, typer.Option(help="seed")] = 0,
+    crf: Annotated[
+        int, typer.Option(min=0, max=51, help="x264 quality of the videos (lower = better)")
+    ] = 20,
+    seed: Annotated[int, seed_option("seed")] = 0,
     workdir: Annotated[Path | None, typer.Option(help="keep the rendered capture here")] = None,
     write: Annotated[bool, typer.Option("--write", help="append to BENCHMARKS.md")] = False,
 ) -> None:

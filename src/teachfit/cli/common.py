@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from typing import Annotated, ParamSpec, TypeVar
+from typing import Annotated, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
@@ -33,6 +33,31 @@ RealtimeOpt = Annotated[
 ]
 
 
+def seed_option(help: str = "random seed") -> Any:
+    """A ``--seed`` option: an integer >= 0 (numpy's generators take no negative seed)."""
+    return typer.Option(min=0, help=f"{help} (an integer >= 0)")
+
+
+#: ``--seed N``: every command with randomness takes it (0 and up)
+SeedOpt = Annotated[int, seed_option()]
+
+
+def count_option(
+    help: str, *, low: int = 1, high: int | None = None, flag: str | None = None
+) -> Any:
+    """An integer option (a count, a size, a rate) in ``[low, high]``; typer refuses others
+    with exit status 2 before the command runs."""
+    decls = () if flag is None else (flag,)
+    return typer.Option(*decls, min=low, max=high, help=help)
+
+
+#: ``--fps``, ``--width``, ``--height`` of a rendered video (pixels; H.264 needs even sizes up
+#: to 8K)
+FpsOpt = Annotated[int, count_option("frames per second", high=240)]
+WidthOpt = Annotated[int, count_option("video width (pixels)", low=16, high=7680)]
+HeightOpt = Annotated[int, count_option("video height (pixels)", low=16, high=4320)]
+
+
 def robot_options(host: str | None, realtime: bool = True) -> dict[str, object]:
     """The ``make_robot`` options the CLI's ``--host``/``--no-realtime`` give (none for
     simulated robots)."""
@@ -52,8 +77,9 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
             return func(*args, **kwargs)
         except TeachfitError as exc:
             err_console.print("[bold red]error:[/] ", end="")
-            # the message is plain text: no markup, no ":emoji:" codes, no highlighting
-            err_console.print(str(exc), markup=False, emoji=False, highlight=False)
+            # the message is plain text: no markup, no ":emoji:" codes, no highlighting; one
+            # line however narrow the terminal (soft_wrap: rich does not break it)
+            err_console.print(str(exc), markup=False, emoji=False, highlight=False, soft_wrap=True)
             raise typer.Exit(2) from exc
 
     return wrapper

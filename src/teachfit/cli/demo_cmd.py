@@ -10,7 +10,15 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import (
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    console,
+    guarded,
+    robot_options,
+    seed_option,
+)
 from teachfit.core.errors import DatasetError, TeachfitError
 from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
@@ -38,8 +46,8 @@ app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_
 @guarded
 def record(
     task: Annotated[str, typer.Option(help="built-in task name or task .toml")] = "peg2d",
-    n: Annotated[int, typer.Option("-n", help="demonstrations to keep")] = 3,
-    seed: Annotated[int, typer.Option(help="random seed")] = 0,
+    n: Annotated[int, typer.Option("-n", min=1, help="demonstrations to keep")] = 3,
+    seed: Annotated[int, seed_option("random seed")] = 0,
     out: Annotated[Path, typer.Option(help="HDF5 file to write")] = Path("demos.h5"),
     pattern: Annotated[str, typer.Option(help=f"search pattern: {', '.join(PATTERNS)}")] = "sweep",
     append: Annotated[bool, typer.Option(help="append to an existing file")] = False,
@@ -48,7 +56,8 @@ def record(
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     duration: Annotated[
-        float | None, typer.Option(help="real robot: seconds to record (default: until Ctrl-C)")
+        float | None,
+        typer.Option(min=0, help="real robot: seconds to record (default: until Ctrl-C)"),
     ] = None,
 ) -> None:
     """Record demonstrations: the simulated blind teacher on a simulated robot, or a person
@@ -102,7 +111,7 @@ def import_(
         str | None, typer.Option(help="demonstration name (default: file stem)")
     ] = None,
     rate: Annotated[
-        float | None, typer.Option(help="Hz, for a CSV log without a time column")
+        float | None, typer.Option(min=0, help="Hz, for a CSV log without a time column")
     ] = None,
     transform: Annotated[
         str | None,
@@ -117,14 +126,14 @@ def import_(
     segment: Annotated[
         str | None, typer.Option(help="cut into demonstrations: window, contact or marker")
     ] = None,
-    window: Annotated[float, typer.Option(help="--segment window: length (s)")] = 30.0,
+    window: Annotated[float, typer.Option(min=0, help="--segment window: length (s)")] = 30.0,
     force_threshold: Annotated[
-        float, typer.Option(help="--segment contact: force (N) that starts a contact phase")
+        float, typer.Option(min=0, help="--segment contact: force (N) that starts a contact phase")
     ] = 5.0,
     force_off: Annotated[
         float | None, typer.Option(help="--segment contact: force (N) that ends it (default half)")
     ] = None,
-    min_duration: Annotated[float, typer.Option(help="shortest piece kept (s)")] = 1.0,
+    min_duration: Annotated[float, typer.Option(min=0, help="shortest piece kept (s)")] = 1.0,
     marker_value: Annotated[
         str | None, typer.Option(help="--segment marker: keep runs with this value")
     ] = None,

@@ -9,7 +9,15 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded
+from teachfit.cli.common import (
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    SeedOpt,
+    console,
+    guarded,
+    seed_option,
+)
 from teachfit.cli.progress import progress_bar
 from teachfit.core.atomic import atomic_write_text
 from teachfit.core.params import LearningError
@@ -36,22 +44,23 @@ def learn_skill(
     task: Annotated[str, typer.Option(help="task: puzzle, key, peg, ...")] = "puzzle",
     skill: Annotated[str, typer.Option(help="built-in skill or skill .toml")] = "peg-in-hole",
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
-    trials: Annotated[int, typer.Option(help="trial budget (restored trials count)")] = 130,
+    trials: Annotated[int, typer.Option(min=1, help="trial budget (restored trials count)")] = 130,
     study: Annotated[
         str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")
     ] = "runs/study.db",
     resume: Annotated[bool, typer.Option(help="continue a stored study")] = False,
     workers: Annotated[
-        int | None, typer.Option(help="worker processes (default: all cores; 0: in this process)")
+        int | None,
+        typer.Option(min=0, help="worker processes (default: all cores; 0: in this process)"),
     ] = None,
     ray: Annotated[
         str | None, typer.Option(help="run trials on Ray: 'local' or an address")
     ] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
     seed: Annotated[
-        int, typer.Option(help="seed of the set-up (hole estimate, starts) and of the learner")
+        int, seed_option("seed of the set-up (hole estimate, starts) and of the learner")
     ] = 0,
-    starts: Annotated[int, typer.Option(help="executions (start poses) per trial")] = 4,
+    starts: Annotated[int, typer.Option(min=1, help="executions (start poses) per trial")] = 4,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
     out: Annotated[Path | None, typer.Option(help="write the best parameters (TOML)")] = None,
     plot: Annotated[Path | None, typer.Option(help="learning curve figure")] = None,
@@ -217,12 +226,14 @@ def _report_best(
 def bench_learning(
     tasks: Annotated[str, typer.Option(help="comma-separated tasks")] = "puzzle,key,peg",
     methods: Annotated[str, typer.Option(help="comma-separated methods")] = "cmaes,pso,bo,lhs",
-    experiments: Annotated[int, typer.Option(help="learning runs per task and method")] = 2,
-    trials: Annotated[int, typer.Option(help="trials per experiment")] = 60,
-    workers: Annotated[int | None, typer.Option(help="worker processes (default: all)")] = None,
-    starts: Annotated[int, typer.Option(help="executions per trial")] = 4,
+    experiments: Annotated[int, typer.Option(min=1, help="learning runs per task and method")] = 2,
+    trials: Annotated[int, typer.Option(min=1, help="trials per experiment")] = 60,
+    workers: Annotated[
+        int | None, typer.Option(min=0, help="worker processes (default: all)")
+    ] = None,
+    starts: Annotated[int, typer.Option(min=1, help="executions per trial")] = 4,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
-    seed: int = 0,
+    seed: SeedOpt = 0,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
     plot: Annotated[Path | None, typer.Option(help="Fig. 6-like learning curves")] = Path(
         "out/bench_learning/curves.png"
@@ -234,7 +245,7 @@ def bench_learning(
         ),
     ] = True,
     speedup_trials: Annotated[
-        int, typer.Option(help="trials of the 1-vs-N-worker speed-up study (0: skip)")
+        int, typer.Option(min=0, help="trials of the 1-vs-N-worker speed-up study (0: skip)")
     ] = 24,
     markdown: Annotated[Path | None, typer.Option(help="also write the results (markdown)")] = None,
     robot: RobotOpt = "floating",
@@ -250,7 +261,7 @@ def bench_learning(
     ] = False,
     scaling_workers: Annotated[str, typer.Option(help="worker counts of --scaling")] = "1,2,4",
     scaling_trials: Annotated[
-        int, typer.Option(help="trials per worker of each --scaling count")
+        int, typer.Option(min=1, help="trials per worker of each --scaling count")
     ] = 6,
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""

@@ -8,7 +8,16 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import (
+    FpsOpt,
+    HeightOpt,
+    RobotOpt,
+    SeedOpt,
+    WidthOpt,
+    console,
+    count_option,
+    guarded,
+)
 from teachfit.tasks.registry import TASKS, load_task
 
 
@@ -39,9 +48,9 @@ def render(
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     demo: Annotated[str, typer.Option(help="demonstration, e.g. demos.h5:0")] = "demos.h5:0",
     out: Annotated[Path, typer.Option(help="mp4 to write")] = Path("demo.mp4"),
-    fps: Annotated[int, typer.Option(help="frames per second")] = 25,
-    width: int = 640,
-    height: int = 480,
+    fps: FpsOpt = 25,
+    width: WidthOpt = 640,
+    height: HeightOpt = 480,
     robot: RobotOpt = "floating",
 ) -> None:
     """Render a recorded demonstration with MuJoCo's offscreen renderer to an mp4."""
@@ -66,9 +75,9 @@ def quickstart(
         "out/quickstart"
     ),
     task: Annotated[str, typer.Option(help="built-in task")] = "peg2d",
-    demos: Annotated[int, typer.Option(help="demonstrations to record")] = 3,
-    starts: Annotated[int, typer.Option(help="new start poses")] = 10,
-    seed: int = 0,
+    demos: Annotated[int, typer.Option(min=1, help="demonstrations to record")] = 3,
+    starts: Annotated[int, typer.Option(min=1, help="new start poses")] = 10,
+    seed: SeedOpt = 0,
     robot: RobotOpt = "floating",
 ) -> None:
     """The main job on the default task: demonstrations -> execution -> success table."""
@@ -80,8 +89,8 @@ def quickstart(
 @guarded
 def bench_sim(
     task: Annotated[str, typer.Option(help="task name")] = "peg2d",
-    steps: Annotated[int, typer.Option(help="steps per measurement")] = 5000,
-    repeats: int = 3,
+    steps: Annotated[int, typer.Option(min=1, help="steps per measurement")] = 5000,
+    repeats: Annotated[int, count_option("measurements to take the best of")] = 3,
     robot: RobotOpt = "floating",
 ) -> None:
     """Raw mj_step steps/s vs. steps/s with the controller in the loop, in contact."""

@@ -14,7 +14,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import console, guarded
+from teachfit.cli.common import console, guarded, seed_option
 from teachfit.cli.progress import progress_bar
 from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import PlanningError, TeachfitError
@@ -70,7 +70,7 @@ def parts_show(
 def demo_synth(
     out: Annotated[Path, typer.Option(help="HDF5 file to write")],
     task: Annotated[str, typer.Option(help="l-groove or tenon")] = "l-groove",
-    seed: Annotated[int, typer.Option(help="seed of the tremor and contacts")] = 0,
+    seed: Annotated[int, seed_option("seed of the tremor and contacts")] = 0,
     count: Annotated[
         int, typer.Option(min=1, help="number of demonstrations (seeds seed, seed+1, ...)")
     ] = 1,
@@ -111,13 +111,15 @@ def plan(
         str | None, typer.Option(help="demonstration: file.h5 (first) or file.h5:INDEX")
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
-    te: Annotated[float, typer.Option(help="budget per attempt (s)")] = 0.02,
+    te: Annotated[float, typer.Option(min=0, help="budget per attempt (s)")] = 0.02,
     max_checks: Annotated[
         int | None,
-        typer.Option(help="budget per attempt in collision checks instead of --te (repeatable)"),
+        typer.Option(
+            min=1, help="budget per attempt in collision checks instead of --te (repeatable)"
+        ),
     ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
-    seed: Annotated[int, typer.Option(help="seed of the key-pose repair and of OMPL")] = 0,
+    seed: Annotated[int, seed_option("seed of the key-pose repair and of OMPL")] = 0,
     render: Annotated[Path | None, typer.Option(help="write an mp4 of the path")] = None,
     strip: Annotated[
         Path | None, typer.Option(help="write the path as a strip of poses (png)")
@@ -176,14 +178,20 @@ def plan(
 def bench_planning_cmd(
     tasks: Annotated[str, typer.Option(help="comma-separated task names")] = "l-groove,tenon",
     seeds: Annotated[int, typer.Option(min=1, help="seeds per task")] = 50,
-    te: Annotated[float, typer.Option(help="budget per attempt (s) with demonstration")] = 0.01,
+    te: Annotated[
+        float, typer.Option(min=0, help="budget per attempt (s) with demonstration")
+    ] = 0.01,
     max_checks: Annotated[
         int | None,
-        typer.Option(help="budget per attempt with demonstration in collision checks, not --te"),
+        typer.Option(
+            min=1, help="budget per attempt with demonstration in collision checks, not --te"
+        ),
     ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
     no_demo_seeds: Annotated[int, typer.Option(min=0, help="seeds run without demonstration")] = 5,
-    no_demo_budget: Annotated[float, typer.Option(help="budget (s) without demonstration")] = 30.0,
+    no_demo_budget: Annotated[
+        float, typer.Option(min=0, help="budget (s) without demonstration")
+    ] = 30.0,
     write: Annotated[
         bool, typer.Option("--write", help="append the table to --benchmarks")
     ] = False,

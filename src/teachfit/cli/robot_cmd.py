@@ -46,7 +46,9 @@ def _real(robot: str, host: str | None) -> str:
 def check(
     robot: RobotOpt = "franka",
     host: HostOpt = None,
-    seconds: Annotated[float, typer.Option(help="seconds of the control loop to time")] = 1.0,
+    seconds: Annotated[
+        float, typer.Option(min=0, help="seconds of the control loop to time")
+    ] = 1.0,
     realtime: Annotated[bool, _REALTIME] = True,
 ) -> None:
     """Connect, read the state, print the safety limits and the loop timing."""
@@ -61,7 +63,7 @@ def check(
 def bench_robot(
     robot: RobotOpt = "franka",
     host: HostOpt = None,
-    seconds: Annotated[float, typer.Option(help="seconds of the 1 kHz loop")] = 10.0,
+    seconds: Annotated[float, typer.Option(min=0, help="seconds of the 1 kHz loop")] = 10.0,
     realtime: Annotated[bool, _REALTIME] = True,
 ) -> None:
     """Tick compute time p50/p99/max and missed deadlines of the 1 kHz loop, through the

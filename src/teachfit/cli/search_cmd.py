@@ -10,7 +10,15 @@ import typer
 from rich.progress import Progress
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import (
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    SeedOpt,
+    console,
+    guarded,
+    robot_options,
+)
 from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
@@ -24,7 +32,7 @@ def learn_search(
     covariance: Annotated[
         str, typer.Option(help="p_e covariance: 'full' (seed A) or 'diag' (per-DOF variances)")
     ] = "full",
-    seed: int = 0,
+    seed: SeedOpt = 0,
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
     from teachfit.demonstrations.dataset import read_dataset
@@ -59,8 +67,8 @@ def plan(
     method: Annotated[
         str, typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
     ] = "tshix",
-    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
-    seed: int = 0,
+    n: Annotated[int, typer.Option("-n", min=1, help="TSHIX sample points")] = 300,
+    seed: SeedOpt = 0,
     plot: Annotated[Path | None, typer.Option(help="figure to write")] = None,
 ) -> None:
     """Plan one search trajectory in the search frame and report its figures of merit."""
@@ -111,17 +119,17 @@ def run(
     method: Annotated[
         str, typer.Option(help="tshix, ergodic, ergodic-opt, spiral or random-walk")
     ] = "tshix",
-    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
-    starts: Annotated[int, typer.Option(help="number of start poses")] = 30,
+    n: Annotated[int, typer.Option("-n", min=1, help="TSHIX sample points")] = 300,
+    starts: Annotated[int, typer.Option(min=1, help="number of start poses")] = 30,
     protocol: Annotated[str, typer.Option(help="start protocol of the task")] = "table1",
     feedforward: Annotated[bool, typer.Option(help="superpose the GMR feed-forward")] = True,
     passes: Annotated[
-        int, typer.Option(help="TSHIX passes: re-sample and continue after a failed pass")
+        int, typer.Option(min=1, help="TSHIX passes: re-sample and continue after a failed pass")
     ] = 1,
     demo: Annotated[
         str | None, typer.Option(help="demonstration whose start anchors the protocol (f.h5:0)")
     ] = None,
-    seed: int = 0,
+    seed: SeedOpt = 0,
     plot: Annotated[Path | None, typer.Option(help="figure of the executed paths")] = None,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
@@ -196,8 +204,8 @@ def run(
 def figures(
     model_file: Annotated[Path, typer.Argument(help="model from 'teachfit learn search'")],
     out: Annotated[Path, typer.Option(help="folder for the figures")] = Path("search_figures"),
-    n: Annotated[int, typer.Option("-n", help="TSHIX sample points")] = 300,
-    seed: int = 0,
+    n: Annotated[int, typer.Option("-n", min=1, help="TSHIX sample points")] = 300,
+    seed: SeedOpt = 0,
     robot: RobotOpt = "floating",
 ) -> None:
     """Seed A's figures for a model: samples over p_e for N = 100...500, samples -> itinerary ->

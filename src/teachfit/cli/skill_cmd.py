@@ -8,7 +8,18 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import (
+    FpsOpt,
+    HeightOpt,
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    WidthOpt,
+    console,
+    guarded,
+    robot_options,
+    seed_option,
+)
 from teachfit.core.atomic import atomic_write_text
 
 skill_app = typer.Typer(
@@ -86,14 +97,14 @@ def run(
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
-    seed: Annotated[int, typer.Option(help="seed of the hole estimate, starts, noise")] = 0,
-    starts: Annotated[int, typer.Option(help="number of start poses")] = 4,
+    seed: Annotated[int, seed_option("seed of the hole estimate, starts, noise")] = 0,
+    starts: Annotated[int, typer.Option(min=1, help="number of start poses")] = 4,
     render: Annotated[Path | None, typer.Option(help="render one execution to this mp4")] = None,
-    render_start: Annotated[int, typer.Option(help="which execution to render")] = 0,
+    render_start: Annotated[int, typer.Option(min=0, help="which execution to render")] = 0,
     plot: Annotated[Path | None, typer.Option(help="plot the traces to this image")] = None,
-    fps: int = 25,
-    width: int = 640,
-    height: int = 480,
+    fps: FpsOpt = 25,
+    width: WidthOpt = 640,
+    height: HeightOpt = 480,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
@@ -116,8 +127,9 @@ def run(
         learned = read_params_toml(params, setup.skill.params, setup.skill.users())
         import tomllib
 
-        given = tomllib.loads(params.read_text()).get("params", {})
-        given = given if isinstance(given, dict) and given else tomllib.loads(params.read_text())
+        given = tomllib.loads(params.read_text(encoding="utf-8")).get("params", {})
+        if not (isinstance(given, dict) and given):
+            given = tomllib.loads(params.read_text(encoding="utf-8"))
         missing = sorted(set(setup.skill.params.learned) - set(given))
         if missing:
             console.print(

@@ -40,22 +40,21 @@ def ensure_parent(dest: str | Path, what: str = "file") -> Path:
     dest = Path(dest)
     if dest.is_dir():
         raise OutputError(f"cannot write {what} {dest}: it is a folder; give a file name")
-    try:
-        dest.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(
-            f"cannot create the folder of {what} {dest}: {exc.strerror or exc}"
-        ) from exc
+    ensure_folder(dest.parent, f"the folder of {what} {dest}")
     return dest
 
 
-def ensure_folder(folder: str | Path, what: str = "output folder") -> Path:
+def ensure_folder(folder: str | Path, what: str = "the output folder") -> Path:
     """Create an output folder (and its parents); :class:`OutputError` if that is impossible."""
     folder = Path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise OutputError(f"cannot create {what} {folder}: {exc.strerror or exc}") from exc
+        why = exc.strerror or str(exc)
+        blocker = next((p for p in (folder, *folder.parents) if p.exists()), None)
+        if blocker is not None and not blocker.is_dir():
+            why = f"{blocker} is a file, not a folder"
+        raise OutputError(f"cannot create {what}: {why}") from exc
     return folder
 
 

@@ -72,9 +72,14 @@ def _quat_wxyz(rot: Rotation) -> np.ndarray:
 def _array(value: Any, column: str, width: int | None, n: int | None) -> np.ndarray:
     """Validated read-only float64 copy with shape (n,) or (n, width); NaN/inf rejected."""
     try:
+        kind = np.asarray(value).dtype.kind
         arr = np.array(value, dtype=np.float64, copy=True)
     except (TypeError, ValueError) as exc:
         raise DatasetError(f"not a numeric array ({exc})", column=column) from exc
+    if kind not in "iuf":  # strings, complex numbers, booleans, objects: no silent conversion
+        raise DatasetError(
+            f"holds {np.asarray(value).dtype} values, not real numbers", column=column
+        )
     want = "(T,)" if width is None else f"(T, {width})"
     if (width is None and arr.ndim != 1) or (width is not None and arr.shape[1:] != (width,)):
         raise DatasetError(f"shape {arr.shape}, expected {want}", column=column)
@@ -378,23 +383,31 @@ def _open(path: Path) -> Iterator[tuple[h5py.Group, list[str]]]:
         f = h5py.File(path, "r")
     except OSError as exc:
         raise DatasetError(f"cannot open as HDF5 ({exc})", path=str(path)) from exc
-    with f:
-        fmt = f.attrs.get("format")
-        fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
-        if fmt != FORMAT:
-            raise DatasetError(f"format attribute is {fmt!r}, expected {FORMAT!r}", path=str(path))
-        version = f.attrs.get("format_version")
-        version = version.item() if isinstance(version, np.generic) else version
-        if not isinstance(version, int) or version != FORMAT_VERSION:
-            raise DatasetError(
-                f"unsupported format_version {version!r} (this teachfit reads {FORMAT_VERSION})",
-                path=str(path),
-            )
-        group = f.get("demos")
-        if not isinstance(group, h5py.Group):
-            raise DatasetError("missing group /demos", path=str(path))
-        keys = sorted((k for k in group if re.fullmatch(r"\d+", k)), key=int)
-        yield group, keys
+    try:
+        with f:
+            fmt = f.attrs.get("format")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+            if fmt != FORMAT:
+                raise DatasetError(
+                    f"format attribute is {fmt!r}, expected {FORMAT!r}", path=str(path)
+                )
+            version = f.attrs.get("format_version")
+            version = version.item() if isinstance(version, np.generic) else version
+            if not isinstance(version, int) or version != FORMAT_VERSION:
+                raise DatasetError(
+                    f"unsupported format_version {version!r} "
+                    f"(this teachfit reads {FORMAT_VERSION})",
+                    path=str(path),
+                )
+            group = f.get("demos")
+            if not isinstance(group, h5py.Group):
+                raise DatasetError("missing group /demos", path=str(path))
+            keys = sorted((k for k in group if re.fullmatch(r"\d+", k)), key=int)
+            if not keys:
+                raise DatasetError("the /demos group holds no demonstrations", path=str(path))
+            yield group, keys
+    except (OSError, RuntimeError, KeyError) as exc:  # h5py's errors on a damaged file
+        raise DatasetError(f"damaged HDF5 file, cannot read it ({exc})", path=str(path)) from exc
 
 
 def _attr(group: h5py.Group, label: str, path: Path, default: str | None = None) -> str:

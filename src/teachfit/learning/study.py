@@ -37,6 +37,7 @@ from optuna.distributions import FloatDistribution
 from optuna.exceptions import StorageInternalError
 from sqlalchemy.exc import DBAPIError
 
+from teachfit.core.atomic import ensure_folder
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
@@ -99,7 +100,20 @@ def storage_url(storage: str | Path) -> str:
     if "://" in text:
         return text
     path = Path(text).expanduser().resolve()
-    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.is_dir():
+        raise LearningError(f"study file {text} is a folder; give a file name (e.g. runs/s.db)")
+    if path.is_file() and path.stat().st_size > 0:
+        try:
+            with path.open("rb") as fh:
+                header = fh.read(16)
+        except OSError as exc:
+            raise LearningError(f"cannot read study file {text}: {exc.strerror}") from exc
+        if header != b"SQLite format 3\x00":
+            raise LearningError(
+                f"study file {text} is not an SQLite database; give a new file name, an "
+                "existing study, or an SQLAlchemy URL"
+            )
+    ensure_folder(path.parent, f"the folder of study file {text}")
     return f"sqlite:///{path}"
 
 

@@ -167,8 +167,8 @@ def read_params_toml(
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise SkillError(f"cannot read parameter file {path}: {exc}") from exc
     data = data.get("params", data)
     bad = {k: v for k, v in data.items() if isinstance(v, bool) or not isinstance(v, int | float)}

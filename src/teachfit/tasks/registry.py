@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from teachfit.core.errors import TaskError
-from teachfit.tasks.base import Task
+from teachfit.tasks.base import Task, read_task_toml
 from teachfit.tasks.geometry.key import Key
 from teachfit.tasks.geometry.peg import AluminiumPeg
 from teachfit.tasks.geometry.peg2d import Peg2D
@@ -40,12 +40,7 @@ def load_task(spec: str) -> Task:
         return get_task(spec)
     path = Path(spec)
     if path.suffix == ".toml":
-        import tomllib
-
-        try:
-            data = tomllib.loads(path.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as exc:
-            raise TaskError(f"cannot read task file {path}: {exc}") from exc
+        data = read_task_toml(path)
         kind = data.get("task")
         if kind not in TASKS:
             raise TaskError(f"{path}: 'task' must name one of {sorted(TASKS)}, got {kind!r}")
