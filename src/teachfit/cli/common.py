@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import functools
+import math
+import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Annotated, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
 
-from teachfit.core.errors import TeachfitError
+from teachfit.core.errors import OutputError, TeachfitError
 
 console = Console()
 err_console = Console(stderr=True)
@@ -64,6 +67,39 @@ def robot_options(host: str | None, realtime: bool = True) -> dict[str, object]:
     return {} if host is None else {"host": host, "realtime": realtime}
 
 
+#: options that name a file or folder a command writes: :func:`guarded` checks them before the
+#: command runs (a new command's output option named otherwise is added here)
+OUTPUT_OPTIONS = frozenset(
+    {"out", "plot", "render", "markdown", "save", "strip", "keyposes", "toml", "traces",
+     "best_plot", "benchmarks", "workdir", "log", "rrd", "columns_out"}
+)  # fmt: skip
+
+
+def check_output(path: object, option: str = "out") -> None:
+    """Refuse an output path whose folder cannot be made before any work is done: the nearest
+    existing folder above it must be a writable folder (a missing folder is created when the
+    file is written, :mod:`teachfit.core.atomic`)."""
+    if not isinstance(path, Path):
+        return
+    above = next((p for p in path.absolute().parents if p.exists()), None)
+    if above is None:
+        return
+    flag = "--" + option.replace("_", "-")
+    if not above.is_dir():
+        raise OutputError(f"{flag} {path}: {above} is a file, not a folder")
+    if not os.access(above, os.W_OK | os.X_OK):
+        raise OutputError(f"{flag} {path}: folder {above} is not writable")
+
+
+def check_finite(value: object, option: str) -> None:
+    """Refuse ``nan``/``inf`` given to a number option (typer parses them as floats)."""
+    values = value if isinstance(value, list | tuple) else [value]
+    for v in values:
+        if isinstance(v, float) and not math.isfinite(v):
+            flag = "--" + option.replace("_", "-")
+            raise TeachfitError(f"{flag} {v}: give a finite number")
+
+
 P = ParamSpec("P")
 R = TypeVar("R")
 
@@ -74,6 +110,10 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
     @functools.wraps(func)
     def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
         try:
+            for name, value in kwargs.items():
+                check_finite(value, name)
+            for name in OUTPUT_OPTIONS.intersection(kwargs):
+                check_output(kwargs[name], name)
             return func(*args, **kwargs)
         except TeachfitError as exc:
             err_console.print("[bold red]error:[/] ", end="")

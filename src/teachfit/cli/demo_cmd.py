@@ -14,6 +14,7 @@ from teachfit.cli.common import (
     HostOpt,
     RealtimeOpt,
     RobotOpt,
+    check_output,
     console,
     guarded,
     robot_options,
@@ -188,10 +189,6 @@ def import_(
     result = build_demos(raw, task=task, name=name or log.stem, options=options)
     for note in result.notes:
         console.print(f"[yellow]note:[/] {escape(note)}")
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)  # like learn/search/skill outputs
-    except OSError as exc:
-        raise TeachfitError(f"--out {out}: cannot create its folder ({exc.strerror})") from exc
     append_dataset(out, list(result.demos))
     table = Table(
         title=f"{log} -> {out}", caption="start, duration: s; rate: Hz; extent: mm; |F|: N"
@@ -227,10 +224,8 @@ def export(
     overwrite: Annotated[bool, typer.Option(help="replace existing files")] = False,
 ) -> None:
     """Export one demonstration as a CSV log (s, m, w-x-y-z, N, N*m)."""
+    check_output(columns, "columns")  # an output here (an input of demo import)
     the_demo = read_demo(demo)
-    for target in (out, columns):
-        if target is not None:
-            target.parent.mkdir(parents=True, exist_ok=True)
     export_csv(the_demo, out, columns=columns, overwrite=overwrite)
     console.print(
         f"exported {the_demo.n_samples} samples of {the_demo.name or demo} "

@@ -39,6 +39,16 @@ def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
     return tuple(out)
 
 
+def _worker_counts(workers: str) -> list[int]:
+    try:
+        counts = [int(w) for w in workers.split(",") if w.strip()]
+    except ValueError:
+        counts = []
+    if not counts or min(counts) < 1:
+        raise LearningError(f"--scaling-workers wants counts >= 1 like 1,2,4, got {workers!r}")
+    return counts
+
+
 @guarded
 def learn_skill(
     task: Annotated[str, typer.Option(help="task: puzzle, key, peg, ...")] = "puzzle",
@@ -270,6 +280,7 @@ def bench_learning(
     from teachfit.bench import learning as bl
     from teachfit.learning.objective import SkillObjective
 
+    _worker_counts(scaling_workers)  # refused before any work, with --scaling or not
     if scaling:
         _bench_scaling(tasks, scaling_workers, scaling_trials, starts, seed, ray, markdown)
         return
@@ -357,10 +368,7 @@ def _bench_scaling(
 
     from teachfit.bench import learning as bl
 
-    try:
-        counts = [int(w) for w in workers.split(",") if w.strip()]
-    except ValueError:
-        raise LearningError(f"--scaling-workers wants counts like 1,2,4, got {workers!r}") from None
+    counts = _worker_counts(workers)
     task = tasks.split(",")[0]
     with console.status(f"scaling: {task}, {trials} trial(s) per worker, {counts} workers"):
         rows = bl.scaling(

@@ -19,6 +19,7 @@ from teachfit.cli.common import (
     guarded,
     robot_options,
 )
+from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(help="Plan and run search trajectories (seed A).", no_args_is_help=True)
@@ -38,6 +39,8 @@ def learn_search(
     from teachfit.demonstrations.dataset import read_dataset
     from teachfit.models.search_model import SearchModel
 
+    if components != "bic" and not (components.isdigit() and int(components) >= 1):
+        raise TeachfitError(f"--components wants a number >= 1 or 'bic', got {components!r}")
     demo_list = read_dataset(demos)
     tasks = {d.task for d in demo_list}
     if len(tasks) != 1:
@@ -219,7 +222,7 @@ def figures(
 
     model = SearchModel.load(model_file)
     task = get_task(model.task)
-    out.mkdir(parents=True, exist_ok=True)
+    ensure_folder(out, f"the figure folder {out}")
     rng = np.random.default_rng(seed)
     written = [sf.save(sf.samples_over_distribution(model.exploration, rng), out / "samples.png")]
     traj = plan_search(model, "tshix", n, np.random.default_rng(seed))

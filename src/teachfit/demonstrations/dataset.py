@@ -72,14 +72,13 @@ def _quat_wxyz(rot: Rotation) -> np.ndarray:
 def _array(value: Any, column: str, width: int | None, n: int | None) -> np.ndarray:
     """Validated read-only float64 copy with shape (n,) or (n, width); NaN/inf rejected."""
     try:
-        kind = np.asarray(value).dtype.kind
-        arr = np.array(value, dtype=np.float64, copy=True)
+        probe = np.asarray(value)
+        kind = probe.dtype.kind
     except (TypeError, ValueError) as exc:
         raise DatasetError(f"not a numeric array ({exc})", column=column) from exc
     if kind not in "iuf":  # strings, complex numbers, booleans, objects: no silent conversion
-        raise DatasetError(
-            f"holds {np.asarray(value).dtype} values, not real numbers", column=column
-        )
+        raise DatasetError(f"holds {probe.dtype} values, not real numbers", column=column)
+    arr = np.array(probe, dtype=np.float64, copy=True)
     want = "(T,)" if width is None else f"(T, {width})"
     if (width is None and arr.ndim != 1) or (width is not None and arr.shape[1:] != (width,)):
         raise DatasetError(f"shape {arr.shape}, expected {want}", column=column)

@@ -54,14 +54,21 @@ SYNC_S = 1.0
 T = TypeVar("T")
 
 
-def _retry(fn: Callable[[], T], attempts: int = 8) -> T:
-    """``fn()``, retried on database errors: processes creating one study's tables race."""
+#: SQLite's words for a file that no retry will make readable
+_BROKEN = ("malformed", "not a database", "file is encrypted")
+
+
+def _retry(fn: Callable[[], T], attempts: int = 8, what: str = "study database") -> T:
+    """``fn()``, retried on database errors: processes creating one study's tables race.
+    A damaged database, or errors that outlast the retries, are a :class:`LearningError`."""
     for i in range(attempts):
         try:
             return fn()
-        except (DBAPIError, StorageInternalError):
-            if i == attempts - 1:
-                raise
+        except (DBAPIError, StorageInternalError) as exc:
+            cause = getattr(exc, "orig", None) or exc.__cause__ or exc
+            text = (str(cause).strip().splitlines() or [type(cause).__name__])[0]
+            if i == attempts - 1 or any(word in text for word in _BROKEN):
+                raise LearningError(f"{what}: {text}") from exc
             time.sleep(0.05 * 2**i)
     raise AssertionError("unreachable")
 
@@ -124,7 +131,10 @@ def stored_tags(storage: str | Path, name: str = "teachfit") -> dict[str, Any] |
     if "://" not in str(storage) and not Path(storage).expanduser().exists():
         return None  # a file that does not exist yet holds no study: do not create it here
     try:
-        study = optuna.load_study(study_name=name, storage=storage_url(storage))
+        study = _retry(
+            lambda: optuna.load_study(study_name=name, storage=storage_url(storage)),
+            what=f"study database {storage}",
+        )
     except KeyError:
         return None
     return dict(study.user_attrs)
@@ -207,15 +217,18 @@ class Study:
         self.tags = tags
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self.learner = make_learner(method, space, seed, options)
+        what = f"study database {storage}"
         rdb = _retry(
-            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url))
+            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url)),
+            what=what,
         )
         serialise_sqlite(rdb.engine)
         self._rdb = rdb
         self._optuna = _retry(
             lambda: optuna.create_study(
                 storage=rdb, study_name=name, direction="minimize", load_if_exists=True
-            )
+            ),
+            what=what,
         )
         self._dists = {
             n: FloatDistribution(d.low, d.high, log=d.log) for n, d in space.domains.items()
