@@ -63,12 +63,18 @@ def test_write_errors_are_one_clear_teachfit_error(tmp_path: Path) -> None:
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
 
 
-def test_interrupted_process_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> None:
-    """A real process interrupted (SIGINT, as Ctrl-C) while it writes."""
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_interrupted_process_leaves_the_old_file_and_no_temporary(
+    tmp_path: Path, sig: signal.Signals
+) -> None:
+    """A real process interrupted (Ctrl-C, or ``kill``/``timeout`` with the CLI's SIGTERM
+    handler) while it writes."""
     dest = atomic_write_text(tmp_path / "model.json", "old")
     code = (
         "import sys, time\n"
+        "from teachfit.cli.common import exit_on_sigterm\n"
         "from teachfit.core.atomic import atomic_path\n"
+        "exit_on_sigterm()\n"
         "with atomic_path(sys.argv[1]) as tmp, open(tmp, 'xb') as fh:\n"
         "    fh.write(b'half'); fh.flush(); print('writing', flush=True); time.sleep(30)\n"
     )
@@ -80,7 +86,7 @@ def test_interrupted_process_leaves_the_old_file_and_no_temporary(tmp_path: Path
     try:
         assert proc.stdout is not None and proc.stdout.readline() == "writing\n"
         assert len(leftovers(tmp_path)) == 1  # the temporary exists while it writes
-        proc.send_signal(signal.SIGINT)
+        proc.send_signal(sig)
         proc.wait(timeout=20)
     finally:
         proc.kill()

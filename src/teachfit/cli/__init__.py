@@ -44,6 +44,9 @@ register(app, bench_app)
 
 def main() -> None:
     """Console-script entry point."""
+    from teachfit.cli.common import exit_on_sigterm
+
+    exit_on_sigterm()
     app()
 
 

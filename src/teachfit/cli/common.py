@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+import signal
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, ParamSpec, TypeVar
@@ -98,6 +99,17 @@ def check_finite(value: object, option: str) -> None:
         if isinstance(v, float) and not math.isfinite(v):
             flag = "--" + option.replace("_", "-")
             raise TeachfitError(f"{flag} {v}: give a finite number")
+
+
+def exit_on_sigterm() -> None:
+    """Make SIGTERM (``kill``, ``timeout``, a scheduler) end the process like Ctrl-C does:
+    ``SystemExit(143)`` unwinds the stack, so half-written outputs' temporary files are removed
+    (:mod:`teachfit.core.atomic`) instead of being left behind by the default handler."""
+
+    def terminate(signum: int, frame: object) -> None:
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, terminate)
 
 
 P = ParamSpec("P")
