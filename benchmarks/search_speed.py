@@ -1,11 +1,14 @@
 """Wall time of TSHIX (ours vs LKH via elkai) and of ergodic search, measured in one run.
 
-Usage: ``python benchmarks/search_speed.py [--repeats 5] [--seed 0]``
+Usage: ``python benchmarks/search_speed.py [--repeats 5] [--seed 0] [--sizes 100,300,1000]``
 
 For each N = 100..500 TSHIX plans ``repeats`` trajectories from a fixed 2-D exploration
 distribution; the tour length of our open-tour solver is compared with LKH-3 (elkai) on the
 same samples. Then one ergodic trajectory of the TSHIX (N = 300) length is generated in 2D and
-3D (x, y, rz). Times are medians of wall-clock seconds (``time.perf_counter``).
+3D (x, y, rz). Last, the open-tour solver alone on three point families (uniform, Gaussian,
+clustered: 8 clusters of 2 mm spread in a 40 mm square) against LKH-3 on the same points.
+Times are medians of wall-clock seconds (``time.perf_counter``); the open-tour timings are
+the solver's CPU time (``time.process_time``), which a loaded machine disturbs less.
 """
 
 from __future__ import annotations
@@ -34,7 +37,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--sizes", default="100,300,1000", help="point counts of the family table")
     args = ap.parse_args()
+    open_tour(np.random.default_rng(0).uniform(size=(20, 2)))  # compile the kernel first
     print("TSHIX wall time (median of", args.repeats, "runs), tour length vs LKH (elkai, RUNS=1)")
     print(
         f"{'dims':>6} {'N':>4} {'TSHIX [ms]':>11} {'TSP ours [ms]':>14} {'LKH [ms]':>9} "
@@ -85,6 +90,37 @@ def main() -> None:
             f"optimised {opt.meta['ergodic_metric']:.4f} in {t_opt:.2f} s "
             f"(length {opt.path_length(ls):.3f} m)"
         )
+
+    families(args.seed, [int(v) for v in args.sizes.split(",")])
+
+
+def _points(family: str, n: int, rng: np.random.Generator) -> np.ndarray:
+    if family == "uniform":
+        return rng.uniform(-0.02, 0.02, (n, 2))
+    if family == "gaussian":
+        return rng.normal(0.0, 0.01, (n, 2))
+    centres = rng.uniform(-0.02, 0.02, (8, 2))
+    return centres[rng.integers(0, 8, n)] + rng.normal(0.0, 0.002, (n, 2))
+
+
+def families(seed: int, sizes: list[int]) -> None:
+    """Open tours on uniform, Gaussian and clustered points: ours vs LKH-3 (elkai, RUNS=1)."""
+    print("\nOpen tour on three point families (CPU ms; length / LKH length)")
+    print(f"{'family':>10} {'N':>5} {'ours [ms]':>10} {'LKH [ms]':>9} {'ratio':>7}")
+    for family in ("uniform", "gaussian", "clustered"):
+        for n in sizes:
+            pts = _points(family, n, np.random.default_rng(seed + n))
+            t0 = time.process_time()
+            ours = open_tour(pts)
+            t_ours = time.process_time() - t0
+            t0 = time.process_time()
+            ref = open_tour(pts, solver="lkh")
+            t_lkh = time.process_time() - t0
+            print(
+                f"{family:>10} {n:>5} {1e3 * t_ours:>10.1f} {1e3 * t_lkh:>9.0f} "
+                f"{ours.length / ref.length:>7.4f}",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -1,10 +1,24 @@
 import functools
 import os
+import shutil
+import tempfile
+import uuid
+from pathlib import Path
 
 import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("COLUMNS", "200")
+
+
+@pytest.fixture(scope="session")
+def mesh_examples(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
+    """The shipped mesh task examples written once per session: name -> task file path (their
+    decompositions are cached beside them)."""
+    from teachfit.tasks.mesh.examples import EXAMPLES, write_example
+
+    folder = tmp_path_factory.mktemp("mesh_examples")
+    return {name: str(write_example(name, folder / name)) for name in EXAMPLES}
 
 
 @functools.cache
@@ -30,3 +44,32 @@ def needs_gl() -> None:
     error = _gl_context_error()
     if error is not None:
         pytest.skip(f"no OpenGL context for offscreen rendering (MUJOCO_GL=egl/osmesa): {error}")
+
+
+_CACHE_ENV = "TEACHFIT_TEACHER_CACHE"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """One teacher cache for the whole run, shared by the xdist workers (they inherit the
+    controller's environment): the seeded teacher's recordings that several tests make
+    (10-20 s each) are simulated once per run, and the folder is removed at the end."""
+    if os.environ.get(_CACHE_ENV):
+        return  # a worker (or a cache the user chose)
+    root = Path(tempfile.gettempdir()) / f"teachfit-teacher-cache-{uuid.uuid4().hex[:12]}"
+    os.environ[_CACHE_ENV] = str(root)
+    config.stash[_owned_cache] = root
+
+
+_owned_cache = pytest.StashKey[Path]()
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    root = config.stash.get(_owned_cache, None)
+    if root is not None:  # the controller (or a run without xdist) made it
+        shutil.rmtree(root, ignore_errors=True)
+
+
+@pytest.fixture
+def no_teacher_cache(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Tests of the teacher itself record for real."""
+    monkeypatch.delenv(_CACHE_ENV, raising=False)

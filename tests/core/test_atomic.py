@@ -111,7 +111,9 @@ def _direct_writes(tree: ast.AST) -> list[tuple[int, str]]:
         if name == "copyfile":  # copyfile(src, dst)
             first = node.args[1] if len(node.args) > 1 else None
         # a temporary from atomic_path, or a file handle opened on one
-        on_tmp = isinstance(first, ast.Name) and first.id in {"tmp", "fh"}
+        on_tmp = isinstance(first, ast.Name) and first.id in {"tmp", "fh", "buf"}
+        if name in {"replace", "rename", "mkstemp"}:
+            on_tmp = False  # moving files into place is the helper's job alone
         target = isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name)
         if name == "open":
             modes = [a for a in node.args[1:2] if isinstance(a, ast.Constant)]
@@ -156,8 +158,9 @@ def test_the_scan_finds_direct_writes() -> None:
     bad = (
         "fig.savefig(path)\np.write_text('x')\nopen(p, 'w')\np.open('a')\nnp.save(p, a)\n"
         "h5py.File(p, 'w')\nos.replace(a, b)\nimageio.get_writer(out)\nshutil.copyfile(tmp, p)\n"
+        "os.replace(tmp, p)\ntempfile.mkstemp(dir=d)\n"
     )
-    assert len(_direct_writes(ast.parse(bad))) == 9
+    assert len(_direct_writes(ast.parse(bad))) == 11
     good = (
         "fig.savefig(tmp)\ntmp.write_text('x')\nopen(tmp, 'xb')\nopen(p)\nnp.save(fh, a)\n"
         "h5py.File(p, 'r')\nh5py.File(tmp, 'x')\ns.replace('a', 'b')\nshutil.copyfile(p, tmp)\n"

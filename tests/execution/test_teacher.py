@@ -5,6 +5,8 @@ from teachfit.core.errors import TeachfitError
 from teachfit.execution.teacher import BlindTeacher, TeacherStyle
 from teachfit.tasks import get_task
 
+pytestmark = pytest.mark.usefixtures("no_teacher_cache")
+
 
 def test_teacher_demos_succeed_and_look_kinesthetic():
     task = get_task("peg2d")

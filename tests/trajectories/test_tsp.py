@@ -46,7 +46,7 @@ def test_close_to_lkh_on_gaussian_samples(dim):
     r = open_tour(pts, rng=np.random.default_rng(0))
     assert sorted(r.order.tolist()) == list(range(300))
     ref = open_tour(pts, solver="lkh")
-    assert r.length <= 1.05 * ref.length
+    assert r.length <= 1.02 * ref.length
     # the solver's speed is a benchmark figure (benchmarks/search_speed.py), not a test
 
 

@@ -70,6 +70,12 @@ def bench_search(
     ] = None,
     markdown: Annotated[Path | None, typer.Option(help="append the tables as markdown")] = None,
     robot: RobotOpt = "floating",
+    task: Annotated[
+        str | None, typer.Option(help="Table I's protocol on this task (name or .toml) instead")
+    ] = None,
+    demo: Annotated[
+        Path | None, typer.Option(help="--task: its demonstrations (default: record one)")
+    ] = None,
 ) -> None:
     """Seed A's search experiments in simulation, beside the paper's numbers.
 
@@ -80,8 +86,13 @@ def bench_search(
 
     if table not in TABLES:
         raise TeachfitError(f"unknown table {table!r}; available: {list(TABLES)}")
+    if demo is not None and task is None:
+        raise TeachfitError(f"--demo {demo} is for --task TASK (the paper's tables record theirs)")
     todo = TABLES[:-1] if table == "all" else (table,)
     bs.use_robot(robot)
+    if task is not None:
+        _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
+        return
     with Progress(console=console, transient=True) as bar:
         if "1" in todo:
             n = starts or 30
@@ -124,3 +135,29 @@ def bench_search(
                 rows,
                 markdown,
             )
+
+
+def _task_table(
+    task: str,
+    demo: Path | None,
+    seed: int,
+    starts: int,
+    points: int,
+    workers: int | None,
+    markdown: Path | None,
+) -> None:
+    from teachfit.bench.search_task import task_demos, task_table
+    from teachfit.demonstrations.dataset import read_dataset
+    from teachfit.tasks.registry import load_task
+
+    load_task(task)  # a bad task file fails first, before any demonstration is read
+    if demo is None:
+        with console.status(f"the blind teacher demonstrates {task}"):
+            demos = task_demos(task, seed)
+    else:
+        demos = read_dataset(demo)
+    with Progress(console=console, transient=True) as bar:
+        job = bar.add_task(f"Table I protocol on {task}", total=2 * starts)
+        rows = task_table(task, demos, seed, starts, points, workers, lambda: bar.advance(job))
+    title = f"Table I protocol ({task}, {len(demos)} demo(s), {starts} starts, seed {seed})"
+    _emit(title, rows, markdown)

@@ -20,6 +20,7 @@ from teachfit.cli.common import (
     robot_options,
     seed_option,
 )
+from teachfit.cli.recording import show_run_log
 from teachfit.core.errors import DatasetError, TeachfitError
 from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
@@ -36,6 +37,7 @@ from teachfit.demonstrations.importing import ImportOptions, build_demos
 from teachfit.demonstrations.plausibility import CHECKS
 from teachfit.demonstrations.rosbag_import import is_bag, read_bag
 from teachfit.demonstrations.segment import Segmenter
+from teachfit.execution.recording import is_run_log
 from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
 from teachfit.tasks.registry import load_task
 
@@ -236,10 +238,14 @@ def export(
 @app.command("show")
 @guarded
 def show(
-    dataset: Annotated[Path, typer.Argument(help="HDF5 demonstration file")],
+    dataset: Annotated[Path, typer.Argument(help="HDF5 demonstration file or run log (--log)")],
     plot: Annotated[Path | None, typer.Option(help="write a figure (PNG/PDF) here")] = None,
 ) -> None:
-    """List the demonstrations in a file; optionally plot paths and wrenches."""
+    """List the demonstrations in a file (or a run log's episodes); optionally plot paths and
+    wrenches (a run log: pose, wrench and active node over time)."""
+    if is_run_log(dataset):
+        show_run_log(dataset, plot)
+        return
     rows = dataset_summary(dataset)
     table = Table(title=str(dataset))
     for col in ("index", "name", "task", "source", "samples", "duration", "rate"):

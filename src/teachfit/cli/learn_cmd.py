@@ -234,7 +234,9 @@ def _report_best(
 
 @guarded
 def bench_learning(
-    tasks: Annotated[str, typer.Option(help="comma-separated tasks")] = "puzzle,key,peg",
+    tasks: Annotated[
+        str, typer.Option("--tasks", "--task", help="comma-separated tasks (names or .toml)")
+    ] = "puzzle,key,peg",
     methods: Annotated[str, typer.Option(help="comma-separated methods")] = "cmaes,pso,bo,lhs",
     experiments: Annotated[int, typer.Option(min=1, help="learning runs per task and method")] = 2,
     trials: Annotated[int, typer.Option(min=1, help="trials per experiment")] = 60,

@@ -1,4 +1,4 @@
-"""Top-level commands: tasks, render, quickstart, bench sim."""
+"""Top-level commands: tasks (:mod:`teachfit.cli.tasks_cmd`), render, quickstart, bench sim."""
 
 from __future__ import annotations
 
@@ -18,29 +18,7 @@ from teachfit.cli.common import (
     count_option,
     guarded,
 )
-from teachfit.tasks.registry import TASKS, load_task
-
-
-@guarded
-def tasks(
-    xml: Annotated[str | None, typer.Option(help="print the MJCF scene of this task")] = None,
-) -> None:
-    """List the built-in tasks with their parameters."""
-    if xml is not None:
-        from teachfit.robot.floating import build_scene
-
-        console.print(build_scene(load_task(xml)), markup=False, highlight=False)
-        return
-    for name, cls in TASKS.items():
-        task = cls()
-        table = Table(title=f"{name}: {cls.description}", title_justify="left")
-        table.add_column("parameter")
-        table.add_column("default", justify="right")
-        table.add_column("meaning")
-        for pname, value, doc in task.param_table():
-            table.add_row(pname, f"{value:g}" if isinstance(value, float) else str(value), doc)
-        console.print(table)
-        console.print(f"  search dims: {', '.join(cls.search_dims)}\n")
+from teachfit.tasks.registry import load_task
 
 
 @guarded
@@ -111,7 +89,9 @@ def bench_sim(
 
 
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
-    app.command("tasks")(tasks)
+    from teachfit.cli.tasks_cmd import tasks_app
+
+    app.add_typer(tasks_app, name="tasks")
     app.command("render")(render)
     app.command("quickstart")(quickstart)
     bench_app.command("sim")(bench_sim)

@@ -19,6 +19,7 @@ from teachfit.cli.common import (
     guarded,
     robot_options,
 )
+from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
 
@@ -31,8 +32,12 @@ def learn_search(
     out: Annotated[Path, typer.Option(help="model file to write (JSON)")] = Path("search.model"),
     components: Annotated[str, typer.Option(help="GMM components: a number or 'bic'")] = "1",
     covariance: Annotated[
-        str, typer.Option(help="p_e covariance: 'full' (seed A) or 'diag' (per-DOF variances)")
-    ] = "full",
+        str,
+        typer.Option(
+            help="p_e covariance: 'auto' (chosen by leave-one-demonstration-out likelihood), "
+            "'full' (seed A) or 'diag' (per-DOF variances)"
+        ),
+    ] = "auto",
     seed: SeedOpt = 0,
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
@@ -59,7 +64,12 @@ def learn_search(
         f"learned from {len(demo_list)} demonstration(s) of [bold]{model.task}[/]: "
         f"dims {', '.join(model.dims)}, {e.n_components} component(s), "
         f"mean {np.round(e.mean * 1e3, 1)} (mm/mrad), teacher speed {model.speed * 1e3:.1f} mm/s"
-        f"\nmodel -> {out}"
+        + (
+            f"\ncovariance: {model.covariance_choice.describe()}"
+            if model.covariance_choice is not None
+            else ""
+        )
+        + f"\nmodel -> {out}"
     )
 
 
@@ -115,6 +125,7 @@ def plan(
 @search_app.command("run")
 @guarded
 def run(
+    ctx: typer.Context,
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     model_file: Annotated[Path, typer.Option("--model", help="learned model")] = Path(
         "search.model"
@@ -137,6 +148,8 @@ def run(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    log: LogOpt = None,
+    rrd: RrdOpt = None,
 ) -> None:
     """Execute searches from the protocol's starts and print the success table.
 
@@ -149,6 +162,7 @@ def run(
     from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
 
+    check_recording_targets(log, rrd)
     the_task = load_task(task)
     model = SearchModel.load(model_file, task=the_task.name)
     demo_start = None
@@ -195,6 +209,7 @@ def run(
         ", ".join(f"{k} {v}" for k, v in reasons.items()),
     )
     console.print(table)
+    write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method), ctx.params)
     if plot is not None:
         from teachfit.viz.figures import plot_executions
 

@@ -20,6 +20,7 @@ from teachfit.cli.common import (
     robot_options,
     seed_option,
 )
+from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.core.atomic import atomic_write_text
 
 skill_app = typer.Typer(
@@ -93,6 +94,7 @@ def show(
 @skill_app.command("run")
 @guarded
 def run(
+    ctx: typer.Context,
     skill: Annotated[str, _SKILL] = "peg-in-hole",
     task: Annotated[str, typer.Option(help="task name or .toml")] = "peg2d",
     params: Annotated[Path | None, typer.Option(help="learned values (TOML)")] = None,
@@ -108,9 +110,12 @@ def run(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    log: LogOpt = None,
+    rrd: RrdOpt = None,
 ) -> None:
     """Run a skill on a task from several start poses: one seed-B trial, (success, cost)."""
     from teachfit.core.errors import SkillError
+    from teachfit.execution.recording import skill_episodes
     from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
     from teachfit.skills.library import get_skill
     from teachfit.skills.params import read_params_toml
@@ -120,6 +125,7 @@ def run(
         raise SkillError(f"--starts must be >= 1, got {starts}")
     if render is not None and not 0 <= render_start < starts:
         raise SkillError(f"--render-start must be within [0, {starts - 1}]")
+    check_recording_targets(log, rrd)
     the_task = load_task(task)
     setup = peg_in_hole_setup(the_task, seed, starts, controller, get_skill(skill, controller))
     learned = None
@@ -165,6 +171,9 @@ def run(
         f"trial: {sum(out.successes)}/{len(out.successes)} succeeded, cost {out.cost:.3f} s; "
         f"{wall / len(out.traces):.3f} s wall per execution, {steps / wall:,.0f} sim steps/s"
     )
+    episodes = skill_episodes(out, setup)
+    info = ("skill", the_task, robot, seed, f"{skill} {controller}")
+    write_recordings(log, rrd, episodes, info, ctx.params)
     if plot is not None:
         from teachfit.viz.skill_figures import plot_traces
 

@@ -200,7 +200,7 @@ def execute(
     blk = np.zeros((6, 6))
     blk[:3, :3] = rot
     blk[3:, 3:] = rot
-    sp_pos, sp_ff = np.zeros(3), np.zeros(6)
+    sp_pos, sp_ff, sp_quat = np.zeros(3), np.zeros(6), np.zeros(4)
     dq, qtmp = np.zeros(4), np.zeros(4)
     last_pos = np.zeros(3)  # the last finite TCP position (world)
     detect = task.detect_success if task is not None and _uses_detected(skill) else None
@@ -213,6 +213,7 @@ def execute(
     pc.hold_here()
     last_pos[:] = pc.pos
     sp_pos[:] = pc.pos
+    sp_quat[:] = pc.quat
     visits: list[NodeVisit] = []
     t_contact = math.nan
     t_success = math.nan
@@ -248,6 +249,7 @@ def execute(
             )
         )  # fmt: skip
         sp_pos[:] = pos_w
+        sp_quat[:] = quat_w
         sp_ff[:] = ff
         pc.p_d += v * dt
         if w[0] != 0.0 or w[1] != 0.0 or w[2] != 0.0:
@@ -274,9 +276,9 @@ def execute(
         if math.isnan(t_contact) and force >= cfg.contact_force:
             t_contact = t
         if (steps // ticks) % log_every == 0:
-            log.add(t, st, pc.depth, sp_pos, sp_ff, node_index)
+            log.add(t, st, pc.depth, sp_pos, sp_ff, node_index, sp_quat)
 
-    log.add(0.0, state, pc.depth, sp_pos, sp_ff, idx)
+    log.add(0.0, state, pc.depth, sp_pos, sp_ff, idx, sp_quat)
     faulted = by_error = False
     while running:
         if success(pc):

@@ -17,7 +17,8 @@ class ExecutionLog:
     ----------
     t : (T,) s since the execution started.
     pos : (T, 3) m;  quat : (T, 4) w-x-y-z;  wrench : (T, 6) N, N·m exerted by the environment.
-    setpoint_pos : (T, 3) m, the last commanded set-point.
+    setpoint_pos : (T, 3) m, the last commanded set-point;  setpoint_quat : (T, 4) w-x-y-z, its
+    orientation.
     wrench_ff : (T, 6) N, N·m, the last commanded feed-forward wrench.
     depth : (T,) m below the task frame's x-y plane.
     node : (T,) index of the active node (-1: recovery).
@@ -31,6 +32,7 @@ class ExecutionLog:
     wrench_ff: np.ndarray
     depth: np.ndarray
     node: np.ndarray
+    setpoint_quat: np.ndarray
 
     @property
     def n_samples(self) -> int:
@@ -44,6 +46,7 @@ class LogBuffer:
         self.t, self.depth = np.zeros(n), np.zeros(n)
         self.pos, self.quat, self.wrench = np.zeros((n, 3)), np.zeros((n, 4)), np.zeros((n, 6))
         self.setpoint_pos, self.wrench_ff = np.zeros((n, 3)), np.zeros((n, 6))
+        self.setpoint_quat = np.zeros((n, 4))
         self.node = np.zeros(n, dtype=int)
         self.k = 0
 
@@ -55,12 +58,14 @@ class LogBuffer:
         setpoint_pos: np.ndarray,
         wrench_ff: np.ndarray,
         node: int,
+        setpoint_quat: np.ndarray,
     ) -> None:
         k = self.k
         if k < self.t.size:
             self.t[k], self.depth[k], self.node[k] = t, depth, node
             self.pos[k], self.quat[k], self.wrench[k] = state.pos, state.quat, state.wrench
             self.setpoint_pos[k], self.wrench_ff[k] = setpoint_pos, wrench_ff
+            self.setpoint_quat[k] = setpoint_quat
             self.k = k + 1
 
     def freeze(self) -> ExecutionLog:
@@ -71,4 +76,5 @@ class LogBuffer:
             self.wrench_ff[:k].copy(),
             self.depth[:k].copy(),
             self.node[:k].copy(),
+            self.setpoint_quat[:k].copy(),
         )

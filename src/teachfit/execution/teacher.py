@@ -30,6 +30,7 @@ from teachfit.core.geometry import Pose, quat_from_rz
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.execution.follow import run_trajectory
+from teachfit.execution.teacher_cache import cache_key, cached
 from teachfit.robot.registry import make_robot
 from teachfit.skills.follow import FollowConfig
 from teachfit.tasks.base import Task
@@ -82,8 +83,11 @@ class BlindTeacher:
     ) -> None:
         self.task = task
         self.style = style or TeacherStyle()
+        self.seed, self.robot_name = int(seed), robot
         self.rng = np.random.default_rng(seed)
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
+        self._fresh = True  # nothing recorded yet: a recording depends on the seed alone
+        self._replayed = False
         self.has_rz = "rz" in task.search_dims
 
     # ------------------------------------------------------------------------ planning
@@ -177,6 +181,13 @@ class BlindTeacher:
     def demonstrate(self, start: Pose | None = None) -> tuple[Demonstration | None, str]:
         """One attempt. Returns ``(demo, "ok")`` or ``(None, why it was discarded)``."""
         st = self.style
+        if self._replayed:
+            raise TeachfitError(
+                "this teacher's first recording came from the teacher cache "
+                "(TEACHFIT_TEACHER_CACHE), so its random state is not where a recording left it: "
+                "record more with a new BlindTeacher"
+            )
+        self._fresh = False
         start = start or self.task.protocol.teacher_start(self.rng)
         cfg = FollowConfig(
             stiffness_along=st.arm_stiffness,
@@ -218,10 +229,35 @@ class BlindTeacher:
         max_attempts: int | None = None,
         progress: bool = False,
     ) -> tuple[list[Demonstration], list[str]]:
-        """Record ``n`` accepted demonstrations; returns them and the reasons for discards."""
+        """Record ``n`` accepted demonstrations; returns them and the reasons for discards.
+
+        A first recording of a teacher is read from the folder named by the environment
+        variable ``TEACHFIT_TEACHER_CACHE`` when it holds the same one (see
+        :mod:`teachfit.execution.teacher_cache`).
+        """
         if n <= 0:
             raise TeachfitError(f"number of demonstrations must be positive, got {n}")
         limit = max_attempts or 5 * n
+        if self._fresh:
+            key = cache_key(
+                task=self.task,
+                style=self.style,
+                seed=self.seed,
+                robot=self.robot_name,
+                n=n,
+                limit=limit,
+            )
+            self._fresh, self._replayed = False, True
+            return cached(key, lambda: self._record_fresh(n, limit, progress))
+        return self._record(n, limit, progress)
+
+    def _record_fresh(
+        self, n: int, limit: int, progress: bool
+    ) -> tuple[list[Demonstration], list[str]]:
+        self._replayed = False  # recorded here, not replayed: the state is where it should be
+        return self._record(n, limit, progress)
+
+    def _record(self, n: int, limit: int, progress: bool) -> tuple[list[Demonstration], list[str]]:
         demos: list[Demonstration] = []
         discarded: list[str] = []
         with Progress(disable=not progress, transient=True) as bar:

@@ -13,7 +13,9 @@ File format (JSON, UTF-8, no pickle)::
       "n_demos": 1,
       "exploration": {"dims": [...], "weights": [K], "means": [K][D], "covs": [K][D][D]},
       "dynamics": {"dims": [...], "weights": [K], "means": [K][2D], "covs": [K][2D][2D]}
-                  or null           # (no wrench recorded: no feed-forward)
+                  or null,          # (no wrench recorded: no feed-forward)
+      "covariance_choice": {"covariance": "diag", "criterion": "held-out",
+                            "scores": {"full": -9.1, "diag": -2.3}}   # optional
     }
 
 Units: m and rad for states and steps (steps per sample at ``rate_hz``), N and N m for actions.
@@ -31,6 +33,7 @@ import numpy as np
 
 from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import ModelError
+from teachfit.models.covariance_choice import CovarianceChoice, choose_covariance
 from teachfit.models.dynamics import DynamicsModel, fit_dynamics
 from teachfit.models.exploration import ExplorationDistribution, fit_exploration
 from teachfit.models.search_data import dims_for_task, search_data, validate_dims
@@ -59,6 +62,8 @@ class SearchModel:
     angular_speed : float or None
         Median teacher |d rz / dt|, rad/s; None when rz is not searched.
     n_demos : int
+    covariance_choice : CovarianceChoice or None
+        How p_e's covariance structure was chosen (None: not recorded, e.g. an older file).
     """
 
     task: str
@@ -69,6 +74,7 @@ class SearchModel:
     speed: float
     angular_speed: float | None = None
     n_demos: int = 1
+    covariance_choice: CovarianceChoice | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dims", validate_dims(self.dims))
@@ -96,25 +102,39 @@ class SearchModel:
         rate_hz: float | None = None,
         rel_floor: float = 0.05,
         seed: int = 0,
-        covariance: Literal["full", "diag"] = "full",
+        covariance: Literal["auto", "full", "diag"] = "auto",
     ) -> SearchModel:
         """Learn p_e and the dynamics from demonstrations (see :func:`search_data`).
 
         ``dims`` defaults to the task's search DOFs; ``covariance`` is p_e's covariance type
-        (:func:`fit_exploration`). Raises ModelError for too few or degenerate samples, or a
+        (:func:`fit_exploration`), ``"auto"`` choosing it by leave-one-demonstration-out
+        likelihood (:mod:`teachfit.models.covariance_choice`; recorded in
+        ``covariance_choice``). Raises ModelError for too few or degenerate samples, or a
         teacher who never moved.
         """
         dims = dims_for_task(task) if dims is None else validate_dims(dims)
+        demos = [demos] if hasattr(demos, "pos") else list(demos)
         data = search_data(demos, dims, rate_hz=rate_hz)
-        expl = fit_exploration(
-            data.states,
-            dims,
-            n_components=n_components,
-            max_components=max_components,
-            rel_floor=rel_floor,
-            seed=seed,
-            covariance=covariance,
-        )
+
+        def fit(states: np.ndarray, structure: str) -> ExplorationDistribution:
+            return fit_exploration(
+                states,
+                dims,
+                n_components=n_components,
+                max_components=max_components,
+                rel_floor=rel_floor,
+                seed=seed,
+                covariance=structure,  # type: ignore[arg-type]
+            )
+
+        if covariance == "auto":
+            per_demo = [search_data(d, dims, rate_hz=data.rate_hz).states for d in demos]
+            choice = choose_covariance(per_demo, fit)
+        elif covariance in ("full", "diag"):
+            choice = CovarianceChoice(covariance, "given")
+        else:
+            raise ModelError(f"covariance must be 'auto', 'full' or 'diag', got {covariance!r}")
+        expl = fit(data.states, choice.covariance)
         dyn = None
         if data.actions is not None:
             dyn = fit_dynamics(
@@ -129,7 +149,15 @@ class SearchModel:
         if data.speed <= 0:
             raise ModelError("the demonstrations never move in the search plane")
         return cls(
-            task, dims, expl, dyn, data.rate_hz, data.speed, data.angular_speed, data.n_demos
+            task,
+            dims,
+            expl,
+            dyn,
+            data.rate_hz,
+            data.speed,
+            data.angular_speed,
+            data.n_demos,
+            choice,
         )
 
     def feedforward(self, velocity: np.ndarray) -> np.ndarray:
@@ -162,6 +190,11 @@ class SearchModel:
             "n_demos": self.n_demos,
             "exploration": self.exploration.to_dict(),
             "dynamics": None if self.dynamics is None else self.dynamics.to_dict(),
+            **(
+                {}
+                if self.covariance_choice is None
+                else {"covariance_choice": self.covariance_choice.to_dict()}
+            ),
         }
 
     def save(self, path: str | Path) -> Path:
@@ -194,6 +227,11 @@ class SearchModel:
                 speed=float(doc["speed"]),
                 angular_speed=None if doc["angular_speed"] is None else float(doc["angular_speed"]),
                 n_demos=int(doc["n_demos"]),
+                covariance_choice=(
+                    None
+                    if doc.get("covariance_choice") is None
+                    else CovarianceChoice.from_dict(doc["covariance_choice"])
+                ),
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise ModelError(f"invalid search model document: {exc!r}") from exc

@@ -310,15 +310,22 @@ PARTS: Mapping[str, Callable[..., LGrooveParams | TenonParams]] = MappingProxyTy
 
 
 def build_assembly(task: str, **overrides: float) -> Assembly:
-    """Build a registered task's assembly, with optional dimension overrides (m).
+    """Build a registered task's assembly, with optional dimension overrides (m); a mesh
+    task file (``.toml``) gives its exact meshes (:mod:`teachfit.plans.mesh_parts`).
 
     Raises
     ------
     TaskError
         Unknown task name, unknown or invalid dimension.
     """
+    if task.endswith(".toml") and task not in PARTS:
+        if overrides:
+            raise TaskError("a mesh task's dimensions are in its meshes: no overrides")
+        from teachfit.plans.mesh_parts import mesh_assembly
+
+        return mesh_assembly(task)
     if task not in PARTS:
-        raise TaskError(f"unknown task {task!r}; known: {', '.join(PARTS)}")
+        raise TaskError(f"unknown task {task!r}; known: {', '.join(PARTS)} (or a mesh .toml)")
     cls = PARTS[task]
     unknown = set(overrides) - set(cls.__dataclass_fields__)
     if unknown:

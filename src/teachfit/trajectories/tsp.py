@@ -4,13 +4,11 @@ The open path is solved as a closed tour over ``start, points…, dummy`` in whi
 zero distance from every node and the edge ``(dummy, start)`` may never be removed: the closed
 tour ``start → p_1 → … → p_N → dummy → start`` then costs exactly the open path.
 
-``solver="fast"`` (default) is written here because no maintained Python package offers a
-millisecond open-path heuristic of LKH-like quality: nearest-neighbour construction, then local
-search with 2-opt and Or-opt moves restricted to K nearest neighbours (``scipy.spatial.cKDTree``)
-with don't-look bits, then iterated local search with local double-bridge kicks (accepted when
-they shorten the tour). Scalar moves use Python lists: for a few hundred nodes this is faster than
-numpy calls on tiny arrays. ``solver="lkh"`` calls LKH-3 through ``elkai`` (slow, reference
-quality).
+``solver="fast"`` (default): nearest-neighbour construction, then the compiled local search
+of :mod:`teachfit.trajectories.tsp_kernel` (2-opt and Or-opt over nearest and quadrant
+neighbours from ``scipy.spatial.cKDTree``, then a fixed number of seeded double-bridge kicks;
+why it is written here is said there). ``solver="lkh"`` calls LKH-3 through ``elkai`` (slow,
+the reference quality of the benchmark).
 
 Distances are Euclidean after scaling each coordinate by ``weights`` (e.g. ``(1, 1, ℓ)`` to
 count a rotation about z as ℓ metres per radian).
@@ -18,8 +16,6 @@ count a rotation about z as ℓ metres per radian).
 
 from __future__ import annotations
 
-import time
-from collections import deque
 from dataclasses import dataclass
 from typing import Literal
 
@@ -53,137 +49,6 @@ def path_length(start: np.ndarray, points: np.ndarray, order: np.ndarray, weight
     return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 
-class _LocalSearch:
-    """2-opt + Or-opt on a cyclic tour held in lists, with neighbour lists and don't-look bits."""
-
-    def __init__(
-        self,
-        dist: list[list[float]],
-        neigh: list[list[int]],
-        tour: list[int],
-        start: int,
-        dummy: int,
-        eps: float,
-    ) -> None:
-        self.d, self.neigh, self.tour = dist, neigh, tour
-        self.n = len(tour)
-        self.pos = [0] * self.n
-        for i, v in enumerate(tour):
-            self.pos[v] = i
-        self.start, self.dummy, self.eps = start, dummy, eps
-        self.gain = 0.0  # total length removed by improving moves so far
-
-    def _fixed(self, u: int, v: int) -> bool:
-        return (u == self.start and v == self.dummy) or (u == self.dummy and v == self.start)
-
-    def _reverse(self, i: int, j: int) -> None:
-        """Reverse the cyclic segment tour[i..j] (forward), or its complement if shorter."""
-        n, tour, pos = self.n, self.tour, self.pos
-        length = (j - i) % n + 1
-        if 2 * length > n:
-            i, j, length = (j + 1) % n, (i - 1) % n, n - length
-        for k in range(length // 2):
-            ii, jj = (i + k) % n, (j - k) % n
-            u, v = tour[ii], tour[jj]
-            tour[ii], tour[jj] = v, u
-            pos[v], pos[u] = ii, jj
-
-    def two_opt(self, a: int) -> list[int] | None:
-        d, tour, pos, n = self.d, self.tour, self.pos, self.n
-        da = d[a]
-        for succ in (True, False):
-            i = pos[a]
-            b = tour[(i + 1) % n] if succ else tour[i - 1]
-            if self._fixed(a, b):
-                continue
-            dab = da[b]
-            for c in self.neigh[a]:
-                dac = da[c]
-                if dac >= dab:
-                    break
-                j = pos[c]
-                e = tour[(j + 1) % n] if succ else tour[j - 1]
-                if c == b or e == a or self._fixed(c, e):
-                    continue
-                delta = dab + d[c][e] - dac - d[b][e]
-                if delta > self.eps:
-                    self.gain += delta
-                    if succ:
-                        self._reverse(pos[b], pos[c])
-                    else:
-                        self._reverse(pos[a], pos[e])
-                    return [a, b, c, e]
-        return None
-
-    def or_opt(self, a: int) -> list[int] | None:
-        d, tour, pos, n = self.d, self.tour, self.pos, self.n
-        start, dummy, eps = self.start, self.dummy, self.eps
-        i = pos[a]
-        rot = tour[i:] + tour[:i]  # rot[0] = a
-        p = rot[-1]
-        for seg_len in (1, 2, 3):
-            if n < seg_len + 3:
-                break
-            seg = rot[:seg_len]
-            s1, s2, nx = seg[0], seg[-1], rot[seg_len]
-            if s2 == start or s2 == dummy:
-                break
-            gain_rm = d[p][s1] + d[s2][nx] - d[p][nx]
-            if gain_rm <= eps:
-                continue
-            best = None
-            for end, other in ((s1, s2), (s2, s1)):
-                dend, doth = d[end], d[other]
-                for c in self.neigh[end]:
-                    dce = dend[c]
-                    if dce >= gain_rm:
-                        break
-                    if c in seg:
-                        continue
-                    j = pos[c]
-                    dc = d[c]
-                    for left in (True, False):  # insert between (c, succ c) or (pred c, c)
-                        o = tour[(j + 1) % n] if left else tour[j - 1]
-                        if o in seg or (c == start and o == dummy) or (c == dummy and o == start):
-                            continue
-                        delta = gain_rm - (dce + doth[o] - dc[o])
-                        if delta > eps and (best is None or delta > best[0]):
-                            # nodes in tour order: x, [first … last], y
-                            best = (delta, c, o, end) if left else (delta, o, c, other)
-            if best is not None:
-                delta, x, y, first = best
-                self.gain += delta
-                oriented = seg if first == s1 else seg[::-1]
-                rest = rot[seg_len:]
-                ix = rest.index(x)
-                if rest[(ix + 1) % len(rest)] != y:  # (x, y) adjacent in reverse order
-                    oriented = oriented[::-1]
-                    ix = rest.index(y)
-                new = rest[: ix + 1] + oriented + rest[ix + 1 :]
-                tour[:] = new
-                for k, v in enumerate(new):
-                    pos[v] = k
-                return [p, nx, s1, s2, x, y]
-        return None
-
-    def run(self, nodes: list[int]) -> None:
-        queue = deque(nodes)
-        queued = [False] * self.n
-        for v in nodes:
-            queued[v] = True
-        while queue:
-            a = queue.popleft()
-            queued[a] = False
-            if a == self.dummy:
-                continue
-            touched = self.two_opt(a) or self.or_opt(a)
-            if touched:
-                for v in touched + [a]:
-                    if not queued[v]:
-                        queued[v] = True
-                        queue.append(v)
-
-
 def _nearest_neighbour(x: np.ndarray) -> list[int]:
     """Greedy path from node 0 always to the nearest unvisited node."""
     n = x.shape[0]
@@ -199,63 +64,58 @@ def _nearest_neighbour(x: np.ndarray) -> list[int]:
     return order
 
 
-def _fast(
-    x: np.ndarray,
-    rng: np.random.Generator,
-    n_neighbours: int,
-    n_kicks: int,
-    time_limit: float | None,
+def _quadrant_neighbours(x: np.ndarray, k: int, per_quadrant: int = 2) -> np.ndarray:
+    """Candidate lists, shape (n, W): the ``k`` nearest nodes plus the ``per_quadrant`` nearest
+    in each quadrant of the first two coordinates (among the 40 nearest), nearest first, padded
+    by repeating the last. Quadrant neighbours let clustered points reach the next cluster."""
+    n = x.shape[0]
+    q = min(n - 1, max(k, 40))
+    _, idx = cKDTree(x).query(x, k=q + 1)
+    idx = np.atleast_2d(idx)
+    # drop each row's own index (first, or later among exact duplicates)
+    own = idx == np.arange(n)[:, None]
+    first_own = np.argmax(own, axis=1)
+    keep = np.ones_like(idx, dtype=bool)
+    keep[np.arange(n), first_own] = ~own[np.arange(n), first_own]
+    keep[np.arange(n), -1] &= own.any(axis=1)  # rows without self: drop the farthest instead
+    idx = idx[keep].reshape(n, q)
+    d = x[idx, :2] - x[:, None, :2]
+    quad = (d[..., 0] >= 0).astype(int) + 2 * (d[..., 1] >= 0).astype(int)
+    mask = np.zeros_like(idx, dtype=bool)
+    mask[:, :k] = True
+    for qd in range(4):
+        hit = quad == qd
+        mask |= hit & (np.cumsum(hit, axis=1) <= per_quadrant)
+    count = mask.sum(axis=1)
+    order = np.argsort(~mask, axis=1, kind="stable")[:, : count.max()]
+    out = np.take_along_axis(idx, order, axis=1)
+    col = np.arange(out.shape[1])[None, :]
+    last = np.take_along_axis(out, (count - 1)[:, None], axis=1)
+    return np.where(col < count[:, None], out, last).astype(np.int64)
+
+
+# kick size and acceptance of the iterated local search (measured in
+# benchmarks/search_speed.py: larger windows and a little threshold accepting win)
+_WINDOW = 50
+_THRESHOLD = 0.1  # of the mean nearest-neighbour edge
+
+
+def _compiled(
+    x: np.ndarray, rng: np.random.Generator, n_neighbours: int, n_kicks: int
 ) -> list[int]:
+    """Nearest-neighbour path improved by :func:`teachfit.trajectories.tsp_kernel.improve_tour`."""
+    from teachfit.trajectories.tsp_kernel import improve_tour
+
     n = x.shape[0]  # node 0 = start, 1..n-1 = points; dummy = n
-    t0 = time.perf_counter()
-    full = np.zeros((n + 1, n + 1))
-    full[:n, :n] = cdist(x, x)
-    dist = full.tolist()
-    k = min(n_neighbours, n - 1)
-    _, idx = cKDTree(x).query(x, k=k + 1)
-    neigh = [[int(j) for j in row if j != i] for i, row in enumerate(np.atleast_2d(idx))]
-    neigh.append([])
-    tour = _nearest_neighbour(x) + [n]
-    scale = float(full.max()) or 1.0
-    ls = _LocalSearch(dist, neigh, tour, 0, n, 1e-12 * scale)
-    ls.run(list(range(n)))
-    if n < 8:
-        return ls.tour
-    size = n + 1  # nodes in the cyclic tour
-    window = min(n - 1, 50)
-    draws = rng.integers(0, 1 << 30, size=(n_kicks, 3))
-    tour, pos = ls.tour, ls.pos
-    for kick in range(n_kicks):
-        if time_limit is not None and time.perf_counter() - t0 > time_limit:
-            break
-        # local double bridge on the cycle: A B C D -> A C B D with B, C inside a window
-        a = int(draws[kick, 0] % size)
-        lb = 1 + int(draws[kick, 1] % (window - 1))
-        lc = 1 + int(draws[kick, 2] % (window - lb))
-        seg = [tour[(a + q) % size] for q in range(lb + lc)]
-        pa, na = tour[a - 1], tour[(a + lb + lc) % size]
-        if ls._fixed(pa, seg[0]) or ls._fixed(seg[lb - 1], seg[lb]) or ls._fixed(seg[-1], na):
-            continue
-        delta = (
-            dist[pa][seg[0]]
-            + dist[seg[lb - 1]][seg[lb]]
-            + dist[seg[-1]][na]
-            - dist[pa][seg[lb]]
-            - dist[seg[-1]][seg[0]]
-            - dist[seg[lb - 1]][na]
-        )
-        saved_tour, saved_pos, saved_gain = tour[:], pos[:], ls.gain
-        new = seg[lb:] + seg[:lb]
-        for q, v in enumerate(new):
-            tour[(a + q) % size] = v
-            pos[v] = (a + q) % size
-        ls.gain += delta
-        ls.run([pa, na, seg[0], seg[lb - 1], seg[lb], seg[-1]])
-        if ls.gain <= saved_gain + ls.eps:  # not shorter: undo
-            tour[:] = saved_tour
-            pos[:] = saved_pos
-            ls.gain = saved_gain
-    return ls.tour
+    neigh = _quadrant_neighbours(x, n_neighbours)
+    tour = np.array(_nearest_neighbour(x) + [n], dtype=np.int64)
+    draws = rng.integers(0, 1 << 30, size=(n_kicks, 3), dtype=np.int64)
+    scale = float(np.ptp(x, axis=0).max()) or 1.0
+    d0 = np.linalg.norm(np.diff(x[tour[:-1]], axis=0), axis=1).mean()
+    out = improve_tour(
+        np.ascontiguousarray(x), neigh, tour, draws, _WINDOW, 1e-12 * scale, _THRESHOLD * d0
+    )
+    return [int(v) for v in out]
 
 
 def _lkh(x: np.ndarray, runs: int) -> list[int]:
@@ -282,7 +142,6 @@ def open_tour(
     rng: np.random.Generator | None = None,
     n_neighbours: int = 6,
     n_kicks: int | None = None,
-    time_limit: float | None = None,
     lkh_runs: int = 1,
 ) -> OpenTour:
     """Shortest open tour from ``start`` through all ``points`` (free end).
@@ -302,9 +161,8 @@ def open_tour(
     n_neighbours : int
         Candidate-list size K of the local search.
     n_kicks : int, optional
-        Iterated-local-search kicks; default ``2 N / 3`` (≈ 25 ms for N = 300).
-    time_limit : float, optional
-        Seconds after which no further kick is tried (fast solver).
+        Iterated-local-search kicks; default ``4 N`` (≈ 20 ms for N = 300). A fixed count,
+        not a time budget: the same input gives the same tour on every machine.
     lkh_runs : int
         LKH ``RUNS`` parameter.
 
@@ -331,8 +189,8 @@ def open_tour(
     else:
         if solver == "fast":
             rng = np.random.default_rng(0) if rng is None else rng
-            kicks = (2 * n) // 3 if n_kicks is None else int(n_kicks)
-            tour = _fast(x, rng, n_neighbours, kicks, time_limit)
+            kicks = 4 * n if n_kicks is None else int(n_kicks)
+            tour = _compiled(x, rng, n_neighbours, kicks)
         elif solver == "lkh":
             tour = _lkh(x, lkh_runs)
         else:

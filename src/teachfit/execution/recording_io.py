@@ -1,0 +1,152 @@
+"""The run-log file format: its marks, and one episode <-> one HDF5 group (the layout is
+in :mod:`.recording`)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import h5py
+import numpy as np
+
+from teachfit.core.geometry import Pose
+from teachfit.core.outcome import Outcome
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.execution.engine import ExecutionResult, NodeVisit
+from teachfit.execution.log import ExecutionLog
+
+if TYPE_CHECKING:
+    from teachfit.execution.recording import Episode
+
+#: the ExecutionLog arrays, in the order of its fields
+LOG_FIELDS: tuple[str, ...] = tuple(ExecutionLog.__dataclass_fields__)
+#: scalar summary attributes of an ExecutionResult
+NUMBERS: tuple[str, ...] = (
+    "t_first_contact",
+    "t_end",
+    "time_to_success",
+    "path_length",
+    "peak_force",
+    "remaining",
+    "wall_s",
+)
+_STR = h5py.string_dtype()
+
+FORMAT = "teachfit-run"
+FORMAT_VERSION = 1
+UNITS: dict[str, str] = {
+    "t": "s",
+    "pos": "m",
+    "quat": "1 (w,x,y,z)",
+    "wrench": "N, N*m",
+    "depth": "m",
+    "path_length": "m",
+    "peak_force": "N",
+}
+
+
+def _format(f: h5py.File) -> str | None:
+    fmt = f.attrs.get("format")
+    return fmt.decode() if isinstance(fmt, bytes) else fmt
+
+
+def is_run_log(path: str | Path) -> bool:
+    """Whether ``path`` is an HDF5 file whose ``format`` attribute says run log."""
+    path = Path(path)
+    if not path.is_file() or not h5py.is_hdf5(path):
+        return False
+    try:
+        with h5py.File(path, "r") as f:
+            return _format(f) == FORMAT
+    except OSError:
+        return False
+
+
+def _tri(value: bool | None) -> int:
+    return -1 if value is None else int(bool(value))
+
+
+def _untri(value: Any) -> bool | None:
+    return None if int(value) < 0 else bool(value)
+
+
+def _put(group: h5py.Group, name: str, data: np.ndarray, dtype: Any = np.float64) -> None:
+    """A dataset, gzip-compressed when it holds anything (empty ones cannot be chunked)."""
+    data = np.asarray(data, dtype=dtype)
+    opts = {"compression": "gzip", "compression_opts": 4} if data.size else {}
+    group.create_dataset(name, data=data, **opts)
+
+
+def write_episode(group: h5py.Group, ep: Episode) -> None:
+    """Fill ``group`` with one episode."""
+    r = ep.result
+    group.attrs["name"] = ep.name
+    group.attrs["skill"] = r.skill
+    group.attrs["outcome"] = r.outcome.value
+    group.attrs["reason"] = r.reason
+    for label in NUMBERS:
+        group.attrs[label] = float(getattr(r, label))
+    group.attrs["steps"] = int(r.steps)
+    group.attrs["detected"] = _tri(r.detected)
+    group.attrs["ground_truth_inserted"] = _tri(r.ground_truth_inserted)
+    group.attrs["nodes"] = json.dumps(list(r.node_names))
+    group.attrs["primitives"] = json.dumps(dict(ep.primitives))
+    if ep.start is not None:
+        group.attrs["start"] = np.concatenate([ep.start.pos, ep.start.quat])
+    for label in LOG_FIELDS:
+        _put(group, label, getattr(r.log, label), np.int32 if label == "node" else np.float64)
+    visits = group.create_group("visits")
+    _put(visits, "node", [v.node for v in r.visits], _STR)
+    _put(visits, "t_enter", [v.t_enter for v in r.visits])
+    _put(visits, "t_exit", [v.t_exit for v in r.visits])
+    _put(visits, "reason", [v.reason for v in r.visits], _STR)
+    if ep.planned is not None:
+        planned = group.create_group("planned")
+        planned.attrs["name"] = ep.planned.name
+        for label in ("t", "pos", "quat", "wrench_ff"):
+            _put(planned, label, getattr(ep.planned, label))
+
+
+def _text(values: h5py.Dataset) -> list[str]:
+    return [v.decode() if isinstance(v, bytes) else str(v) for v in values[()]]
+
+
+def read_episode(group: h5py.Group) -> Episode:
+    """The episode stored in ``group`` (KeyError for a missing dataset or attribute)."""
+    from teachfit.execution.recording import Episode
+
+    a = group.attrs
+    log = ExecutionLog(
+        **{k: group[k][()].astype(int if k == "node" else float) for k in LOG_FIELDS}
+    )
+    vg = group["visits"]
+    visits = tuple(
+        NodeVisit(n, float(t0), float(t1), why)
+        for n, t0, t1, why in zip(
+            _text(vg["node"]), vg["t_enter"][()], vg["t_exit"][()], _text(vg["reason"]), strict=True
+        )
+    )
+    result = ExecutionResult(
+        skill=str(a["skill"]),
+        outcome=Outcome(str(a["outcome"])),
+        reason=str(a["reason"]),
+        visits=visits,
+        log=log,
+        node_names=tuple(json.loads(a["nodes"])),
+        steps=int(a["steps"]),
+        detected=_untri(a["detected"]),
+        ground_truth_inserted=_untri(a["ground_truth_inserted"]),
+        **{k: float(a[k]) for k in NUMBERS},  # type: ignore[arg-type]
+    )
+    start = None
+    if "start" in a:
+        raw = np.asarray(a["start"], dtype=float)
+        start = Pose(raw[:3], raw[3:])
+    planned = None
+    if "planned" in group:
+        p = group["planned"]
+        planned = SetpointTrajectory(
+            *(p[k][()] for k in ("t", "pos", "quat", "wrench_ff")), name=str(p.attrs["name"])
+        )
+    return Episode(result, start, planned, json.loads(a["primitives"]), str(a["name"]))

@@ -1,0 +1,270 @@
+"""Compiled local search of the open-tour solver (numba): 2-opt, Or-opt and local kicks.
+
+Why written here: the maintained packages miss one of the three things TSHIX needs. LKH-3
+(``elkai``) is 20-40x over the time budget (0.7 s for 300 points); ``fast-tsp`` stops on a
+wall-clock budget, so its tours change with the machine's load (the same seed must give the
+same tour); OR-Tools' guided local search is also time-bounded. This kernel runs a fixed,
+seeded number of moves: the same input gives the same tour on every machine.
+
+The tour is a path ``tour[0] = start, ..., tour[M-1] = dummy`` over ``M = N + 2`` nodes (node 0
+the start, nodes ``1..N`` the points, node ``M-1`` a dummy at distance 0 from every node), both
+ends fixed: the closed tour's edge ``(dummy, start)`` is never removed, so the path through the
+points costs exactly the open tour. Moves (all in O(segment) time on arrays):
+
+- **2-opt**: reverse ``tour[lo+1..hi]``, replacing edges ``(t_lo, t_lo+1), (t_hi, t_hi+1)`` by
+  ``(t_lo, t_hi), (t_lo+1, t_hi+1)``;
+- **Or-opt**: move a segment of 1-3 nodes between two neighbours elsewhere, either way round
+  (done by two or three reversals);
+
+both restricted to K nearest neighbours with don't-look bits. Then **iterated local search**:
+a local double bridge (two adjacent segments of at most ``window`` nodes swapped), local
+search from its six end nodes, kept only if the tour got shorter.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _d(x: np.ndarray, a: int, b: int, dummy: int) -> float:
+    if a == dummy or b == dummy:
+        return 0.0
+    s = 0.0
+    for k in range(x.shape[1]):
+        t = x[a, k] - x[b, k]
+        s += t * t
+    return np.sqrt(s)
+
+
+@njit(cache=True)
+def _reverse(tour: np.ndarray, pos: np.ndarray, i: int, j: int) -> None:
+    """Reverse ``tour[i..j]`` in place and keep ``pos`` (node -> index) in step."""
+    while i < j:
+        a, b = tour[i], tour[j]
+        tour[i], tour[j] = b, a
+        pos[b], pos[a] = i, j
+        i += 1
+        j -= 1
+
+
+@njit(cache=True)
+def _move_segment(
+    tour: np.ndarray, pos: np.ndarray, s: int, e: int, q: int, flip: bool
+) -> tuple[int, int]:
+    """Move ``tour[s..e]`` between ``tour[q]`` and ``tour[q+1]`` (``q`` outside ``s-1..e``),
+    reversed if ``flip``; returns the index range that changed."""
+    n_seg = e - s + 1
+    if q > e:  # A B -> B A, with B = tour[e+1..q]
+        _reverse(tour, pos, s, q)  # rev(B) rev(A)
+        _reverse(tour, pos, s, q - n_seg)  # B rev(A)
+        if not flip:
+            _reverse(tour, pos, q - n_seg + 1, q)  # B A
+        return s, q
+    # B A -> A B, with B = tour[q+1..s-1]
+    _reverse(tour, pos, q + 1, e)  # rev(A) rev(B)
+    _reverse(tour, pos, q + 1 + n_seg, e)  # rev(A) B
+    if not flip:
+        _reverse(tour, pos, q + 1, q + n_seg)  # A B
+    return q + 1, e
+
+
+@njit(cache=True)
+def _push(queue: np.ndarray, inq: np.ndarray, head_tail: np.ndarray, v: int) -> None:
+    if not inq[v]:
+        m = queue.shape[0]
+        queue[head_tail[1] % m] = v
+        head_tail[1] += 1
+        inq[v] = True
+
+
+@njit(cache=True)
+def _improve_node(
+    x: np.ndarray,
+    neigh: np.ndarray,
+    tour: np.ndarray,
+    pos: np.ndarray,
+    a: int,
+    eps: float,
+) -> tuple[float, int, int]:
+    """Apply the first improving 2-opt or Or-opt move around node ``a``.
+
+    Returns (gain, lo, hi): the gain (0: none found) and the index range that changed.
+    """
+    m = tour.shape[0]
+    dummy = m - 1
+    i = pos[a]
+    # 2-opt, with a's successor then a's predecessor as the removed edge
+    for side in range(2):
+        if side == 0 and i > m - 2:
+            continue
+        if side == 1 and i < 1:
+            continue
+        b = tour[i + 1] if side == 0 else tour[i - 1]
+        dab = _d(x, a, b, dummy)
+        for c in neigh[a]:
+            dac = _d(x, a, c, dummy)
+            if dab - dac <= eps:
+                break
+            j = pos[c]
+            if side == 0:
+                if j == i + 1 or j > m - 2 or j == i:
+                    continue
+                cn = tour[j + 1]
+                delta = dab + _d(x, c, cn, dummy) - dac - _d(x, b, cn, dummy)
+                if delta > eps:
+                    lo, hi = (i + 1, j) if j > i else (j + 1, i)
+                    _reverse(tour, pos, lo, hi)
+                    return delta, lo, hi
+            else:
+                if j == i - 1 or j < 1 or j == i:
+                    continue
+                cp = tour[j - 1]
+                delta = dab + _d(x, cp, c, dummy) - dac - _d(x, b, cp, dummy)
+                if delta > eps:
+                    lo, hi = (j, i - 1) if j < i else (i, j - 1)
+                    _reverse(tour, pos, lo, hi)
+                    return delta, lo, hi
+    # Or-opt: the segment of 1-3 nodes that starts at a (going forward)
+    for n_seg in range(1, 4):
+        s, e = i, i + n_seg - 1
+        if s < 1 or e > m - 2:
+            break
+        p_, n_ = tour[s - 1], tour[e + 1]
+        f, g = tour[s], tour[e]
+        removed = _d(x, p_, f, dummy) + _d(x, g, n_, dummy) - _d(x, p_, n_, dummy)
+        if removed <= eps:
+            continue
+        for end in range(2):
+            y = f if end == 0 else g
+            for c in neigh[y]:
+                if removed - _d(x, y, c, dummy) <= eps:
+                    break
+                j = pos[c]
+                if s <= j <= e:
+                    continue
+                for q in (j - 1, j):  # between (tour[q], tour[q+1]) with c at one end
+                    if q < 0 or q > m - 2 or (s - 1 <= q <= e):
+                        continue
+                    u, v = tour[q], tour[q + 1]
+                    base = _d(x, u, v, dummy)
+                    for flip in (False, True):
+                        first, last = (g, f) if flip else (f, g)
+                        added = _d(x, u, first, dummy) + _d(x, last, v, dummy) - base
+                        delta = removed - added
+                        if delta > eps:
+                            lo, hi = _move_segment(tour, pos, s, e, q, flip)
+                            return delta, lo, hi
+    return 0.0, 0, -1
+
+
+@njit(cache=True)
+def _local_search(
+    x: np.ndarray,
+    neigh: np.ndarray,
+    tour: np.ndarray,
+    pos: np.ndarray,
+    seeds: np.ndarray,
+    eps: float,
+    queue: np.ndarray,
+    inq: np.ndarray,
+) -> float:
+    """Local search from the nodes ``seeds`` until no move improves; returns the total gain."""
+    head_tail = np.zeros(2, dtype=np.int64)
+    inq[:] = False
+    for v in seeds:
+        _push(queue, inq, head_tail, v)
+    dummy = tour.shape[0] - 1
+    gain = 0.0
+    while head_tail[0] < head_tail[1]:
+        a = queue[head_tail[0] % queue.shape[0]]
+        head_tail[0] += 1
+        inq[a] = False
+        if a == dummy:
+            continue
+        delta, lo, hi = _improve_node(x, neigh, tour, pos, a, eps)
+        if delta > 0.0:
+            gain += delta
+            for k in (lo - 1, lo, hi, hi + 1):
+                if 0 <= k < tour.shape[0]:
+                    _push(queue, inq, head_tail, tour[k])
+            _push(queue, inq, head_tail, a)
+    return gain
+
+
+@njit(cache=True)
+def improve_tour(
+    x: np.ndarray,
+    neigh: np.ndarray,
+    tour: np.ndarray,
+    draws: np.ndarray,
+    window: int,
+    eps: float,
+    threshold: float = 0.0,
+) -> np.ndarray:
+    """Local search, then one kick per row of ``draws`` (three non-negative ints each).
+
+    A kicked tour is kept when it is at most ``threshold`` longer than before (threshold
+    accepting); the shortest tour seen is returned.
+
+    Parameters
+    ----------
+    x : ndarray, shape (M - 1, D)
+        Weighted coordinates of the start (row 0) and the points.
+    neigh : ndarray of int, shape (M - 1, K)
+        K nearest other nodes of each node, nearest first.
+    tour : ndarray of int, shape (M,)
+        Initial path: ``tour[0] = 0``, ``tour[M-1] = M-1`` (the dummy).
+    """
+    m = tour.shape[0]
+    tour = tour.copy()
+    pos = np.empty(m, dtype=np.int64)
+    for k in range(m):
+        pos[tour[k]] = k
+    queue = np.empty(m, dtype=np.int64)
+    inq = np.zeros(m, dtype=np.bool_)
+    all_nodes = np.arange(m - 1)
+    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq)
+    inner = m - 2  # movable positions 1..m-2
+    if inner < 4:
+        return tour
+    window = min(window, inner - 1)
+    saved_tour = tour.copy()
+    saved_pos = pos.copy()
+    ends = np.empty(6, dtype=np.int64)
+    dummy = m - 1
+    best_tour = tour.copy()
+    total, best = 0.0, 0.0  # gain of the current / best tour over the first local optimum
+    for r in range(draws.shape[0]):
+        lb = 1 + draws[r, 1] % (window - 1) if window > 1 else 1
+        lc = 1 + draws[r, 2] % max(1, window - lb)
+        if lb + lc > inner:
+            continue
+        a = 1 + draws[r, 0] % (inner - lb - lc + 1)  # B = tour[a..a+lb-1], C follows
+        b_end, c_end = a + lb - 1, a + lb + lc - 1
+        pa, na = tour[a - 1], tour[c_end + 1]
+        b0, b1, c0, c1 = tour[a], tour[b_end], tour[b_end + 1], tour[c_end]
+        delta = (
+            _d(x, pa, b0, dummy)
+            + _d(x, b1, c0, dummy)
+            + _d(x, c1, na, dummy)
+            - _d(x, pa, c0, dummy)
+            - _d(x, c1, b0, dummy)
+            - _d(x, b1, na, dummy)
+        )
+        saved_tour[:] = tour
+        saved_pos[:] = pos
+        _move_segment(tour, pos, a, b_end, c_end, True)  # A B C D -> A C rev(B) D
+        _reverse(tour, pos, c_end - lb + 1, c_end)  # -> A C B D
+        ends[0], ends[1], ends[2], ends[3], ends[4], ends[5] = pa, na, b0, b1, c0, c1
+        gain = delta + _local_search(x, neigh, tour, pos, ends, eps, queue, inq)
+        if gain <= eps - threshold:  # longer than accepted: undo
+            tour[:] = saved_tour
+            pos[:] = saved_pos
+            continue
+        total += gain
+        if total > best + eps:
+            best = total
+            best_tour[:] = tour
+    return best_tour
