@@ -20,6 +20,7 @@ from rich.console import Console
 from rich.progress import Progress
 from rich.table import Table
 
+from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.demonstrations.dataset import Demonstration, write_dataset
@@ -31,7 +32,7 @@ from teachfit.execution.search import plan_search, run_search
 from teachfit.execution.teacher import BlindTeacher
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
-from teachfit.robot.registry import make_robot
+from teachfit.robot.registry import ROBOTS, make_robot
 from teachfit.tasks.registry import get_task
 from teachfit.viz import search_figures
 from teachfit.viz.figures import plot_demonstrations, plot_executions
@@ -72,8 +73,10 @@ def run_quickstart(
     console = console or Console()
     if n_starts < 2:
         raise TeachfitError(f"--starts must be >= 2 (half run with the hole moved), not {n_starts}")
-    out.mkdir(parents=True, exist_ok=True)
     task = get_task(task_name)
+    if robot_name not in ROBOTS:
+        make_robot(robot_name, task)  # the registry's error, before any output
+    ensure_folder(out)
     console.rule(f"[bold]teachfit quickstart[/]: {task.name} - {task.description}")
     teacher = BlindTeacher(task, seed=seed, robot=robot_name)
     demos, discarded = teacher.record(n_demos, progress=True)

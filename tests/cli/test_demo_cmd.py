@@ -46,7 +46,7 @@ def assert_refused(res, out: Path, *needles: str) -> str:
     assert "Traceback" not in res.output and res.output.count("error:") == 1
     for needle in needles:
         assert squeeze(needle) in text, (needle, res.output)
-    assert not out.exists() and not list(out.parent.glob(".*.tmp"))  # nothing half-written
+    assert not out.exists() and not list(out.parent.glob(".*.tmp*"))  # nothing half-written
     return text
 
 

@@ -37,7 +37,7 @@ def make_demo(
 
 
 def tmp_leftovers(directory: Path) -> list[Path]:
-    return [p for p in directory.iterdir() if p.name.endswith(".tmp")]
+    return [p for p in directory.iterdir() if ".tmp" in p.name]
 
 
 # ---------------------------------------------------------------- Demonstration validation
@@ -311,3 +311,34 @@ def test_corrupt_file(
     assert info.value.path == str(path)
     assert (info.value.column, info.value.row) == (column, row)
     assert str(path) in str(info.value)
+
+
+def test_strings_complex_numbers_empty_and_damaged_files_are_refused(tmp_path: Path) -> None:
+    path = write_dataset(tmp_path / "d.h5", [make_demo(1)])
+    for label, bad in (("t", lambda a: a.astype("S")), ("pos", lambda a: a + 1j)):
+        copy = tmp_path / f"{label}.h5"
+        copy.write_bytes(path.read_bytes())
+        with h5py.File(copy, "r+") as f:
+            data = f[f"demos/000/{label}"][()]
+            del f[f"demos/000/{label}"]
+            f[f"demos/000/{label}"] = bad(data)
+        with pytest.raises(DatasetError, match=f"column '{label}'.*not real numbers"):
+            read_dataset(copy)
+    empty = tmp_path / "empty.h5"
+    empty.write_bytes(path.read_bytes())
+    with h5py.File(empty, "r+") as f:
+        del f["demos/000"]
+    with pytest.raises(DatasetError, match="holds no demonstrations"):
+        read_dataset(empty)
+    # a damaged metadata block (found by flipping bytes: h5py raises OSError/RuntimeError)
+    raw = bytearray(path.read_bytes())
+    refused = 0
+    for off in range(96, 6000, 97):
+        bad = bytearray(raw)
+        bad[off : off + 64] = bytes(b ^ 0xA5 for b in bad[off : off + 64])
+        (tmp_path / "x.h5").write_bytes(bytes(bad))
+        try:
+            read_dataset(tmp_path / "x.h5")
+        except DatasetError:
+            refused += 1
+    assert refused > 5  # and nothing else escaped

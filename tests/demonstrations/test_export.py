@@ -45,4 +45,4 @@ def test_without_wrench_and_existing_files(tmp_path: Path) -> None:
     assert info.value.path == str(out)
     export_csv(demo, out, overwrite=True)
     assert out.read_text().splitlines()[0].endswith("tz")
-    assert not list(tmp_path.glob(".*.tmp"))  # written atomically, nothing left behind
+    assert not list(tmp_path.glob(".*.tmp*"))  # written atomically, nothing left behind

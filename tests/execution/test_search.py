@@ -66,8 +66,9 @@ def test_methods_and_bad_input(peg_model):
     for method in ("ergodic", "spiral", "random-walk"):
         traj = plan_search(model, method, 50, rng)
         assert traj.states.shape[1] == 2 and traj.duration > 1.0
-    with pytest.raises(TeachfitError, match="positive"):
-        plan_search(model, "tshix", 0, rng)
+    for n in (0, 100_000_000):  # a limit: 1e8 points would take minutes and GBs
+        with pytest.raises(TeachfitError, match=r"must be 1 \.\.\. 10000"):
+            plan_search(model, "tshix", n, rng)
     with pytest.raises(TeachfitError, match="unknown search method"):
         plan_search(model, "telepathy", 10, rng)
 

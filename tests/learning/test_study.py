@@ -200,3 +200,24 @@ def test_claims_of_dead_or_silent_processes_are_taken_over(tmp_path: Path) -> No
     assert not other.begin_store("i3")  # the silent owner lost it: it must not store it
     other.close()
     impatient.close()
+
+
+def test_a_study_file_that_is_no_database_is_one_clear_error(tmp_path: Path) -> None:
+    import sqlite3
+
+    from teachfit.core.params import LearningError
+    from teachfit.learning.study import storage_url, stored_tags
+
+    junk = tmp_path / "junk.db"
+    junk.write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(LearningError, match="junk.db is not an SQLite database"):
+        storage_url(junk)
+    good = tmp_path / "good.db"
+    with sqlite3.connect(good) as con:
+        con.execute("create table t (x)")
+    cut = tmp_path / "cut.db"
+    cut.write_bytes(good.read_bytes()[: good.stat().st_size // 2])
+    with pytest.raises(LearningError, match="cut.db: database disk image is malformed"):
+        stored_tags(cut)
+    with pytest.raises(LearningError, match="is a folder"):
+        storage_url(tmp_path)

@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from teachfit.core.errors import SimulationDiverged
+from teachfit.core.control import AdaptiveSpec
+from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.robot.interface import Robot
@@ -50,3 +51,23 @@ def test_divergence_is_reported_not_crashed():
     robot.data.qvel[0] = np.nan
     with pytest.raises(SimulationDiverged):
         robot.step(5)
+
+
+def test_a_nan_wrench_of_the_law_is_a_control_error_not_divergence():
+    """The state goes NaN because the (adaptive) law commanded NaN: the law is reported."""
+    task = get_task("peg2d")
+    robot = FloatingToolRobot(task, controller=AdaptiveSpec())
+    robot.reset(task.contact_pose([0.02, 0.0]))
+    law = robot.law
+    real = law.compute  # type: ignore[attr-defined]
+
+    def blown_up(*args: object) -> np.ndarray:
+        w = real(*args) * np.nan
+        law.last_wrench = w  # type: ignore[attr-defined]
+        return w
+
+    law.compute = blown_up  # type: ignore[attr-defined]
+    with pytest.raises(ControlError, match="AdaptiveImpedance control law produced a non-fin"):
+        robot.step(5)
+    with pytest.raises(ControlError):  # the robot stays faulted until reset
+        robot.step(1)

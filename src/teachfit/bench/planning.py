@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from teachfit.core.atomic import atomic_append_text
 from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.plans.collision import CollisionChecker
@@ -358,6 +359,4 @@ def append_markdown(text: str, path: str | Path = "BENCHMARKS.md") -> Path:
     """Append ``text`` to ``path`` (created with a title when missing)."""
     path = Path(path)
     head = "" if path.exists() else "# Benchmarks\n\n"
-    with path.open("a", encoding="utf-8") as fh:
-        fh.write(head + text + "\n")
-    return path
+    return atomic_append_text(path, head + text + "\n", "benchmark file")

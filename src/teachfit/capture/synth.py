@@ -13,6 +13,7 @@ Outputs of :func:`write_synth_capture`: ``cam<i>.mp4``, ``rig.toml``, ``markers.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from contextlib import ExitStack
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -25,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from teachfit.capture.markers import Marker, MarkerSet, marker_image, write_markers
 from teachfit.capture.rig import Camera, Rig, write_rig
 from teachfit.capture.scene import Carrier, Quad, camera_K, look_at, scene_xml
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import CaptureError, RenderError
 from teachfit.core.geometry import rotation_to_wxyz, wxyz_to_rotation
 from teachfit.demonstrations.dataset import Demonstration, write_dataset
@@ -273,28 +275,29 @@ def write_synth_capture(
     fps = 30.0 / cfg.stride
     rng = np.random.default_rng(seed)
     paths = {f"video{i}": out / f"cam{i}.mp4" for i in range(len(cfg.resolutions))}
-    writers = [
-        imageio.get_writer(
-            p,
-            fps=fps,
-            codec="libx264",
-            quality=None,
-            macro_block_size=1,
-            ffmpeg_params=["-crf", str(cfg.crf), "-preset", "veryfast"],
-            ffmpeg_log_level="error",
-        )
-        for p in paths.values()
-    ]
     try:
-        for k, L2G in enumerate(_matrices(truth)):
-            phase = 2 * np.pi * truth.t[k] / 3.0
-            for writer, img in zip(writers, scene.render(L2G, rng, phase), strict=True):
-                writer.append_data(img)
-            if progress is not None:
-                progress(k + 1, truth.n_samples)
+        with ExitStack() as files:
+            writers = []
+            for p in paths.values():
+                tmp = files.enter_context(atomic_path(p, "video"))
+                writer = imageio.get_writer(
+                    tmp,
+                    fps=fps,
+                    codec="libx264",
+                    quality=None,
+                    macro_block_size=1,
+                    ffmpeg_params=["-crf", str(cfg.crf), "-preset", "veryfast"],
+                    ffmpeg_log_level="error",
+                )
+                files.callback(writer.close)  # closed before its file is moved into place
+                writers.append(writer)
+            for k, L2G in enumerate(_matrices(truth)):
+                phase = 2 * np.pi * truth.t[k] / 3.0
+                for writer, img in zip(writers, scene.render(L2G, rng, phase), strict=True):
+                    writer.append_data(img)
+                if progress is not None:
+                    progress(k + 1, truth.n_samples)
     finally:
-        for writer in writers:
-            writer.close()
         scene.close()
     paths["rig"] = write_rig(scene.rig, out / "rig.toml")
     paths["markers"] = write_markers(scene.markers, out / "markers.toml")

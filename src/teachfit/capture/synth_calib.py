@@ -19,6 +19,7 @@ from teachfit.capture.calibrate import CharucoSpec
 from teachfit.capture.rig import Rig
 from teachfit.capture.scene import Quad, scene_xml
 from teachfit.capture.synth import SynthConfig, synth_rig
+from teachfit.core.atomic import atomic_write_bytes
 from teachfit.core.errors import RenderError
 from teachfit.core.geometry import rotation_to_wxyz
 from teachfit.plans.parts import pose_from_xyz_rpy
@@ -78,11 +79,10 @@ def write_charuco_shots(
             mujoco.mj_forward(model, data)
             for i, r in enumerate(renderers):
                 r.update_scene(data, camera=f"cam{i}")
-                (out / f"cam{i}").mkdir(parents=True, exist_ok=True)
-                cv2.imwrite(
-                    str(out / f"cam{i}" / f"{k:03d}.png"),
-                    cv2.cvtColor(r.render(), cv2.COLOR_RGB2GRAY),
-                )
+                ok, png = cv2.imencode(".png", cv2.cvtColor(r.render(), cv2.COLOR_RGB2GRAY))
+                if not ok:
+                    raise RenderError(f"cannot encode calibration image {k} of camera {i}")
+                atomic_write_bytes(out / f"cam{i}" / f"{k:03d}.png", png.tobytes(), "image")
     finally:
         for r in renderers:
             r.close()

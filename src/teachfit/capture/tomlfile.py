@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import CaptureError
 
 __all__ = ["read_versioned_toml", "write_versioned_toml"]
@@ -20,7 +21,9 @@ def read_versioned_toml(path: str | Path, what: str, fmt: str, version: int) -> 
     """The parsed document of ``path``, a ``what`` file (e.g. ``"rig"``) of ``fmt``/``version``."""
     path = Path(path)
     try:
-        doc = tomllib.loads(path.read_text())
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise CaptureError(f"{what} file {path}: not a text (TOML) file ({exc.reason})") from exc
     except OSError as exc:
         raise CaptureError(f"{what} file {path}: cannot read ({exc.strerror or exc})") from exc
     except tomllib.TOMLDecodeError as exc:
@@ -37,6 +40,5 @@ def write_versioned_toml(path: str | Path, fmt: str, version: int, lines: Sequen
     """Write ``format``, ``version`` and then ``lines`` (TOML written by hand: tomllib only
     reads) to ``path``, creating its folder."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join([f'format = "{fmt}"', f"version = {version}", *lines]))
-    return path
+    text = "\n".join([f'format = "{fmt}"', f"version = {version}", *lines])
+    return atomic_write_text(path, text, f"{fmt} file")

@@ -77,6 +77,9 @@ assemble_cmd.register(app, bench_app)
 
 def main() -> None:
     """Console-script entry point."""
+    from teachfit.cli.common import exit_on_sigterm
+
+    exit_on_sigterm()
     app()
 
 

@@ -89,6 +89,8 @@ def bench_search(
 
     if table not in TABLES:
         raise TeachfitError(f"unknown table {table!r}; available: {list(TABLES)}")
+    if demo is not None and task is None:
+        raise TeachfitError(f"--demo {demo} is for --task TASK (the paper's tables record theirs)")
     todo = TABLES[:-1] if table == "all" else (table,)
     bs.use_robot(robot)
     if task is not None:

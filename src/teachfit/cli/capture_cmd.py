@@ -81,7 +81,7 @@ def markers(
     camera: Annotated[
         list[int] | None, typer.Option(help="live camera index per rig camera")
     ] = None,
-    frames: Annotated[int, typer.Option(help="live: stop after this many frames")] = 300,
+    frames: Annotated[int, typer.Option(min=1, help="live: stop after this many frames")] = 300,
     task: Annotated[str, o.task("the task the parts belong to: l-groove or tenon")] = "l-groove",
     plot: Annotated[Path | None, o.plot("the tracked pose over time")] = None,
     truth: Annotated[
@@ -166,8 +166,8 @@ def synth(
     blur: Annotated[float, typer.Option(help="Gaussian blur (px)")] = 0.0,
     lighting: Annotated[float, typer.Option(help="light variation amplitude [0, 1)")] = 0.0,
     stride: Annotated[int, typer.Option(min=1, help="keep every n-th 30 Hz sample")] = 1,
-    max_frames: Annotated[int | None, typer.Option(help="cap on the frame count")] = None,
-    calib: Annotated[int, typer.Option(help="also render this many ChArUco shots")] = 0,
+    max_frames: Annotated[int | None, typer.Option(min=1, help="cap on the frame count")] = None,
+    calib: Annotated[int, typer.Option(min=0, help="also render this many ChArUco shots")] = 0,
 ) -> None:
     """Render a scripted demonstration with marker-carrying parts: videos, rig, markers, truth."""
     from teachfit.capture.synth import write_synth_capture
@@ -229,7 +229,9 @@ def bench_capture_cmd(
     noise: Annotated[float, typer.Option(help="pixel noise (grey levels)")] = 2.0,
     blur: Annotated[float, typer.Option(help="Gaussian blur (px)")] = 0.5,
     lighting: Annotated[float, typer.Option(help="light variation amplitude [0, 1)")] = 0.3,
-    crf: Annotated[int, typer.Option(help="x264 quality of the videos (lower = better)")] = 20,
+    crf: Annotated[
+        int, typer.Option(min=0, max=51, help="x264 quality of the videos (lower = better)")
+    ] = 20,
     seed: Annotated[int, o.seed("the demonstration and the noise")] = 0,
     workdir: Annotated[Path | None, typer.Option(help="keep the rendered capture here")] = None,
     markdown: o.Markdown = None,

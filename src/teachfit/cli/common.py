@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import functools
+import math
+import os
+import signal
 from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, ParamSpec, TypeVar
+from typing import Annotated, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
 
-from teachfit.core.errors import TeachfitError
+from teachfit.core.errors import OutputError, TeachfitError
 
 console = Console()
 err_console = Console(stderr=True)
@@ -34,10 +37,79 @@ RealtimeOpt = Annotated[
 ]
 
 
+def seed_option(help: str = "random seed") -> Any:
+    """A ``--seed`` option: an integer >= 0 (numpy's generators take no negative seed)."""
+    return typer.Option(min=0, help=f"{help} (an integer >= 0)")
+
+
+#: ``--seed N``: every command with randomness takes it (0 and up)
+SeedOpt = Annotated[int, seed_option()]
+
+
+def count_option(
+    help: str, *, low: int = 1, high: int | None = None, flag: str | None = None
+) -> Any:
+    """An integer option (a count, a size, a rate) in ``[low, high]``; typer refuses others
+    with exit status 2 before the command runs."""
+    decls = () if flag is None else (flag,)
+    return typer.Option(*decls, min=low, max=high, help=help)
+
+
+#: ``--fps``, ``--width``, ``--height`` of a rendered video (pixels; H.264 needs even sizes up
+#: to 8K)
+FpsOpt = Annotated[int, count_option("frames per second", high=240)]
+WidthOpt = Annotated[int, count_option("video width (pixels)", low=16, high=7680)]
+HeightOpt = Annotated[int, count_option("video height (pixels)", low=16, high=4320)]
+
+
 def robot_options(host: str | None, realtime: bool = True) -> dict[str, object]:
     """The ``make_robot`` options the CLI's ``--host``/``--no-realtime`` give (none for
     simulated robots)."""
     return {} if host is None else {"host": host, "realtime": realtime}
+
+
+#: options that name a file or folder a command writes: :func:`guarded` checks them before the
+#: command runs (a new command's output option named otherwise is added here)
+OUTPUT_OPTIONS = frozenset(
+    {"out", "plot", "render", "markdown", "save", "strip", "keyposes", "toml", "traces",
+     "best_plot", "benchmarks", "workdir", "log", "rrd", "columns_out"}
+)  # fmt: skip
+
+
+def check_output(path: object, option: str = "out") -> None:
+    """Refuse an output path whose folder cannot be made before any work is done: the nearest
+    existing folder above it must be a writable folder (a missing folder is created when the
+    file is written, :mod:`teachfit.core.atomic`)."""
+    if not isinstance(path, Path):
+        return
+    above = next((p for p in path.absolute().parents if p.exists()), None)
+    if above is None:
+        return
+    flag = "--" + option.replace("_", "-")
+    if not above.is_dir():
+        raise OutputError(f"{flag} {path}: {above} is a file, not a folder")
+    if not os.access(above, os.W_OK | os.X_OK):
+        raise OutputError(f"{flag} {path}: folder {above} is not writable")
+
+
+def check_finite(value: object, option: str) -> None:
+    """Refuse ``nan``/``inf`` given to a number option (typer parses them as floats)."""
+    values = value if isinstance(value, list | tuple) else [value]
+    for v in values:
+        if isinstance(v, float) and not math.isfinite(v):
+            flag = "--" + option.replace("_", "-")
+            raise TeachfitError(f"{flag} {v}: give a finite number")
+
+
+def exit_on_sigterm() -> None:
+    """Make SIGTERM (``kill``, ``timeout``, a scheduler) end the process like Ctrl-C does:
+    ``SystemExit(143)`` unwinds the stack, so half-written outputs' temporary files are removed
+    (:mod:`teachfit.core.atomic`) instead of being left behind by the default handler."""
+
+    def terminate(signum: int, frame: object) -> None:
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, terminate)
 
 
 P = ParamSpec("P")
@@ -50,11 +122,16 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
     @functools.wraps(func)
     def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
         try:
+            for name, value in kwargs.items():
+                check_finite(value, name)
+            for name in OUTPUT_OPTIONS.intersection(kwargs):
+                check_output(kwargs[name], name)
             return func(*args, **kwargs)
         except TeachfitError as exc:
             err_console.print("[bold red]error:[/] ", end="")
-            # the message is plain text: no markup, no ":emoji:" codes, no highlighting
-            err_console.print(str(exc), markup=False, emoji=False, highlight=False)
+            # the message is plain text: no markup, no ":emoji:" codes, no highlighting; one
+            # line however narrow the terminal (soft_wrap: rich does not break it)
+            err_console.print(str(exc), markup=False, emoji=False, highlight=False, soft_wrap=True)
             raise typer.Exit(2) from exc
 
     return wrapper
@@ -63,7 +140,7 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
 def append_markdown(path: Path, text: str) -> Path:
     """Append ``text`` to the markdown file ``path`` (created with its folder if missing): every
     ``--markdown FILE`` appends, so one file can collect several benchmark runs."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("a", encoding="utf-8") as fh:
-        fh.write(("\n" if path.stat().st_size else "") + text.rstrip("\n") + "\n")
-    return path
+    from teachfit.core.atomic import atomic_append_text
+
+    sep = "\n" if path.is_file() and path.stat().st_size else ""
+    return atomic_append_text(path, sep + text.rstrip("\n") + "\n", "markdown file")

@@ -11,7 +11,15 @@ from rich.markup import escape
 from rich.table import Table
 
 from teachfit.cli import options as o
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import (
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    check_output,
+    console,
+    guarded,
+    robot_options,
+)
 from teachfit.cli.recording import show_run_log
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import DatasetError, TeachfitError
@@ -52,7 +60,8 @@ def record(
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     duration: Annotated[
-        float | None, typer.Option(help="real robot: seconds to record (default: until Ctrl-C)")
+        float | None,
+        typer.Option(min=0, help="real robot: seconds to record (default: until Ctrl-C)"),
     ] = None,
     n: o.CountOld = None,
 ) -> None:
@@ -135,7 +144,7 @@ def import_(
         str | None, typer.Option(help="demonstration name (default: file stem)")
     ] = None,
     rate: Annotated[
-        float | None, typer.Option(help="Hz, for a CSV log without a time column")
+        float | None, typer.Option(min=0, help="Hz, for a CSV log without a time column")
     ] = None,
     transform: Annotated[
         str | None,
@@ -150,14 +159,14 @@ def import_(
     segment: Annotated[
         str | None, typer.Option(help="cut into demonstrations: window, contact or marker")
     ] = None,
-    window: Annotated[float, typer.Option(help="--segment window: length (s)")] = 30.0,
+    window: Annotated[float, typer.Option(min=0, help="--segment window: length (s)")] = 30.0,
     force_threshold: Annotated[
-        float, typer.Option(help="--segment contact: force (N) that starts a contact phase")
+        float, typer.Option(min=0, help="--segment contact: force (N) that starts a contact phase")
     ] = 5.0,
     force_off: Annotated[
         float | None, typer.Option(help="--segment contact: force (N) that ends it (default half)")
     ] = None,
-    min_duration: Annotated[float, typer.Option(help="shortest piece kept (s)")] = 1.0,
+    min_duration: Annotated[float, typer.Option(min=0, help="shortest piece kept (s)")] = 1.0,
     marker_value: Annotated[
         str | None, typer.Option(help="--segment marker: keep runs with this value")
     ] = None,
@@ -249,10 +258,8 @@ def export(
     overwrite: Annotated[bool, typer.Option(help="replace an existing file (CSV and map)")] = False,
 ) -> None:
     """Export one demonstration as a CSV log (s, m, w-x-y-z, N, N*m)."""
+    check_output(columns, "columns")  # an output here (an input of demo import)
     the_demo = read_demo(demo)
-    for target in (out, columns):
-        if target is not None:
-            target.parent.mkdir(parents=True, exist_ok=True)
     export_csv(the_demo, out, columns=columns, overwrite=overwrite)
     console.print(
         f"exported {the_demo.n_samples} samples of {the_demo.name or demo} "

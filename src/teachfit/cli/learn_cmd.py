@@ -39,12 +39,22 @@ def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
     return tuple(out)
 
 
+def _worker_counts(workers: str) -> list[int]:
+    try:
+        counts = [int(w) for w in workers.split(",") if w.strip()]
+    except ValueError:
+        counts = []
+    if not counts or min(counts) < 1:
+        raise LearningError(f"--scaling-workers wants counts >= 1 like 1,2,4, got {workers!r}")
+    return counts
+
+
 @guarded
 def learn_skill(
     task: Annotated[str, o.task("puzzle, key, peg, ... (teachfit tasks)")] = "puzzle",
     skill: Annotated[str, typer.Option(help="skill: built-in name or skill .toml")] = "peg-in-hole",
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
-    trials: Annotated[int, typer.Option(help="trials in all (restored trials count)")] = 130,
+    trials: Annotated[int, typer.Option(min=1, help="trials in all (restored trials count)")] = 130,
     study: Annotated[
         str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")
     ] = "runs/study.db",
@@ -246,8 +256,8 @@ def bench_learning(
         str, typer.Option("--tasks", "--task", help="tasks, comma-separated (names or .toml)")
     ] = "puzzle,key,peg",
     methods: Annotated[str, typer.Option(help="comma-separated methods")] = "cmaes,pso,bo,lhs",
-    experiments: Annotated[int, typer.Option(help="learning runs per task and method")] = 2,
-    trials: Annotated[int, typer.Option(help="trials per experiment")] = 60,
+    experiments: Annotated[int, typer.Option(min=1, help="learning runs per task and method")] = 2,
+    trials: Annotated[int, typer.Option(min=1, help="trials per experiment")] = 60,
     workers: o.Workers = None,
     starts: Annotated[int, o.starts("per trial (one execution each)")] = 4,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
@@ -263,7 +273,7 @@ def bench_learning(
         ),
     ] = True,
     speedup_trials: Annotated[
-        int, typer.Option(help="trials of the 1-vs-N-worker speed-up study (0: skip)")
+        int, typer.Option(min=0, help="trials of the 1-vs-N-worker speed-up study (0: skip)")
     ] = 24,
     markdown: o.Markdown = None,
     robot: RobotOpt = "floating",
@@ -279,7 +289,7 @@ def bench_learning(
     ] = False,
     scaling_workers: Annotated[str, typer.Option(help="worker counts of --scaling")] = "1,2,4",
     scaling_trials: Annotated[
-        int, typer.Option(help="trials per worker of each --scaling count")
+        int, typer.Option(min=1, help="trials per worker of each --scaling count")
     ] = 6,
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
@@ -288,6 +298,7 @@ def bench_learning(
     from teachfit.bench import learning as bl
     from teachfit.learning.objective import SkillObjective
 
+    _worker_counts(scaling_workers)  # refused before any work, with --scaling or not
     if scaling:
         _bench_scaling(tasks, scaling_workers, scaling_trials, starts, seed, ray, markdown)
         return
@@ -370,10 +381,7 @@ def _bench_scaling(
 
     from teachfit.bench import learning as bl
 
-    try:
-        counts = [int(w) for w in workers.split(",") if w.strip()]
-    except ValueError:
-        raise LearningError(f"--scaling-workers wants counts like 1,2,4, got {workers!r}") from None
+    counts = _worker_counts(workers)
     task = tasks.split(",")[0]
     with console.status(f"scaling: {task}, {trials} trial(s) per worker, {counts} workers"):
         rows = bl.scaling(

@@ -89,8 +89,8 @@ def quickstart(
 @guarded
 def bench_sim(
     task: Annotated[str, o.task()] = "peg2d",
-    steps: Annotated[int, typer.Option(help="steps per measurement")] = 5000,
-    repeats: Annotated[int, typer.Option(help="measurements (the fastest counts)")] = 3,
+    steps: Annotated[int, typer.Option(min=1, help="steps per measurement")] = 5000,
+    repeats: Annotated[int, typer.Option(min=1, help="measurements (the fastest counts)")] = 3,
     robot: RobotOpt = "floating",
 ) -> None:
     """Raw mj_step steps/s vs. steps/s with the controller in the loop, in contact."""

@@ -66,7 +66,9 @@ def pick(new: T, old_value: T | None) -> T:
 
 def seed(what: str = "") -> Any:
     """``--seed N``: a seed *value* (a count of seeds is never called ``--seed(s)``)."""
-    return typer.Option("--seed", help="random seed" + (f" of {what}" if what else ""))
+    return typer.Option(
+        "--seed", min=0, help="random seed" + (f" of {what}" if what else "") + " (an integer >= 0)"
+    )
 
 
 def plot(what: str) -> Any:
@@ -110,11 +112,11 @@ Overwrite = Annotated[bool, typer.Option(help="replace an existing file")]
 Append = Annotated[bool, typer.Option(help="append to an existing file")]
 Workers = Annotated[
     int | None,
-    typer.Option(help="worker processes (default: all cores; 0: in this process)"),
+    typer.Option(min=0, help="worker processes (default: all cores; 0: in this process)"),
 ]
-Fps = Annotated[int, typer.Option(min=1, help="video frames per second")]
-Width = Annotated[int, typer.Option(min=16, help="video width (px)")]
-Height = Annotated[int, typer.Option(min=16, help="video height (px)")]
+Fps = Annotated[int, typer.Option(min=1, max=240, help="video frames per second")]
+Width = Annotated[int, typer.Option(min=16, max=7680, help="video width (px)")]
+Height = Annotated[int, typer.Option(min=16, max=4320, help="video height (px)")]
 View = Annotated[
     bool, typer.Option("--view", help="watch the run in MuJoCo's viewer (needs a display)")
 ]

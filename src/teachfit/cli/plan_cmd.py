@@ -18,6 +18,7 @@ from teachfit.cli import options as o
 from teachfit.cli.common import append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_table
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import PlanningError, TeachfitError
 
 __all__ = [
@@ -110,10 +111,12 @@ def plan(
         str | None, typer.Option(help="demonstration FILE.h5:INDEX (FILE.h5: its first)")
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
-    te: Annotated[float, typer.Option(help="budget per attempt (s)")] = 0.02,
+    te: Annotated[float, typer.Option(min=0, help="budget per attempt (s)")] = 0.02,
     max_checks: Annotated[
         int | None,
-        typer.Option(help="budget per attempt in collision checks instead of --te (any machine)"),
+        typer.Option(
+            min=1, help="budget per attempt in collision checks instead of --te (any machine)"
+        ),
     ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
     seed: Annotated[int, o.seed("the key-pose repair and of OMPL")] = 0,
@@ -155,7 +158,8 @@ def plan(
     if not result.success:
         raise typer.Exit(code=1)
     if save is not None:
-        np.save(save, poses_to_array(result.poses))
+        with atomic_path(save, "path file") as tmp, open(tmp, "xb") as fh:
+            np.save(fh, poses_to_array(result.poses))
         console.print(f"wrote {save}")
     if strip is not None:
         from teachfit.viz.plan_figures import path_strip_figure
@@ -177,16 +181,22 @@ def bench_planning_cmd(
     runs: Annotated[
         int, typer.Option(min=1, help="planning runs per task (seeds 0, 1, ..., runs - 1)")
     ] = 50,
-    te: Annotated[float, typer.Option(help="budget per attempt (s) with demonstration")] = 0.01,
+    te: Annotated[
+        float, typer.Option(min=0, help="budget per attempt (s) with demonstration")
+    ] = 0.01,
     max_checks: Annotated[
         int | None,
-        typer.Option(help="budget per attempt in collision checks instead of --te (with demo)"),
+        typer.Option(
+            min=1, help="budget per attempt in collision checks instead of --te (with demo)"
+        ),
     ] = None,
     planner: Annotated[str, typer.Option(help="OMPL planner")] = "RRTConnect",
     no_demo_runs: Annotated[
         int, typer.Option(min=0, help="planning runs without demonstration, per task")
     ] = 5,
-    no_demo_budget: Annotated[float, typer.Option(help="budget (s) without demonstration")] = 30.0,
+    no_demo_budget: Annotated[
+        float, typer.Option(min=0, help="budget (s) without demonstration")
+    ] = 30.0,
     markdown: o.Markdown = None,
     seeds: Annotated[int | None, o.old("--seeds", "--runs")] = None,
     no_demo_seeds: Annotated[int | None, o.old("--no-demo-seeds", "--no-demo-runs")] = None,

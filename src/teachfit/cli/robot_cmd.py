@@ -47,7 +47,9 @@ def _real(robot: str, host: str | None) -> str:
 def check(
     robot: RobotOpt = "franka",
     host: HostOpt = None,
-    seconds: Annotated[float, typer.Option(help="seconds of the 1 kHz control loop to time")] = 1.0,
+    seconds: Annotated[
+        float, typer.Option(min=0, help="seconds of the 1 kHz control loop to time")
+    ] = 1.0,
     realtime: Annotated[bool, _REALTIME] = True,
 ) -> None:
     """Connect, read the state, print the safety limits and the loop timing."""
@@ -63,7 +65,7 @@ def bench_robot(
     robot: RobotOpt = "franka",
     host: HostOpt = None,
     seconds: Annotated[
-        float, typer.Option(help="seconds of the 1 kHz control loop to time")
+        float, typer.Option(min=0, help="seconds of the 1 kHz control loop to time")
     ] = 10.0,
     realtime: Annotated[bool, _REALTIME] = True,
 ) -> None:

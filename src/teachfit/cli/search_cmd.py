@@ -14,6 +14,7 @@ from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.cli.tables import print_table
+from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
 
 search_app = typer.Typer(
@@ -45,6 +46,8 @@ def learn_search(
     from teachfit.demonstrations.dataset import read_demos
     from teachfit.models.search_model import SearchModel
 
+    if components != "bic" and not (components.isdigit() and int(components) >= 1):
+        raise TeachfitError(f"--components wants a number >= 1 or 'bic', got {components!r}")
     demo_list = read_demos(demos)
     tasks = {d.task for d in demo_list}
     if len(tasks) != 1:
@@ -138,7 +141,7 @@ def run(
     protocol: Annotated[str, typer.Option(help="start protocol of the task")] = "table1",
     feedforward: Annotated[bool, typer.Option(help="superpose the GMR feed-forward")] = True,
     passes: Annotated[
-        int, typer.Option(help="TSHIX passes: re-sample and continue after a failed pass")
+        int, typer.Option(min=1, help="TSHIX passes: re-sample and continue after a failed pass")
     ] = 1,
     demo: Annotated[
         str | None,
@@ -248,7 +251,7 @@ def figures(
 
     model = SearchModel.load(model_file)
     task = get_task(model.task)
-    out.mkdir(parents=True, exist_ok=True)
+    ensure_folder(out, f"the figure folder {out}")
     rng = np.random.default_rng(seed)
     samples = sf.samples_over_distribution(model.exploration, rng, seed=seed)
     written = [sf.save(samples, out / "samples.png")]

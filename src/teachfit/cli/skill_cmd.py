@@ -12,6 +12,7 @@ from teachfit.cli import options as o
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.cli.tables import print_table
+from teachfit.core.atomic import atomic_write_text
 
 skill_app = typer.Typer(
     help="Manipulation skills (Johannsmeier et al. 2019): show a skill's graph, run it on a task.",
@@ -73,8 +74,7 @@ def show(
         )
     print_table(lrn)
     if toml is not None:
-        toml.parent.mkdir(parents=True, exist_ok=True)
-        toml.write_text(skill_to_toml(sk))
+        atomic_write_text(toml, skill_to_toml(sk), "skill file")
         console.print(f"skill -> {toml}")
     if plot is not None:
         from teachfit.viz.skill_figures import plot_skill_graph
@@ -127,8 +127,9 @@ def run(
         learned = read_params_toml(params, setup.skill.params, setup.skill.users())
         import tomllib
 
-        given = tomllib.loads(params.read_text()).get("params", {})
-        given = given if isinstance(given, dict) and given else tomllib.loads(params.read_text())
+        given = tomllib.loads(params.read_text(encoding="utf-8")).get("params", {})
+        if not (isinstance(given, dict) and given):
+            given = tomllib.loads(params.read_text(encoding="utf-8"))
         missing = sorted(set(setup.skill.params.learned) - set(given))
         if missing:
             console.print(

@@ -91,3 +91,9 @@ class SkillError(TeachfitError):
     def __init__(self, message: str, *, node: str | None = None) -> None:
         self.node = node
         super().__init__(f"node {node!r}: {message}" if node is not None else message)
+
+
+class OutputError(TeachfitError, OSError):
+    """An output file or folder cannot be written (folder cannot be created, disk full,
+    read-only file system). Also an :class:`OSError`, so callers that catch write errors as
+    ``OSError`` keep doing so."""

@@ -266,6 +266,8 @@ class ColumnMap:
                 data = tomllib.load(f)
         except OSError as exc:
             raise DatasetError(f"cannot read ({exc.strerror})", path=str(path)) from exc
+        except UnicodeDecodeError as exc:
+            raise DatasetError(f"not a text (TOML) file ({exc.reason})", path=str(path)) from exc
         except tomllib.TOMLDecodeError as exc:
             raise DatasetError(f"invalid TOML ({exc})", path=str(path)) from exc
         return cls.from_mapping(data, path=str(path), rate_hz=rate_hz)

@@ -20,10 +20,8 @@ failed write never leaves a half-written file behind.
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import uuid
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -35,6 +33,7 @@ import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 
@@ -73,9 +72,13 @@ def _quat_wxyz(rot: Rotation) -> np.ndarray:
 def _array(value: Any, column: str, width: int | None, n: int | None) -> np.ndarray:
     """Validated read-only float64 copy with shape (n,) or (n, width); NaN/inf rejected."""
     try:
-        arr = np.array(value, dtype=np.float64, copy=True)
+        probe = np.asarray(value)
+        kind = probe.dtype.kind
     except (TypeError, ValueError) as exc:
         raise DatasetError(f"not a numeric array ({exc})", column=column) from exc
+    if kind not in "iuf":  # strings, complex numbers, booleans, objects: no silent conversion
+        raise DatasetError(f"holds {probe.dtype} values, not real numbers", column=column)
+    arr = np.array(probe, dtype=np.float64, copy=True)
     want = "(T,)" if width is None else f"(T, {width})"
     if (width is None and arr.ndim != 1) or (width is not None and arr.shape[1:] != (width,)):
         raise DatasetError(f"shape {arr.shape}, expected {want}", column=column)
@@ -313,13 +316,8 @@ def _checked_demos(demos: Sequence[Demonstration], path: Path) -> list[Demonstra
 
 def _atomic(path: Path, fill: Callable[[Path], None]) -> None:
     """Run ``fill(tmp)`` on a temporary path next to ``path`` and move it into place."""
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
+    with atomic_path(path, "demonstration file") as tmp:
         fill(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def write_dataset(
@@ -384,23 +382,31 @@ def _open(path: Path) -> Iterator[tuple[h5py.Group, list[str]]]:
         f = h5py.File(path, "r")
     except OSError as exc:
         raise DatasetError(f"cannot open as HDF5 ({exc})", path=str(path)) from exc
-    with f:
-        fmt = f.attrs.get("format")
-        fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
-        if fmt != FORMAT:
-            raise DatasetError(f"format attribute is {fmt!r}, expected {FORMAT!r}", path=str(path))
-        version = f.attrs.get("format_version")
-        version = version.item() if isinstance(version, np.generic) else version
-        if not isinstance(version, int) or version != FORMAT_VERSION:
-            raise DatasetError(
-                f"unsupported format_version {version!r} (this teachfit reads {FORMAT_VERSION})",
-                path=str(path),
-            )
-        group = f.get("demos")
-        if not isinstance(group, h5py.Group):
-            raise DatasetError("missing group /demos", path=str(path))
-        keys = sorted((k for k in group if re.fullmatch(r"\d+", k)), key=int)
-        yield group, keys
+    try:
+        with f:
+            fmt = f.attrs.get("format")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+            if fmt != FORMAT:
+                raise DatasetError(
+                    f"format attribute is {fmt!r}, expected {FORMAT!r}", path=str(path)
+                )
+            version = f.attrs.get("format_version")
+            version = version.item() if isinstance(version, np.generic) else version
+            if not isinstance(version, int) or version != FORMAT_VERSION:
+                raise DatasetError(
+                    f"unsupported format_version {version!r} "
+                    f"(this teachfit reads {FORMAT_VERSION})",
+                    path=str(path),
+                )
+            group = f.get("demos")
+            if not isinstance(group, h5py.Group):
+                raise DatasetError("missing group /demos", path=str(path))
+            keys = sorted((k for k in group if re.fullmatch(r"\d+", k)), key=int)
+            if not keys:
+                raise DatasetError("the /demos group holds no demonstrations", path=str(path))
+            yield group, keys
+    except (OSError, RuntimeError, KeyError) as exc:  # h5py's errors on a damaged file
+        raise DatasetError(f"damaged HDF5 file, cannot read it ({exc})", path=str(path)) from exc
 
 
 def _attr(group: h5py.Group, label: str, path: Path, default: str | None = None) -> str:

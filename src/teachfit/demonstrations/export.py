@@ -8,12 +8,11 @@ map gives the same float64 values. Both files are written atomically (temporary 
 
 from __future__ import annotations
 
-import os
-import uuid
 from pathlib import Path
 
 import numpy as np
 
+from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import DatasetError
 from teachfit.demonstrations.dataset import Demonstration
 
@@ -22,13 +21,7 @@ WRENCH_COLUMNS = ("fx", "fy", "fz", "tx", "ty", "tz")
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    except OSError as exc:
-        tmp.unlink(missing_ok=True)
-        raise DatasetError(f"cannot write ({exc.strerror})", path=str(path)) from exc
+    atomic_write_text(path, text, "CSV file" if path.suffix == ".csv" else "file")
 
 
 def columns_toml(demo: Demonstration) -> str:

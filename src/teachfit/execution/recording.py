@@ -40,10 +40,8 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import shlex
 import sys
-import uuid
 from collections.abc import Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
@@ -54,7 +52,8 @@ import h5py
 import numpy as np
 
 from teachfit import __version__
-from teachfit.core.errors import DatasetError
+from teachfit.core.atomic import atomic_path
+from teachfit.core.errors import DatasetError, OutputError
 from teachfit.core.geometry import Pose
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult
@@ -215,12 +214,7 @@ def write_run_log(
     path = check_run_log_target(path)
     items = RunLog.of(episodes, info, path).episodes
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise DatasetError(f"cannot create its folder ({exc.strerror})", path=str(path)) from exc
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
-        with h5py.File(tmp, "x") as f:
+        with atomic_path(path, "run log") as tmp, h5py.File(tmp, "x") as f:
             f.attrs["format"] = FORMAT
             f.attrs["format_version"] = FORMAT_VERSION
             f.attrs["units"] = json.dumps(UNITS)
@@ -230,12 +224,8 @@ def write_run_log(
             group = f.create_group("episodes")
             for i, ep in enumerate(items):
                 write_episode(group.create_group(f"{i:03d}"), ep)
-        os.replace(tmp, path)
-    except BaseException as exc:
-        tmp.unlink(missing_ok=True)
-        if isinstance(exc, OSError):
-            raise DatasetError(f"cannot write ({exc})", path=str(path)) from exc
-        raise
+    except OutputError as exc:
+        raise DatasetError(str(exc), path=str(path)) from exc
     return path
 
 

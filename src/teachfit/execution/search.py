@@ -72,6 +72,10 @@ class SearchRun:
     setpoints: SetpointTrajectory
 
 
+#: most TSHIX samples / random-walk steps per pass: a plan through more takes minutes and GBs
+MAX_POINTS = 10_000
+
+
 def plan_search(
     model: SearchModel,
     method: str,
@@ -95,8 +99,10 @@ def plan_search(
     starting where the previous one ends (seed A's re-sampling): the runner stops at insertion,
     so a pass is only executed when every pass before it failed.
     """
-    if n_points <= 0:
-        raise TeachfitError(f"number of points must be positive, got {n_points}")
+    if not 0 < n_points <= MAX_POINTS:
+        raise TeachfitError(
+            f"number of points must be 1 ... {MAX_POINTS} (seed A uses 300-600), got {n_points}"
+        )
     if passes < 1 or (passes > 1 and method != "tshix"):
         raise TeachfitError(f"passes must be 1, or >= 1 for tshix; got {passes} for {method}")
     dims = model.dims

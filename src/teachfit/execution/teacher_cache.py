@@ -18,6 +18,7 @@ from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 
+from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import DatasetError
 from teachfit.demonstrations.dataset import Demonstration, read_dataset, write_dataset
 
@@ -72,8 +73,6 @@ def cached(key: str, record: Callable[[], Recording]) -> Recording:
     demos, discarded = record()
     root.mkdir(parents=True, exist_ok=True)
     # the notes first: an entry counts only once its demonstrations are in place (os.replace)
-    tmp = notes.with_name(f".{notes.name}.{os.getpid()}")
-    tmp.write_text(json.dumps({"discarded": discarded}))
-    os.replace(tmp, notes)
+    atomic_write_text(notes, json.dumps({"discarded": discarded}), "teacher cache entry")
     write_dataset(data, demos, overwrite=True)
     return demos, discarded

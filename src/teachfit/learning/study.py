@@ -37,6 +37,7 @@ from optuna.distributions import FloatDistribution
 from optuna.exceptions import StorageInternalError
 from sqlalchemy.exc import DBAPIError
 
+from teachfit.core.atomic import ensure_folder
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
@@ -53,14 +54,21 @@ SYNC_S = 1.0
 T = TypeVar("T")
 
 
-def _retry(fn: Callable[[], T], attempts: int = 8) -> T:
-    """``fn()``, retried on database errors: processes creating one study's tables race."""
+#: SQLite's words for a file that no retry will make readable
+_BROKEN = ("malformed", "not a database", "file is encrypted")
+
+
+def _retry(fn: Callable[[], T], attempts: int = 8, what: str = "study database") -> T:
+    """``fn()``, retried on database errors: processes creating one study's tables race.
+    A damaged database, or errors that outlast the retries, are a :class:`LearningError`."""
     for i in range(attempts):
         try:
             return fn()
-        except (DBAPIError, StorageInternalError):
-            if i == attempts - 1:
-                raise
+        except (DBAPIError, StorageInternalError) as exc:
+            cause = getattr(exc, "orig", None) or exc.__cause__ or exc
+            text = (str(cause).strip().splitlines() or [type(cause).__name__])[0]
+            if i == attempts - 1 or any(word in text for word in _BROKEN):
+                raise LearningError(f"{what}: {text}") from exc
             time.sleep(0.05 * 2**i)
     raise AssertionError("unreachable")
 
@@ -99,7 +107,20 @@ def storage_url(storage: str | Path) -> str:
     if "://" in text:
         return text
     path = Path(text).expanduser().resolve()
-    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.is_dir():
+        raise LearningError(f"study file {text} is a folder; give a file name (e.g. runs/s.db)")
+    if path.is_file() and path.stat().st_size > 0:
+        try:
+            with path.open("rb") as fh:
+                header = fh.read(16)
+        except OSError as exc:
+            raise LearningError(f"cannot read study file {text}: {exc.strerror}") from exc
+        if header != b"SQLite format 3\x00":
+            raise LearningError(
+                f"study file {text} is not an SQLite database; give a new file name, an "
+                "existing study, or an SQLAlchemy URL"
+            )
+    ensure_folder(path.parent, f"the folder of study file {text}")
     return f"sqlite:///{path}"
 
 
@@ -110,7 +131,10 @@ def stored_tags(storage: str | Path, name: str = "teachfit") -> dict[str, Any] |
     if "://" not in str(storage) and not Path(storage).expanduser().exists():
         return None  # a file that does not exist yet holds no study: do not create it here
     try:
-        study = optuna.load_study(study_name=name, storage=storage_url(storage))
+        study = _retry(
+            lambda: optuna.load_study(study_name=name, storage=storage_url(storage)),
+            what=f"study database {storage}",
+        )
     except KeyError:
         return None
     return dict(study.user_attrs)
@@ -193,15 +217,18 @@ class Study:
         self.tags = tags
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self.learner = make_learner(method, space, seed, options)
+        what = f"study database {storage}"
         rdb = _retry(
-            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url))
+            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url)),
+            what=what,
         )
         serialise_sqlite(rdb.engine)
         self._rdb = rdb
         self._optuna = _retry(
             lambda: optuna.create_study(
                 storage=rdb, study_name=name, direction="minimize", load_if_exists=True
-            )
+            ),
+            what=what,
         )
         self._dists = {
             n: FloatDistribution(d.low, d.high, log=d.log) for n, d in space.domains.items()

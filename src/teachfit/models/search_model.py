@@ -31,6 +31,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import ModelError
 from teachfit.models.covariance_choice import CovarianceChoice, choose_covariance
 from teachfit.models.dynamics import DynamicsModel, fit_dynamics
@@ -199,8 +200,7 @@ class SearchModel:
     def save(self, path: str | Path) -> Path:
         """Write the model as JSON; returns the path."""
         path = Path(path)
-        path.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
-        return path
+        return atomic_write_text(path, json.dumps(self.to_dict(), indent=1), "model file")
 
     @classmethod
     def from_dict(

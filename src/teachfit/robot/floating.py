@@ -20,6 +20,7 @@ from teachfit.core.control import ControllerSpec, FixedGainSpec
 from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.interface import law_fault
 from teachfit.tasks.base import Task
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
 
@@ -163,7 +164,7 @@ class FloatingToolRobot:
         self._warnings = 0
         self._warning_numbers = self.data.warning.number
         self._cmd: ImpedanceCommand | None = None
-        self._fault: SimulationDiverged | None = None
+        self._fault: SimulationDiverged | ControlError | None = None
 
     # ------------------------------------------------------------------ Robot protocol
     @property
@@ -284,6 +285,12 @@ class FloatingToolRobot:
 
     def _check_divergence(self) -> None:
         count = self._warning_count()
+        finite = np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))
+        if count > self._warnings or not finite:
+            self._fault = law_fault(self._law, float(self.data.time))
+            if self._fault is not None:
+                self._warnings = count
+                raise self._fault
         if count > self._warnings:
             kinds = [
                 mujoco.mjtWarning(i).name for i, w in enumerate(self.data.warning) if w.number > 0

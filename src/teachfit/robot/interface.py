@@ -26,7 +26,10 @@ from __future__ import annotations
 
 from typing import Protocol, runtime_checkable
 
+import numpy as np
+
 from teachfit.core.control import ControllerSpec
+from teachfit.core.errors import ControlError
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
 
@@ -73,3 +76,18 @@ class Robot(Protocol):
     def close(self) -> None:
         """Release the robot (stop the control loop, free the connection or the simulator)."""
         ...
+
+
+def law_fault(law: object, t: float) -> ControlError | None:
+    """A :class:`ControlError` if the control law's last wrench is not finite, else ``None``.
+
+    A simulator asks before it reports a diverged state: when the law (an adaptive law whose
+    gains blew up, a NaN in a command) produced the NaN, the law is the cause, not the physics.
+    """
+    w = getattr(law, "last_wrench", None)
+    if w is None or np.all(np.isfinite(w)):
+        return None
+    return ControlError(
+        f"the {type(law).__name__} control law produced a non-finite wrench {np.asarray(w)} "
+        f"at t={t:.3f} s (its command or gains are invalid); the simulation is invalid after it"
+    )

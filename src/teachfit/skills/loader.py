@@ -118,8 +118,8 @@ def load_skill(path: str | Path) -> Skill:
     """A skill from a TOML file; errors name the file (and the node)."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise SkillError(f"cannot read skill file {path}: {exc}") from exc
     try:
         return skill_from_dict(data, str(path))

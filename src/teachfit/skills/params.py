@@ -14,14 +14,13 @@ per execution, never in the control loop.
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 import tomllib
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from teachfit.core.errors import SkillError
+from teachfit.core.atomic import atomic_write_text
+from teachfit.core.errors import OutputError, SkillError
 from teachfit.core.params import ParamDomain, ParamSpace
 
 #: a literal number or a (possibly negated) parameter name
@@ -168,8 +167,8 @@ def read_params_toml(
     """
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise SkillError(f"cannot read parameter file {path}: {exc}") from exc
     data = data.get("params", data)
     bad = {k: v for k, v in data.items() if isinstance(v, bool) or not isinstance(v, int | float)}
@@ -203,20 +202,7 @@ def write_params_toml(path: str | Path, params: Mapping[str, float], header: str
             raise SkillError(f"parameter {name!r} must be a finite number, got {v!r}")
         lines.append(f"{name} = {float(v)!r}")
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise SkillError(f"cannot write parameter file {path}: {exc}") from exc
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            os.fchmod(fh.fileno(), 0o644)  # mkstemp creates 0600; a parameter file is shared
-            fh.write("\n".join(lines) + "\n")
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        Path(tmp).unlink(missing_ok=True)
-        if isinstance(exc, OSError):
-            raise SkillError(f"cannot write parameter file {path}: {exc}") from exc
-        raise
+        atomic_write_text(path, "\n".join(lines) + "\n", "parameter file")
+    except OutputError as exc:
+        raise SkillError(str(exc)) from exc
     return path

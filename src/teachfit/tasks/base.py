@@ -15,6 +15,7 @@ A :class:`Task` holds its geometry and success test itself (concern of the subcl
 from __future__ import annotations
 
 import dataclasses
+import math
 import tomllib
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
@@ -136,22 +137,23 @@ class Task(ABC):
         unknown = sorted(set(values) - set(fields))
         if unknown:
             raise TaskError(f"unknown {cls.name} parameter(s) {unknown}; known: {sorted(fields)}")
-        kwargs = {}
-        for key, val in values.items():
-            default = getattr(cls.params_type(), key)
-            kwargs[key] = tuple(val) if isinstance(default, tuple) else type(default)(val)
+        defaults = cls.params_type()
+        kwargs = {
+            key: _typed(cls.name, key, val, getattr(defaults, key)) for key, val in values.items()
+        }
         return cls(cls.params_type(**kwargs))
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Self:
         """Load parameters from a TOML file (a flat table, or a ``[params]`` table)."""
-        try:
-            data = tomllib.loads(Path(path).read_text())
-        except (OSError, tomllib.TOMLDecodeError) as exc:
-            raise TaskError(f"cannot read task file {path}: {exc}") from exc
+        data = read_task_toml(path)
         data = data.get("params", data)
-        data = {k: v for k, v in data.items() if k != "task"}
-        return cls.from_mapping(data)
+        if not isinstance(data, dict):
+            raise TaskError(f"task file {path}: [params] must be a table, got {data!r}")
+        try:
+            return cls.from_mapping({k: v for k, v in data.items() if k != "task"})
+        except TaskError as exc:
+            raise TaskError(f"task file {path}: {exc}") from exc
 
     def param_table(self) -> list[tuple[str, Any, str]]:
         """``(name, value, description)`` rows for listing a task's parameters."""
@@ -159,3 +161,46 @@ class Task(ABC):
         for f in dataclasses.fields(self.params):
             rows.append((f.name, getattr(self.params, f.name), f.metadata.get("doc", "")))
         return rows
+
+
+def read_task_toml(path: str | Path) -> dict[str, Any]:
+    """The table of a task TOML file; :class:`TaskError` (naming the file) if it is missing,
+    not UTF-8 text (a binary file) or not TOML."""
+    try:
+        return tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise TaskError(f"cannot read task file {path}: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise TaskError(f"task file {path} is not a text (TOML) file: {exc.reason}") from exc
+    except tomllib.TOMLDecodeError as exc:
+        raise TaskError(f"task file {path} is not valid TOML: {exc}") from exc
+
+
+def _typed(task: str, key: str, val: Any, default: Any) -> Any:
+    """``val`` as the type of the parameter's default, refusing what TOML would convert
+    silently (a boolean as a number, 12.9 as an integer, ``nan``, a string or a table)."""
+    where = f"{task} parameter {key!r}"
+    if isinstance(default, bool):
+        if not isinstance(val, bool):
+            raise TaskError(f"{where} must be true or false, got {val!r}")
+        return val
+    if isinstance(default, tuple):
+        if not isinstance(val, list | tuple) or len(val) != len(default):
+            raise TaskError(f"{where} must be a list of {len(default)} values, got {val!r}")
+        return tuple(
+            _typed(task, f"{key}[{i}]", v, d)
+            for i, (v, d) in enumerate(zip(val, default, strict=True))
+        )
+    if isinstance(default, int | float):
+        if isinstance(val, bool) or not isinstance(val, int | float):
+            raise TaskError(f"{where} must be a number, got {val!r}")
+        if not math.isfinite(val):
+            raise TaskError(f"{where} must be a finite number, got {val!r}")
+        if isinstance(default, int):
+            if float(val) != int(val):
+                raise TaskError(f"{where} must be a whole number, got {val!r}")
+            return int(val)
+        return float(val)
+    if isinstance(default, str) and not isinstance(val, str):
+        raise TaskError(f"{where} must be a string, got {val!r}")
+    return val

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from teachfit.core.errors import TaskError
-from teachfit.tasks.base import Task
+from teachfit.tasks.base import Task, read_task_toml
 from teachfit.tasks.geometry.key import Key
 from teachfit.tasks.geometry.peg import AluminiumPeg
 from teachfit.tasks.geometry.peg2d import Peg2D
@@ -22,14 +22,7 @@ def _is_file(name: str) -> bool:
 
 
 def _kind(path: Path) -> str:
-    import tomllib
-
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise TaskError(f"cannot read task file {path}: {exc.strerror or exc}") from exc
-    except tomllib.TOMLDecodeError as exc:
-        raise TaskError(f"cannot read task file {path}: {exc}") from exc
+    data = read_task_toml(path)
     kind = data.get("task")
     if kind != "mesh" and kind not in TASKS:
         raise TaskError(

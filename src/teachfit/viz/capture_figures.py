@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation  # noqa: E402
 from teachfit.capture.track import Track  # noqa: E402
 from teachfit.core.geometry import wxyz_to_rotation  # noqa: E402
 from teachfit.demonstrations.dataset import Demonstration  # noqa: E402
+from teachfit.viz.output import save_figure
 
 __all__ = ["track_figure"]
 
@@ -74,7 +75,4 @@ def track_figure(track: Track, out: str | Path, truth: Demonstration | None = No
         title += "; dashed: ground truth (under the track where they agree)"
     axes[0].set_title(title)
     fig.tight_layout()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save_figure(fig, out, dpi=110)

@@ -16,6 +16,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from teachfit.tasks.mesh.sections import ENTRY_EPS, footprint, section  # noqa: E402
 from teachfit.tasks.mesh.task import MeshTask  # noqa: E402
+from teachfit.viz.output import save_figure
 
 __all__ = ["cell_figure"]
 
@@ -86,7 +87,4 @@ def cell_figure(task: MeshTask, path: str | Path, lift: float = 0.01) -> Path:
     unique = dict(zip(labels, handles, strict=True))
     ax2.legend(unique.values(), unique.keys(), loc="upper right", fontsize=8)
     fig.tight_layout()
-    out = Path(path)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save_figure(fig, path, dpi=110)

@@ -14,6 +14,7 @@ from matplotlib.patches import Circle  # noqa: E402
 
 from teachfit.demonstrations.dataset import Demonstration  # noqa: E402
 from teachfit.tasks.base import Task  # noqa: E402
+from teachfit.viz.output import save_figure  # noqa: E402
 from teachfit.viz.style import axis_label, end_handles, mark_ends  # noqa: E402
 
 
@@ -81,10 +82,7 @@ def plot_demonstrations(
         axes_w[1].text(0.5, 0.5, "no force recorded", ha="center", transform=axes_w[1].transAxes)
     axes_w[0].set_title(f"force the environment exerts on the tool (in {frame})")
     axes_w[-1].set_xlabel("time (s)")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_executions(
@@ -117,7 +115,4 @@ def plot_executions(
         *end_handles(),
     ]
     ax.legend(handles=handles, fontsize=7, loc="best")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

@@ -22,14 +22,11 @@ from teachfit.core.params import ParamSpace  # noqa: E402
 from teachfit.execution.engine import ExecutionResult  # noqa: E402
 from teachfit.learning.curves import Band, best_so_far  # noqa: E402
 from teachfit.learning.study import TrialRecord  # noqa: E402
+from teachfit.viz.output import save_figure
 
 
 def _save(fig: plt.Figure, path: str | Path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_learning_curves(

@@ -16,6 +16,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.plans.keyposes import KeyPoses  # noqa: E402
 from teachfit.plans.parts import Assembly  # noqa: E402
+from teachfit.viz.output import save_figure
 
 __all__ = ["add_mesh", "keypose_figure", "parts_figure", "path_strip_figure"]
 
@@ -63,8 +64,7 @@ def _frame_axes(ax: plt.Axes, asm: Assembly, extra: np.ndarray | None = None) ->
 
 def _save(fig: plt.Figure, path: str | Path | None) -> plt.Figure:
     if path is not None:
-        fig.savefig(path, dpi=120, bbox_inches="tight")
-        plt.close(fig)
+        save_figure(fig, path, dpi=120, bbox_inches="tight")
     return fig
 
 

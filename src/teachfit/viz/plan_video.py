@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from contextlib import ExitStack
 from pathlib import Path
 
 import imageio.v2 as imageio
@@ -12,6 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from teachfit.core.atomic import atomic_path  # noqa: E402
 from teachfit.core.errors import RenderError  # noqa: E402
 from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.plans.parts import Assembly  # noqa: E402
@@ -61,28 +63,20 @@ def render_path_video(
     ax.view_init(elev=22, azim=-65)
     ax.plot(*(1e3 * positions.T), "-", color="C0", lw=0.8)
     idx = np.linspace(0, len(path) - 1, max(frames, 2)).round().astype(int)
-    moving = None
-    try:
-        writer = imageio.get_writer(out, fps=fps, codec="libx264", macro_block_size=16)
-    except Exception as exc:  # imageio reports a missing ffmpeg with several exception types
-        plt.close(fig)
-        raise RenderError(f"cannot open an mp4 writer (imageio-ffmpeg): {exc}") from exc
-    try:
+    with ExitStack() as stack:
+        stack.callback(plt.close, fig)
+        tmp = stack.enter_context(atomic_path(out, "video"))
+        try:
+            writer = imageio.get_writer(tmp, fps=fps, codec="libx264", macro_block_size=16)
+        except Exception as exc:  # imageio reports a missing ffmpeg with several exception types
+            raise RenderError(f"cannot open an mp4 writer (imageio-ffmpeg): {exc}") from exc
+        stack.callback(writer.close)  # closed (and flushed) before the file is moved into place
+        moving = None
         for i in idx:
             if moving is not None:
                 moving.remove()
-            moving = add_mesh(
-                ax,
-                asm.moving,
-                path[i].matrix,
-                color=MOVING_COLOR,
-                alpha=0.9,
-            )
+            moving = add_mesh(ax, asm.moving, path[i].matrix, color=MOVING_COLOR, alpha=0.9)
             ax.set_title(f"{asm.task}: pose {i + 1}/{len(path)}")
             fig.canvas.draw()
-            frame = np.asarray(fig.canvas.buffer_rgba())[..., :3]
-            writer.append_data(frame)
-    finally:
-        writer.close()
-        plt.close(fig)
+            writer.append_data(np.asarray(fig.canvas.buffer_rgba())[..., :3])
     return out

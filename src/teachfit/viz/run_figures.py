@@ -13,6 +13,7 @@ import numpy as np  # noqa: E402
 
 from teachfit.core.geometry import rz_from_quat  # noqa: E402
 from teachfit.execution.recording import RunLog  # noqa: E402
+from teachfit.viz.output import save_figure
 
 MAX_EPISODES = 8
 
@@ -78,7 +79,4 @@ def plot_run(run: RunLog, path: str | Path, episodes: Sequence[int] | None = Non
     # fixed margins: a layout engine would draw the figure twice
     fig.subplots_adjust(left=0.11, right=0.98, bottom=0.5 / fig.get_figheight(), hspace=0.12)
     fig.subplots_adjust(top=1 - 0.55 / fig.get_figheight())
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110)

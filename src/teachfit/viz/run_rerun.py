@@ -18,7 +18,6 @@ subtree per episode, on the timeline ``time`` (s since the episode started; worl
 
 from __future__ import annotations
 
-import os
 import uuid
 from collections.abc import Iterable
 from pathlib import Path
@@ -26,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import TeachfitError
 from teachfit.execution.recording import Episode, RunInfo, RunLog
 
@@ -97,27 +97,23 @@ def write_rrd(
     run = RunLog.of(episodes, info, path)
     if path.is_dir():
         raise TeachfitError(f"--rrd {path} is a folder: give a file name such as run.rrd")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
     rec = rr.RecordingStream("teachfit", recording_id=uuid.uuid4().hex)
     try:
-        rec.save(tmp)
-        rec.send_recording_name(name or f"{info.kind} {info.method} on {info.task}")
-        rec.log(
-            "run",
-            rr.TextDocument(
-                f"{info.kind} on {info.task} with {info.robot}, method {info.method}, "
-                f"seed {info.seed}\n{info.command}"
-            ),
-            static=True,
-        )
-        for i, ep in enumerate(run.episodes):
-            _episode(rec, rr, f"episodes/{i:03d}", ep, run.depth(i))
-        rec.flush()
+        with atomic_path(path, "Rerun recording") as tmp:
+            rec.save(tmp)
+            rec.send_recording_name(name or f"{info.kind} {info.method} on {info.task}")
+            rec.log(
+                "run",
+                rr.TextDocument(
+                    f"{info.kind} on {info.task} with {info.robot}, method {info.method}, "
+                    f"seed {info.seed}\n{info.command}"
+                ),
+                static=True,
+            )
+            for i, ep in enumerate(run.episodes):
+                _episode(rec, rr, f"episodes/{i:03d}", ep, run.depth(i))
+            rec.flush()
+            rec.disconnect()  # the file is complete before it is moved into place
+    finally:
         rec.disconnect()
-        os.replace(tmp, path)
-    except BaseException:
-        rec.disconnect()
-        tmp.unlink(missing_ok=True)
-        raise
     return path

@@ -18,6 +18,7 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from teachfit.models.exploration import ExplorationDistribution  # noqa: E402
 from teachfit.trajectories.tshix import SearchTrajectory  # noqa: E402
+from teachfit.viz.output import save_figure  # noqa: E402
 from teachfit.viz.style import END, START, end_handles, mark_ends  # noqa: E402
 
 _MM = 1e3
@@ -188,7 +189,4 @@ def planned_vs_executed(
 
 def save(fig: Figure, path: str | Path, dpi: int = 150) -> Path:
     """Write a figure (format from the suffix) and close it."""
-    path = Path(path)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=dpi)

@@ -21,6 +21,7 @@ from matplotlib.patches import FancyBboxPatch  # noqa: E402
 
 from teachfit.execution.engine import ExecutionResult  # noqa: E402
 from teachfit.skills.graph import Skill  # noqa: E402
+from teachfit.viz.output import save_figure
 
 
 def _order(skill: Skill) -> list[str]:
@@ -183,10 +184,7 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
     ax.set_ylim(-2.1, 1.25)
     ax.set_aspect("equal")
     ax.axis("off")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=130)
 
 
 def plot_traces(traces: Sequence[ExecutionResult], path: str | Path, title: str = "") -> Path:
@@ -237,7 +235,4 @@ def plot_traces(traces: Sequence[ExecutionResult], path: str | Path, title: str 
         ax1.legend(fontsize=7)
     if title:
         fig.suptitle(title, fontsize=10)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

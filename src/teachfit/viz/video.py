@@ -14,6 +14,7 @@ from pathlib import Path
 import imageio.v2 as imageio
 import numpy as np
 
+from teachfit.core.atomic import atomic_path
 from teachfit.robot.render import motion_frames
 from teachfit.tasks.base import Task
 
@@ -21,13 +22,12 @@ from teachfit.tasks.base import Task
 @contextmanager
 def video_writer(path: str | Path, fps: int = 30) -> Iterator[imageio.core.Format.Writer]:
     """An mp4 writer (H.264 through the ``imageio-ffmpeg`` packaged binary)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    writer = imageio.get_writer(path, fps=fps, codec="libx264", quality=7, macro_block_size=8)
-    try:
-        yield writer
-    finally:
-        writer.close()
+    with atomic_path(path, "video") as tmp:
+        writer = imageio.get_writer(tmp, fps=fps, codec="libx264", quality=7, macro_block_size=8)
+        try:
+            yield writer
+        finally:
+            writer.close()
 
 
 def render_motion(

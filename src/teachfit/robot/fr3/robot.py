@@ -27,6 +27,7 @@ from teachfit.robot.fr3.control import TorqueImpedance, operational_inertia
 from teachfit.robot.fr3.ik import IKSettings, solve_ik
 from teachfit.robot.fr3.params import DQ_MAX, DTAU_MAX, Q_MAX, Q_MIN, READY_Q, TAU_MAX, FR3Params
 from teachfit.robot.fr3.sensing import JointTorqueObserver, WristFT
+from teachfit.robot.interface import law_fault
 from teachfit.tasks.base import Task
 
 
@@ -216,6 +217,13 @@ class FR3Robot:
     def _check_divergence(self) -> None:
         d = self.data
         count = int(self._warning_numbers.sum())
+        finite = np.all(np.isfinite(d.qpos)) and np.all(np.isfinite(d.qvel))
+        if count > self._warnings or not finite:
+            cause = law_fault(self.ctl.law, float(d.time))
+            if cause is not None:
+                self._warnings = count
+                self._fault = cause  # type: ignore[assignment]
+                raise cause
         if count > self._warnings:
             kinds = [mujoco.mjtWarning(i).name for i, w in enumerate(d.warning) if w.number > 0]
             self._warnings = count

@@ -9,8 +9,6 @@ that fits its declared units (a 20 m peg is a mm mesh declared as m). Each failu
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import coal
@@ -18,6 +16,7 @@ import manifold3d
 import numpy as np
 import trimesh
 
+from teachfit.core.atomic import atomic_write_bytes
 from teachfit.core.errors import TaskError
 
 #: file types accepted for part meshes
@@ -155,14 +154,5 @@ def from_manifold(solid: manifold3d.Manifold) -> trimesh.Trimesh:
 
 
 def write_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder (``os.replace``),
-    so that a reader never sees half a file."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    """Write ``data`` to ``path`` atomically (:func:`teachfit.core.atomic.atomic_write_bytes`)."""
+    atomic_write_bytes(path, data)

@@ -123,9 +123,11 @@ def read_spec(path: str | Path) -> MeshTaskSpec:
     """Parse and check the task file ``path`` (see the module docstring for its layout)."""
     path = Path(path)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
     except OSError as exc:
         raise _fail(path, f"cannot read the task file ({exc.strerror or exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise _fail(path, f"not a text (TOML) file ({exc.reason})") from exc
     except tomllib.TOMLDecodeError as exc:
         raise _fail(path, f"not valid TOML ({exc})") from exc
     top = ("task", "units", "name", "held", "fixed", "params", "protocol", "decomposition")

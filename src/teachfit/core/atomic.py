@@ -1,0 +1,126 @@
+"""Atomic file output: every file teachfit produces goes through :func:`atomic_path`.
+
+A file is written to a hidden temporary file in the destination's folder, flushed to disk
+(``fsync``) and moved onto the destination with ``os.replace``, so a reader (or a user after a
+crash, a full disk, ``kill -9`` or Ctrl-C) sees the old file or the new one, never half of one.
+On any exception, ``KeyboardInterrupt`` included, the temporary file is removed and the old file
+is left as it was.
+
+Policy for a missing output folder: it is created (with its parents), as ``mkdir -p`` would; a
+folder that cannot be created (a file in the way, no permission) is an :class:`OutputError`
+naming the file. Write errors (full disk, read-only file system) are :class:`OutputError` too.
+
+The standard library has the pieces (``os.replace``, ``os.fsync``) but no atomic-write helper;
+the one maintained package for it (``atomicwrites``) is archived, hence this module.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from teachfit.core.errors import OutputError
+
+#: marker in every temporary file's name (``.NAME.<hex>.tmp.SUFFIX``)
+TMP_MARK = ".tmp"
+
+
+def temporary_name(dest: Path) -> Path:
+    """A hidden temporary path next to ``dest`` that keeps its suffix (``.png``, ``.mp4``...),
+    so that writers which pick the format from the file name (matplotlib, ffmpeg, numpy) still
+    do."""
+    return dest.with_name(f".{dest.name}.{uuid.uuid4().hex[:12]}{TMP_MARK}{dest.suffix}")
+
+
+def ensure_parent(dest: str | Path, what: str = "file") -> Path:
+    """Create ``dest``'s folder if it is missing; :class:`OutputError` if that is impossible."""
+    dest = Path(dest)
+    if dest.is_dir():
+        raise OutputError(f"cannot write {what} {dest}: it is a folder; give a file name")
+    ensure_folder(dest.parent, f"the folder of {what} {dest}")
+    return dest
+
+
+def ensure_folder(folder: str | Path, what: str = "the output folder") -> Path:
+    """Create an output folder (and its parents); :class:`OutputError` if that is impossible."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        why = exc.strerror or str(exc)
+        blocker = next((p for p in (folder, *folder.parents) if p.exists()), None)
+        if blocker is not None and not blocker.is_dir():
+            why = f"{blocker} is a file, not a folder"
+        raise OutputError(f"cannot create {what}: {why}") from exc
+    return folder
+
+
+def _fsync(path: Path, directory: bool = False) -> None:
+    fd = os.open(path, os.O_RDONLY | (os.O_DIRECTORY if directory else 0))
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+@contextmanager
+def atomic_path(dest: str | Path, what: str = "file", mode: int = 0o644) -> Iterator[Path]:
+    """Yield a temporary path to write; on success it replaces ``dest`` atomically.
+
+    ``what`` names the file in error messages ("model file", "figure"). ``mode`` is the
+    permission bits of the result (the umask does not apply: a shared output is readable).
+
+    Raises
+    ------
+    OutputError
+        The folder cannot be created, the body wrote nothing, or writing failed with an
+        ``OSError`` (the error's text is kept). Other exceptions propagate unchanged; in every
+        case the temporary file is removed and ``dest`` is untouched.
+    """
+    dest = ensure_parent(dest, what)
+    tmp = temporary_name(dest)
+    try:
+        yield tmp
+        if not tmp.is_file():
+            raise OutputError(f"cannot write {what} {dest}: nothing was written")
+        os.chmod(tmp, mode)
+        _fsync(tmp)
+        os.replace(tmp, dest)
+        _fsync(dest.parent, directory=True)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        if isinstance(exc, OutputError):
+            raise
+        raise OutputError(f"cannot write {what} {dest}: {exc.strerror or exc}") from exc
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def atomic_write_bytes(dest: str | Path, data: bytes, what: str = "file") -> Path:
+    """Write ``data`` to ``dest`` atomically; returns ``dest`` as a :class:`Path`."""
+    dest = Path(dest)
+    with atomic_path(dest, what) as tmp, open(tmp, "xb") as fh:
+        fh.write(data)
+    return dest
+
+
+def atomic_write_text(dest: str | Path, text: str, what: str = "file") -> Path:
+    """Write ``text`` (UTF-8) to ``dest`` atomically; returns ``dest`` as a :class:`Path`."""
+    return atomic_write_bytes(dest, text.encode("utf-8"), what)
+
+
+def atomic_append_text(dest: str | Path, text: str, what: str = "file") -> Path:
+    """Append ``text`` to ``dest`` (created if missing): the old content plus ``text`` is
+    written as a new file and moved into place, so a failed append leaves the old file."""
+    dest = Path(dest)
+    old = b""
+    if dest.is_file():
+        try:
+            old = dest.read_bytes()
+        except OSError as exc:
+            raise OutputError(f"cannot read {what} {dest}: {exc.strerror or exc}") from exc
+    return atomic_write_bytes(dest, old + text.encode("utf-8"), what)
