@@ -58,16 +58,29 @@ def assemble(
     seed: Annotated[int, typer.Option(help="random seed of the trials")] = 0,
     workers: Annotated[int, typer.Option(help="worker processes (0: in this process)")] = 0,
     plot: Annotated[Path | None, typer.Option(help="figure: phases of one trial over time")] = None,
-    video: Annotated[
+    render: Annotated[
         Path | None, typer.Option("--render", help="video (mp4) of that trial")
     ] = None,
     robot: RobotOpt = "floating",
 ) -> None:
     """Assemble over trials: taught hole -> approach -> skill -> learned search recovery."""
     from teachfit.metrics.stats import summarize
+    from teachfit.robot.registry import ROBOTS
 
+    video = render
     err = parse_quantity(hole_error)
     yaw = parse_quantity(yaw_error, "deg", "--yaw-error")
+    if robot not in ROBOTS:
+        raise TeachfitError(f"unknown robot {robot!r}; robots: {', '.join(sorted(ROBOTS))}")
+    if demo is not None and task not in ("l-groove", "tenon"):
+        from teachfit.cli.plan_cmd import _load_demo
+
+        _load_demo(str(demo))  # a bad file is named first
+        raise TeachfitError(f"--demo {demo}: only l-groove and tenon plan from a demonstration")
+    if task not in ("l-groove", "tenon"):
+        from teachfit.tasks.registry import load_task
+
+        load_task(task)  # a bad task (file) before any output
     if task in ("l-groove", "tenon"):
         ang = parse_quantity(angle_error, "deg", "--angle-error")
         _assemble_plan(task, demo, err, ang, trials, seed, plot, video)

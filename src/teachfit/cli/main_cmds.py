@@ -59,11 +59,11 @@ def view(
     from teachfit.demonstrations.dataset import read_demo
     from teachfit.robot.viewer import require_display, view_motion
 
-    require_display()
-    the_task = load_task(task)
+    the_task = load_task(task)  # inputs first: a bad file is named even without a display
     d = read_demo(demo)
     if d.task != the_task.name:
         raise DatasetError(f"demonstration is of task {d.task!r}, not {the_task.name!r}")
+    require_display()
     console.print(f"viewing {d.name or demo} ({d.duration:.1f} s); close the window to end")
     view_motion(the_task, d.t, d.pos, d.quat, speed=speed)
 
