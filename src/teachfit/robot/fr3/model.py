@@ -66,6 +66,8 @@ HAND = f"{ARM_PREFIX}hand"
 TCP_SITE = "tcp"
 FLANGE_SITE = f"{ARM_PREFIX}flange"
 FT_FORCE, FT_TORQUE = "ft_force", "ft_torque"
+#: the link-side joint torque sensors: a torque sensor on a site at each joint's anchor
+JOINT_TORQUE_SENSORS = tuple(f"{j}_tau" for j in JOINTS)
 PART_PREFIX = "part/"
 _PART_SRC = "held_part"
 _FINGER_BODIES = ("left_finger", "right_finger")
@@ -139,7 +141,7 @@ def _arm_spec(params: FR3Params) -> mujoco.MjSpec:
 
 def build_fr3_spec(task: Task, params: FR3Params | None = None) -> mujoco.MjSpec:
     """The whole cell: the task's fixture, the FR3 on its base, the held part on the hand,
-    torque motors, and the wrist F/T sensors."""
+    torque motors, the wrist F/T sensors and the joint torque sensors."""
     params = params or FR3Params()
     contact = dataclasses.replace(
         task.scene.contact or ContactParams(),
@@ -180,6 +182,17 @@ def build_fr3_spec(task: Task, params: FR3Params | None = None) -> mujoco.MjSpec
         objtype=mujoco.mjtObj.mjOBJ_SITE,
         objname=FLANGE_SITE,
     )
+    for name, sensor in zip(JOINTS, JOINT_TORQUE_SENSORS, strict=True):
+        # MuJoCo's torque between the link and its parent, on the joint axis, is what a
+        # link-side joint torque sensor reads: motor torque past gear friction and rotor inertia
+        joint = spec.joint(name)
+        joint.parent.add_site(name=sensor, pos=list(joint.pos), size=[0.001] * 3, group=5)
+        spec.add_sensor(
+            name=sensor,
+            type=mujoco.mjtSensor.mjSENS_TORQUE,
+            objtype=mujoco.mjtObj.mjOBJ_SITE,
+            objname=sensor,
+        )
     return spec
 
 
