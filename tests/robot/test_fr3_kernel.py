@@ -58,3 +58,16 @@ def test_replaying_the_torques_through_mj_step_gives_the_same_run(task):
     mujoco.mj_forward(m, d)
     kernel.replay(kernel.routines(), m._address, d._address, d.ctrl, log)
     np.testing.assert_allclose(d.qpos, end, atol=1e-12)
+
+
+def test_the_robot_keeps_each_executions_joint_torques(task):
+    robot = FR3Robot(task)
+    start = task.protocol.teacher_start(np.random.default_rng(0))
+    for n in (3, 5):
+        robot.reset(start)
+        for _ in range(n):
+            robot.step(10)
+    first, second = robot.recent_torque_traces(2)
+    assert first[1].shape == (3, 7) and second[1].shape == (5, 7)
+    np.testing.assert_allclose(second[0], np.arange(1, 6) * 0.01, atol=1e-9)
+    np.testing.assert_allclose(second[1][-1], robot.joint_torques)

@@ -17,6 +17,8 @@ tick, as the FR3's firmware does); a MuJoCo warning or a NaN/inf state raises
 
 from __future__ import annotations
 
+from collections import deque
+
 import mujoco
 import numpy as np
 
@@ -33,6 +35,7 @@ from teachfit.robot.fr3.params import DQ_MAX, DTAU_MAX, Q_MAX, Q_MIN, READY_Q, T
 from teachfit.robot.fr3.sensing import JointTorqueObserver, WristFT
 from teachfit.tasks.base import Task
 
+TORQUE_TRACES = 16  # executions whose joint torques are kept (FR3Robot.torque_traces)
 _UNTIMED = np.zeros(0, dtype=np.int64)
 _UNLOGGED = np.zeros((0, 7))
 
@@ -103,6 +106,11 @@ class FR3Robot:
         self._fault: RobotFault | None = None
         self._cmd: ImpedanceCommand | None = None
         self.q_start = np.array(READY_Q)
+        #: commanded joint torques of the last executions, one ``(t, tau)`` pair per reset: t
+        #: (T,) s since that reset, tau (T, 7) N·m, one row at the end of each ``step`` call
+        self.torque_traces: deque[tuple[np.ndarray, np.ndarray]] = deque(maxlen=TORQUE_TRACES)
+        self._trace_t: list[float] = []
+        self._trace_tau: list[np.ndarray] = []
         self.reset(task.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.05]))
 
     # ------------------------------------------------------------------ Robot protocol
@@ -142,7 +150,24 @@ class FR3Robot:
         self.ft.reset(d.site_xpos[self._tcp])
         self.command(ImpedanceCommand.hold(pose))
         self._warnings = int(self._warning_numbers.sum())
+        self._close_trace()
+        self._t_reset = float(d.time)
         return self.state()
+
+    def _close_trace(self) -> None:
+        if self._trace_t:
+            self.torque_traces.append((np.array(self._trace_t), np.array(self._trace_tau)))
+        self._trace_t, self._trace_tau = [], []
+
+    def torque_trace(self) -> tuple[np.ndarray, np.ndarray]:
+        """The commanded joint torques since the last reset: ``(t (T,) s, tau (T, 7) N·m)``."""
+        return np.array(self._trace_t), np.array(self._trace_tau).reshape(-1, self.model.nu)
+
+    def recent_torque_traces(self, k: int) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The last ``k`` executions' ``(t, tau)`` (oldest first), the current one included."""
+        current = self.torque_trace()
+        traces = [*self.torque_traces, *([current] if current[0].size else [])]
+        return traces[-k:] if k > 0 else []
 
     def command(self, cmd: ImpedanceCommand) -> None:
         if self._fault is not None:
@@ -158,6 +183,8 @@ class FR3Robot:
         else:
             self._run_python_law(n)
         self._check_divergence()
+        self._trace_t.append(float(self.data.time) - self._t_reset)
+        self._trace_tau.append(self.ctl.tau.copy())
         return self.state()
 
     def _run_compiled(
@@ -227,6 +254,7 @@ class FR3Robot:
     def close(self) -> None:
         """Nothing to release but the simulator's memory (kept until garbage collection)."""
         self._cmd = None
+        self._close_trace()
 
     def __enter__(self) -> FR3Robot:
         return self
