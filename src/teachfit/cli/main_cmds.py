@@ -106,7 +106,11 @@ def bench_sim(
     table.add_row("raw mj_step", f"{s.raw_steps_per_s:,.0f} steps/s", "")
     table.add_row("with controller", f"{s.controlled_steps_per_s:,.0f} steps/s", "")
     table.add_row("ratio", f"{s.ratio:.2f}", ">= 0.70")
-    table.add_row("real-time factor", f"{s.real_time_factor:.1f}x", ">= 10")
+    arm = hasattr(s, "compute_p99_us")
+    table.add_row("real-time factor", f"{s.real_time_factor:.1f}x", ">= 5" if arm else ">= 10")
+    if arm:
+        table.add_row("law per tick p50", f"{s.compute_p50_us:.1f} µs", "")
+        table.add_row("law per tick p99", f"{s.compute_p99_us:.1f} µs", "<= 100 µs")
     print_table(table)
 
 

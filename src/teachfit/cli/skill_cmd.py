@@ -173,12 +173,19 @@ def run(
 
         title = f"{setup.skill.name} on {the_task.name}, {controller} controller, seed {seed}"
         console.print(f"traces -> {plot_traces(out.traces, plot, title)}")
+        if hasattr(trial.robot, "recent_torque_traces"):  # the FR3: joint torques over time
+            from teachfit.viz.torque_figures import plot_joint_torques
+
+            torques = trial.robot.recent_torque_traces(len(out.traces))
+            image = plot.with_name(f"{plot.stem}-torques{plot.suffix}")
+            console.print(f"joint torques -> {plot_joint_torques(torques, image)}")
     if render is not None:
         from teachfit.viz.video import render_motion
 
         log = out.traces[render_start].log
         with console.status("rendering"):
             path = render_motion(
-                the_task, log.t, log.pos, log.quat, render, fps=fps, width=width, height=height
-            )
+                the_task, log.t, log.pos, log.quat, render, fps=fps, width=width, height=height,
+                robot=robot,
+            )  # fmt: skip
         console.print(f"video -> {path}")

@@ -4,9 +4,9 @@ Both loops start from the same state: the tool pressed onto the surface at the t
 The raw loop keeps the last controller wrench applied (``qfrc_applied`` persists), so it stays
 in the same contact; the controlled loop recomputes the impedance law every 1 ms tick.
 
-For the FR3 (``robot="fr3"``) the raw loop keeps the last joint torques (``ctrl`` persists) and
-the controlled loop runs the whole 1 ms tick (torque law, limits, wrench sensing); the torque
-law's compute time per tick is also timed on its own (median and 99th percentile).
+For the FR3 (``robot="fr3"``) the controlled loop runs the whole 1 ms tick (torque law, limits,
+wrench sensing) and the raw loop replays its torques through plain ``mj_step``; the torque
+law's compute time per tick is also timed (median and 99th percentile).
 """
 
 from __future__ import annotations
@@ -100,70 +100,40 @@ def measure_sim_speed(
     return SimSpeed(raw_best, ctl_best, ctl_best / raw_best, rtf, contacts)
 
 
-RAW_CHUNK = 50
-
-
-def _pressed_fr3(task: Task):  # -> tuple[FR3Robot, ImpedanceCommand]
-    from teachfit.robot.fr3 import FR3Robot
-
-    robot = FR3Robot(task)
-    start = task.protocol.teacher_start(np.random.default_rng(0))
-    robot.reset(start)
-    cmd = ImpedanceCommand(
-        pos=start.pos,
-        quat=start.quat,
-        lin_vel=[0.01, 0.0, 0.0],
-        wrench_ff=[0, 0, -6.0, 0, 0, 0],
-        stiffness=[1500, 150, 100, 40, 40, 40],
-        expires_after=60.0,
-    )
-    robot.command(cmd)
-    robot.step(300)  # settle into contact; the raw loop keeps the last torques (ctrl persists)
-    return robot, cmd
-
-
 def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSimSpeed:
     """The FR3's figures: raw ``mj_step`` vs. the full controlled tick (best of ``repeats``,
-    interleaved), and the torque law's compute time per tick (p50, p99 over all ticks)."""
-    if steps < RAW_CHUNK:
-        raise TeachfitError(f"steps must be >= {RAW_CHUNK}")
+    interleaved), and the torque law's compute time per tick (p50, p99 over all ticks).
+
+    The controlled tick runs as one compiled loop (:mod:`teachfit.robot.fr3.kernel`), so the
+    raw loop is compiled too: from the same pressed state it replays the controlled run's
+    torques through plain ``mj_step`` (the same states, contacts and solver work, no Python
+    per step), so the ratio is what the controller adds to the physics. Speeds are in CPU
+    seconds of this thread (``time.thread_time``): on a shared machine other jobs' time does
+    not count, and on an idle one it equals the wall clock. The compute time is measured
+    inside the loop around the law and the torque map of each tick (wall clock, ns).
+    """
+    from teachfit.robot.fr3 import kernel
+
     raw_best = ctl_best = 0.0
     contacts = 0
     samples: list[np.ndarray] = []
     robot = None
     for _ in range(repeats):
-        robot, cmd = _pressed_fr3(task)
-        m, d = robot.model, robot.data
-        snapshot = (d.qpos.copy(), d.qvel.copy(), d.ctrl.copy(), d.time)
-        # the arm drifts off the surface under constant torques: restart the raw loop from the
-        # pressed state every RAW_CHUNK steps (untimed) so that it stays in the same contact
-        raw_time = 0.0
-        for _ in range(steps // RAW_CHUNK):
-            d.qpos[:], d.qvel[:], d.ctrl[:], d.time = snapshot
-            mujoco.mj_forward(m, d)
-            t0 = time.perf_counter()
-            for _ in range(RAW_CHUNK):
-                mujoco.mj_step(m, d)
-            raw_time += time.perf_counter() - t0
-        raw_best = max(raw_best, RAW_CHUNK * (steps // RAW_CHUNK) / raw_time)
-        d.qpos[:], d.qvel[:], d.ctrl[:], d.time = snapshot
+        robot, _cmd = _pressed_robot(task, "fr3")
+        m, d = robot.model, robot.data  # type: ignore[attr-defined]
+        snapshot = (d.qpos.copy(), d.qvel.copy(), d.ctrl.copy(), d.qacc_warmstart.copy(), d.time)
+        contacts = max(contacts, int(d.ncon))
+        t0 = time.thread_time()
+        ticks, log = robot.step_timed(steps)  # type: ignore[attr-defined]
+        ctl_best = max(ctl_best, steps / (time.thread_time() - t0))
+        samples.append(ticks)
+        d.qpos[:], d.qvel[:], d.ctrl[:], d.qacc_warmstart[:], d.time = snapshot
         mujoco.mj_forward(m, d)
-        robot.command(cmd)
-        contacts = int(d.ncon)
-        t0 = time.perf_counter()
-        robot.step(steps)
-        ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
-        ctl, clock = robot.ctl, time.perf_counter_ns
-        ticks = np.empty(steps)
-        for k in range(steps):  # the torque law alone, in the same contact
-            mujoco.mj_step1(m, d)
-            t0 = clock()
-            d.ctrl[:] = ctl.compute(d.time)
-            ticks[k] = clock() - t0
-            mujoco.mj_step2(m, d)
-        samples.append(ticks / 1e3)
+        t0 = time.thread_time()
+        kernel.replay(kernel.routines(), m._address, d._address, d.ctrl, log)
+        raw_best = max(raw_best, steps / (time.thread_time() - t0))
     assert robot is not None
-    rtf = ctl_best * robot.control_period
+    rtf = ctl_best * robot.control_period  # type: ignore[attr-defined]
     per_tick = np.concatenate(samples)
     return ArmSimSpeed(
         raw_best,

@@ -19,6 +19,9 @@ space inertia; its diagonal is the apparent mass the law's critical damping uses
 The commanded torque is limited as the FR3 limits it: first the rate,
 ``|tau_k - tau_{k-1}| <= dtau_max dt`` (1000 N·m/s), then the magnitude,
 ``|tau_k| <= tau_max`` (87/87/87/87/12/12/12 N·m), every tick.
+
+The arithmetic runs compiled (:mod:`teachfit.robot.fr3.kernel`); this class owns the buffers
+(allocated once, names and pointers resolved once) that the kernel works on.
 """
 
 from __future__ import annotations
@@ -26,7 +29,9 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from teachfit.control import CartesianImpedance
 from teachfit.control.base import Controller
+from teachfit.robot.fr3 import kernel as k
 
 
 def operational_inertia(model: mujoco.MjModel, data: mujoco.MjData, site: int) -> np.ndarray:
@@ -49,6 +54,9 @@ class TorqueImpedance:
     law : the Cartesian controller producing ``F`` (TCP wrench, world frame).
     tau_max : (nv,) torque limits (N·m); ``dtau_max`` rate limit (N·m/s).
     null_stiffness, null_damping : ``K_n`` (N·m/rad) and ``D_n`` (N·m·s/rad).
+
+    ``sc`` holds the kernel's scalars (:data:`teachfit.robot.fr3.kernel.N_SCALARS` slots),
+    shared with the robot's sensing.
     """
 
     def __init__(
@@ -63,30 +71,72 @@ class TorqueImpedance:
         null_damping: float,
     ) -> None:
         nv = model.nv
-        self.model, self.data, self.site, self.law = model, data, site, law
+        self.model, self.data, self.site = model, data, site
+        self.fns = k.routines()
+        self.m_ptr, self.d_ptr = model._address, data._address
+        self.sc = np.zeros(k.N_SCALARS)
+        self.sc[k.K_NULL], self.sc[k.D_NULL] = float(null_stiffness), float(null_damping)
+        self.sc[k.DT] = float(model.opt.timestep)
+        self.sc[k.DTAU] = float(dtau_max) * float(model.opt.timestep)
         self.tau_max = np.asarray(tau_max, dtype=float)
-        self.dtau_step = float(dtau_max) * float(model.opt.timestep)
-        self.k_null, self.d_null = float(null_stiffness), float(null_damping)
         self.q_null = np.zeros(nv)
         self.jac = np.zeros((6, nv))
-        self._jacp, self._jacr = self.jac[:3], self.jac[3:]
-        self._jminv = np.zeros((6, nv))
-        self._lam_inv = np.zeros((6, 6))
         self.twist = np.zeros(6)
         self._v, self._w = self.twist[:3], self.twist[3:]
         self.quat = np.zeros(4)
         self.pos = data.site_xpos[site]
-        self._xmat = data.site_xmat[site]
-        self._qpos, self._qvel, self._bias = data.qpos, data.qvel, data.qfrc_bias
-        self._neg_tau_max = -self.tau_max
-        self._null = self.k_null > 0.0 or self.d_null > 0.0
         self.tau = np.zeros(nv)
         self.tau_prev = np.zeros(nv)
         self.wrench = np.zeros(6)
-        self._tau0 = np.zeros(nv)
-        self._tmp = np.zeros(nv)
-        self._y = np.zeros(6)
-        self._z = np.zeros(6)
+        self._work = (np.zeros((6, nv)), np.zeros((6, 6)), np.zeros(nv), np.zeros(6), np.zeros(6))
+        self.dat = (
+            data.qpos,
+            data.qvel,
+            data.qfrc_bias,
+            data.ctrl,
+            data.sensordata,
+            data.site_xmat[site],
+            data.site_xpos[site],
+        )
+        self.law = law
+
+    @property
+    def law(self) -> Controller:
+        return self._law
+
+    @law.setter
+    def law(self, law: Controller) -> None:
+        """Install ``law``; the fixed-gain Cartesian law runs compiled, others in Python."""
+        self._law = law
+        #: True when the whole tick runs compiled (:func:`teachfit.robot.fr3.kernel.run_fixed`)
+        self.compiled = type(law) is CartesianImpedance
+        if self.compiled:
+            e = law._error  # the law's own buffers: the kernel updates them in place
+            self.law_bufs = (law._k, law._d, law._ff, e._xd, e._qd, e._vd, e.err, e.derr)
+            self.law_bufs += (e._qtmp, e._rtmp, self.wrench, self.quat, self.twist)
+        else:
+            z3, z4, z6, z66 = np.zeros(3), np.zeros(4), np.zeros(6), np.zeros((6, 6))
+            self.law_bufs = (z66, z66, z6, z3, z4, z6, z6, z6, z4, z3, z6, self.quat, self.twist)
+
+    def ctl_bufs(self) -> tuple:
+        """The torque map's buffers in the kernel's order (``tau_max`` may be changed)."""
+        jminv, lam, tau0, y, z = self._work
+        tau = self.tau
+        return (self.jac, jminv, lam, self.q_null, self.tau_prev, self.tau_max, tau, tau0, y, z)
+
+    def load_law(self) -> None:
+        """Copy the fixed-gain law's scalar state into the kernel's scalars."""
+        e, lim, sc = self._law._error, self._law.limits, self.sc
+        sc[k.T0], sc[k.EXPIRY] = e._t0, e._expiry
+        sc[k.SPINNING], sc[k.LAPSED] = float(e._spinning), float(e.lapsed)
+        sc[k.MAX_F], sc[k.MAX_T] = lim.max_force, lim.max_torque
+
+    def store_law(self) -> None:
+        """Copy the kernel's scalars back into the fixed-gain law (after a compiled run)."""
+        e, sc = self._law._error, self.sc
+        e._t0, e._expiry = float(sc[k.T0]), float(sc[k.EXPIRY])
+        e._spinning, e.lapsed = bool(sc[k.SPINNING]), bool(sc[k.LAPSED])
+        self._law.last_wrench = self.wrench.copy()
 
     def reset(self, q_null: np.ndarray) -> None:
         """Hold the posture ``q_null`` and start the rate limit from the current bias torque
@@ -97,41 +147,24 @@ class TorqueImpedance:
 
     def update_kinematics(self) -> None:
         """TCP Jacobian, pose and twist (world frame) from the current kinematics."""
-        mujoco.mj_jacSite(self.model, self.data, self._jacp, self._jacr, self.site)
-        mujoco.mju_mat2Quat(self.quat, self._xmat)
-        mujoco.mju_mulMatVec(self.twist, self.jac, self._qvel)
+        k.kinematics(
+            self.fns, self.m_ptr, self.d_ptr, self.site, self.jac, self.dat[5], self.quat,
+            self.twist, self.data.qvel,
+        )  # fmt: skip
 
     def compute(self, t: float) -> np.ndarray:
-        """Joint torques (nv,) for this tick, limited in rate and magnitude (a view, reused).
-
-        MuJoCo's own vector and matrix routines (``mju_*``) do the small algebra: they cost a
-        fraction of numpy's per-call overhead at these sizes (1 kHz path).
-        """
+        """Joint torques (nv,) for this tick, limited in rate and magnitude (a view, reused);
+        the kinematics of the current state must be done (``mj_step1``)."""
+        if self.compiled:
+            self.load_law()
+            k.compute_fixed(
+                t, self.fns, self.m_ptr, self.d_ptr, self.site, self.dat, self.ctl_bufs(),
+                self.law_bufs, self.sc,
+            )  # fmt: skip
+            self.store_law()
+            return self.tau
         self.update_kinematics()
-        jac, tau, tau0 = self.jac, self.tau, self._tau0
-        wrench = self.law.compute(t, self.pos, self.quat, self._v, self._w)
-        self.wrench = wrench
-        mujoco.mju_mulMatTVec(tau, jac, wrench)  # J^T F
-        mujoco.mju_addTo(tau, self._bias)
-        if self._null:
-            mujoco.mju_sub(tau0, self.q_null, self._qpos)
-            mujoco.mju_scl(tau0, tau0, self.k_null)
-            mujoco.mju_addToScl(tau0, self._qvel, -self.d_null)
-            mujoco.mj_solveM(self.model, self.data, self._jminv, jac)  # rows of J M^-1
-            lam_inv = self._lam_inv
-            mujoco.mju_mulMatMatT(lam_inv, self._jminv, jac)
-            mujoco.mju_cholFactor(lam_inv, 1e-10)
-            mujoco.mju_mulMatVec(self._y, self._jminv, tau0)
-            mujoco.mju_cholSolve(self._z, lam_inv, self._y)  # Lambda J M^-1 tau_0
-            mujoco.mju_mulMatTVec(self._tmp, jac, self._z)
-            mujoco.mju_subFrom(tau0, self._tmp)  # N^T tau_0
-            mujoco.mju_addTo(tau, tau0)
-        step = self._tmp  # (ufuncs: np.clip's Python wrapper costs more than the arithmetic)
-        mujoco.mju_sub(step, tau, self.tau_prev)
-        np.minimum(step, self.dtau_step, out=step)
-        np.maximum(step, -self.dtau_step, out=step)
-        mujoco.mju_add(tau, self.tau_prev, step)
-        np.minimum(tau, self.tau_max, out=tau)
-        np.maximum(tau, self._neg_tau_max, out=tau)
-        mujoco.mju_copy(self.tau_prev, tau)
-        return tau
+        w = self._law.compute(t, self.pos, self.quat, self._v, self._w)
+        self.wrench[:] = w
+        k.torques(self.fns, self.m_ptr, self.d_ptr, self.wrench, self.dat, self.ctl_bufs(), self.sc)
+        return self.tau

@@ -25,11 +25,12 @@ The kinematics and link inertias are Franka's published ones. Edits made here:
 - the arm's base stands at ``FR3Params.base_pos`` in the task's world frame, so the fixture
   stays where the task builds it; a wrist F/T site sits on the flange.
 
-Contact model, and why it differs from the tasks' default. With the tasks' contact (``solimp``
-impedance 0.95 from the first micrometre of penetration, ``solref`` time constant 2 ms = two
-steps) a part pressed with 6 N and slid at about 1 cm/s *hops*: it loses every contact for a
-few ticks, lands, and is thrown up again with a restitution of about one, every 2 to 8 ms. The
-wrist signal is that train of impacts, white noise at 100 Hz (std 1.6 N on the floating tool).
+Contact model, and why it differs from the tasks' default. With the tasks' former contact
+(``solimp`` impedance 0.95 from the first micrometre of penetration, ``solref`` time constant
+2 ms = two steps) a part pressed with 6 N and slid at about 1 cm/s *hops*: it loses every
+contact for a few ticks, lands, and is thrown up again with a restitution of about one, every
+2 to 8 ms. The wrist signal is that train of impacts, white noise at 100 Hz (std 1.6 N on the
+floating tool).
 The energy comes from friction: at each landing the full-stiffness contact stops the sliding
 contact points within one tick, and the friction impulse at the tip tips the part and throws it
 up. It is not the mesh pieces (a primitive box sliding on a box hops too), nor the friction cone
@@ -38,6 +39,9 @@ tolerance or the integrator (0.25 ms substeps hop too); without friction it does
 What fixes it is a *progressive* contact, as real machined surfaces are (asperities first):
 impedance rising from 0.05 at first touch to 0.99 over 0.5 mm, time constant 4 ms
 (``FR3Params.contact_solimp`` / ``contact_solref``; the task's friction coefficient is kept).
+The tasks now use a progressive contact too, with a stiffer 0.1 mm ramp from 0.1 (enough for
+the floating tool); on the arm that one still loses contact now and then (lag-1 0.2-0.5), so
+the arm keeps this softer one.
 Landings are then absorbed over several ticks and the part stays on the surface; it sinks a few
 tens of micrometres under the press, which the 0.2 mm clearance tolerates. The joints' dry
 friction gets a 5 ms time constant (``joint_friction_solref``, MuJoCo's default is 20 ms): it
@@ -66,6 +70,8 @@ HAND = f"{ARM_PREFIX}hand"
 TCP_SITE = "tcp"
 FLANGE_SITE = f"{ARM_PREFIX}flange"
 FT_FORCE, FT_TORQUE = "ft_force", "ft_torque"
+#: the link-side joint torque sensors: a torque sensor on a site at each joint's anchor
+JOINT_TORQUE_SENSORS = tuple(f"{j}_tau" for j in JOINTS)
 PART_PREFIX = "part/"
 _PART_SRC = "held_part"
 _FINGER_BODIES = ("left_finger", "right_finger")
@@ -139,7 +145,7 @@ def _arm_spec(params: FR3Params) -> mujoco.MjSpec:
 
 def build_fr3_spec(task: Task, params: FR3Params | None = None) -> mujoco.MjSpec:
     """The whole cell: the task's fixture, the FR3 on its base, the held part on the hand,
-    torque motors, and the wrist F/T sensors."""
+    torque motors, the wrist F/T sensors and the joint torque sensors."""
     params = params or FR3Params()
     contact = dataclasses.replace(
         task.scene.contact or ContactParams(),
@@ -180,6 +186,17 @@ def build_fr3_spec(task: Task, params: FR3Params | None = None) -> mujoco.MjSpec
         objtype=mujoco.mjtObj.mjOBJ_SITE,
         objname=FLANGE_SITE,
     )
+    for name, sensor in zip(JOINTS, JOINT_TORQUE_SENSORS, strict=True):
+        # MuJoCo's torque between the link and its parent, on the joint axis, is what a
+        # link-side joint torque sensor reads: motor torque past gear friction and rotor inertia
+        joint = spec.joint(name)
+        joint.parent.add_site(name=sensor, pos=list(joint.pos), size=[0.001] * 3, group=5)
+        spec.add_sensor(
+            name=sensor,
+            type=mujoco.mjtSensor.mjSENS_TORQUE,
+            objtype=mujoco.mjtObj.mjOBJ_SITE,
+            objname=sensor,
+        )
     return spec
 
 

@@ -3,8 +3,11 @@
 One control tick is one 1 ms physics step, split as MuJoCo intends for a controller:
 ``mj_step1`` (kinematics, inertia, bias forces of the current state), the torque law of
 :mod:`teachfit.robot.fr3.control` writes ``ctrl``, ``mj_step2`` integrates, and the sensing of
-:mod:`teachfit.robot.fr3.sensing` reads the step's torques. ``reset(pose)`` solves the inverse
-kinematics (:mod:`teachfit.robot.fr3.ik`) and places the arm there at rest.
+:mod:`teachfit.robot.fr3.sensing` reads the step's torques. The tick runs compiled
+(:mod:`teachfit.robot.fr3.kernel`): with the fixed-gain law a whole ``step(n)`` is one call;
+another law (adaptive) is called from Python between the compiled halves of each tick.
+``reset(pose)`` solves the inverse kinematics (:mod:`teachfit.robot.fr3.ik`) and places the
+arm there at rest.
 
 Faults, latched until the next :meth:`FR3Robot.reset`: a joint outside its position range or
 faster than its speed limit raises :class:`~teachfit.core.errors.LimitViolation` (checked every
@@ -14,6 +17,8 @@ tick, as the FR3's firmware does); a MuJoCo warning or a NaN/inf state raises
 
 from __future__ import annotations
 
+from collections import deque
+
 import mujoco
 import numpy as np
 
@@ -22,6 +27,7 @@ from teachfit.core.control import ControllerSpec, FixedGainSpec
 from teachfit.core.errors import LimitViolation, RobotFault, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.fr3 import kernel
 from teachfit.robot.fr3 import model as fr3_model
 from teachfit.robot.fr3.control import TorqueImpedance, operational_inertia
 from teachfit.robot.fr3.ik import IKSettings, solve_ik
@@ -29,6 +35,10 @@ from teachfit.robot.fr3.params import DQ_MAX, DTAU_MAX, Q_MAX, Q_MIN, READY_Q, T
 from teachfit.robot.fr3.sensing import JointTorqueObserver, WristFT
 from teachfit.robot.interface import law_fault
 from teachfit.tasks.base import Task
+
+TORQUE_TRACES = 16  # executions whose joint torques are kept (FR3Robot.torque_traces)
+_UNTIMED = np.zeros(0, dtype=np.int64)
+_UNLOGGED = np.zeros((0, 7))
 
 
 class FR3Robot:
@@ -64,7 +74,6 @@ class FR3Robot:
             raise RobotFault("the FR3 cell must have exactly the 7 arm joints as its dofs")
         self.q_min, self.q_max = np.array(Q_MIN), np.array(Q_MAX)
         self.dq_max = np.array(DQ_MAX)
-        self._speed_weight = np.diag(1.0 / self.dq_max**2)
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
         self.ctl = TorqueImpedance(
             m,
@@ -77,17 +86,32 @@ class FR3Robot:
             self.params.null_damping,
         )
         self.observer = JointTorqueObserver(
-            m, d, self.params.wrench_cutoff, self.params.torque_noise, self.rng
+            m,
+            d,
+            fr3_model.JOINT_TORQUE_SENSORS,
+            self.params.wrench_cutoff,
+            self.params.torque_noise,
+            self.rng,
         )
         force = mujoco.mj_name2id(m, obj.mjOBJ_SENSOR, fr3_model.FT_FORCE)
         torque = mujoco.mj_name2id(m, obj.mjOBJ_SENSOR, fr3_model.FT_TORQUE)
         self.ft = WristFT(m, d, flange, force, torque, self.params.wrench_cutoff)
         self._use_ft = self.wrench_source == "wrist-ft"
+        sc = self.ctl.sc
+        sc[kernel.ALPHA], sc[kernel.INV_DT] = self.observer.alpha, 1.0 / self.control_period
+        sc[kernel.USE_FT] = float(self._use_ft)
+        self._obs_bufs = (*self.observer.bufs, self.ft.adr, self.ft.filt)
+        self._limits = (self.q_min, self.q_max, self.dq_max)
         self._warning_numbers = d.warning.number
         self._warnings = 0
         self._fault: RobotFault | None = None
         self._cmd: ImpedanceCommand | None = None
         self.q_start = np.array(READY_Q)
+        #: commanded joint torques of the last executions, one ``(t, tau)`` pair per reset: t
+        #: (T,) s since that reset, tau (T, 7) N·m, one row at the end of each ``step`` call
+        self.torque_traces: deque[tuple[np.ndarray, np.ndarray]] = deque(maxlen=TORQUE_TRACES)
+        self._trace_t: list[float] = []
+        self._trace_tau: list[np.ndarray] = []
         self.reset(task.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.05]))
 
     # ------------------------------------------------------------------ Robot protocol
@@ -123,10 +147,28 @@ class FR3Robot:
         mujoco.mj_forward(m, d)  # the wrist sensor now sees the arm holding itself
         self.ctl.update_kinematics()
         self.observer.reset()
+        self.ctl.sc[kernel.NOISE_I] = 0.0
         self.ft.reset(d.site_xpos[self._tcp])
         self.command(ImpedanceCommand.hold(pose))
         self._warnings = int(self._warning_numbers.sum())
+        self._close_trace()
+        self._t_reset = float(d.time)
         return self.state()
+
+    def _close_trace(self) -> None:
+        if self._trace_t:
+            self.torque_traces.append((np.array(self._trace_t), np.array(self._trace_tau)))
+        self._trace_t, self._trace_tau = [], []
+
+    def torque_trace(self) -> tuple[np.ndarray, np.ndarray]:
+        """The commanded joint torques since the last reset: ``(t (T,) s, tau (T, 7) N·m)``."""
+        return np.array(self._trace_t), np.array(self._trace_tau).reshape(-1, self.model.nu)
+
+    def recent_torque_traces(self, k: int) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The last ``k`` executions' ``(t, tau)`` (oldest first), the current one included."""
+        current = self.torque_trace()
+        traces = [*self.torque_traces, *([current] if current[0].size else [])]
+        return traces[-k:] if k > 0 else []
 
     def command(self, cmd: ImpedanceCommand) -> None:
         if self._fault is not None:
@@ -137,26 +179,64 @@ class FR3Robot:
     def step(self, n: int = 1) -> RobotState:
         if self._fault is not None:
             raise self._fault
-        m, d = self.model, self.data
-        ctl, obs, ft = self.ctl, self.observer, self.ft
-        use_ft = self._use_ft
-        ctrl, dq, speed_w = d.ctrl, d.qvel, self._speed_weight
-        for _ in range(n):
-            mujoco.mj_step1(m, d)
-            mujoco.mju_copy(ctrl, ctl.compute(d.time))
-            if use_ft:
-                mujoco.mj_step2(m, d)
-                ft.after_step()
-            else:
-                obs.before_step()
-                mujoco.mj_step2(m, d)
-                obs.after_step()
-            # limits every tick, cheaply: MuJoCo makes a limit row only for a joint past its
-            # range (margin 0); sum (dq_i / dq_max_i)^2 > 1 whenever some |dq_i| > dq_max_i
-            if d.nl or mujoco.mju_mulVecMatVec(dq, speed_w, dq) > 1.0:
-                self._check_limits()
+        if self.ctl.compiled:
+            self._run_compiled(n)
+        else:
+            self._run_python_law(n)
         self._check_divergence()
+        self._trace_t.append(float(self.data.time) - self._t_reset)
+        self._trace_tau.append(self.ctl.tau.copy())
         return self.state()
+
+    def _run_compiled(
+        self, n: int, times: np.ndarray = _UNTIMED, log: np.ndarray = _UNLOGGED
+    ) -> None:
+        ctl, d, sc = self.ctl, self.data, self.ctl.sc
+        ctl.load_law()
+        done = 0
+        while done < n:
+            ticks, status = kernel.run_fixed(
+                n - done, d.time, ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.site, ctl.dat,
+                ctl.ctl_bufs(), ctl.law_bufs, self._obs_bufs, self._limits, sc, times[done:],
+                log[done:],
+            )  # fmt: skip
+            done += ticks
+            if status == kernel.NOISE_EMPTY:
+                self._next_noise()
+            elif status == kernel.LIMIT:
+                ctl.store_law()
+                self._check_limits()
+        ctl.store_law()
+
+    def step_timed(self, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`step` ``n`` ticks of the fixed-gain law, returning each tick's law and torque
+        compute time (µs, measured inside the compiled loop) and torques (n, 7) (N·m)."""
+        if not self.ctl.compiled:
+            raise RobotFault("step_timed needs the fixed-gain law (the compiled tick)")
+        times = np.zeros(n, dtype=np.int64)
+        log = np.zeros((n, self.model.nu))
+        self._run_compiled(n, times, log)
+        self._check_divergence()
+        return times / 1e3, log
+
+    def _run_python_law(self, n: int) -> None:
+        ctl, d, sc = self.ctl, self.data, self.ctl.sc
+        law, fns, m_ptr, d_ptr, site = ctl.law, ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.site
+        dat = ctl.dat
+        bufs, obs, lim = ctl.ctl_bufs(), self._obs_bufs, self._limits
+        block = len(obs[6])
+        pos, quat, v, w = ctl.pos, ctl.quat, ctl.twist[:3], ctl.twist[3:]
+        for _ in range(n):
+            if sc[kernel.NOISE_I] >= block:
+                self._next_noise()
+            kernel.tick_pre(fns, m_ptr, d_ptr, site, dat, bufs, ctl.law_bufs)
+            ctl.wrench[:] = law.compute(d.time, pos, quat, v, w)
+            if kernel.tick_post(fns, m_ptr, d_ptr, ctl.wrench, dat, bufs, obs, lim, sc):
+                self._check_limits()
+
+    def _next_noise(self) -> None:
+        self.observer.draw_noise()
+        self.ctl.sc[kernel.NOISE_I] = 0.0
 
     def state(self) -> RobotState:
         m, d = self.model, self.data
@@ -175,6 +255,7 @@ class FR3Robot:
     def close(self) -> None:
         """Nothing to release but the simulator's memory (kept until garbage collection)."""
         self._cmd = None
+        self._close_trace()
 
     def __enter__(self) -> FR3Robot:
         return self

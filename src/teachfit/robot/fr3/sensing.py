@@ -1,7 +1,9 @@
 """How the FR3 measures the external wrench: from its joint torques, or with a wrist F/T sensor.
 
 **Joint torques** (Franka's ``tau_ext_hat_filtered`` / ``O_F_ext_hat_K``). The link-side torque
-sensors read what the motors transmit past the gear friction, ``tau_J = tau_motor - tau_f``. The
+sensors read what the motors transmit past the gear friction and the rotors' inertia; in MuJoCo
+that is the torque sensor on a site at each joint's anchor, projected on the joint axis
+(``tau_J = tau_motor - tau_f - I_rotor ddq``, exactly). The
 model of the arm predicts the torque that motion needs, ``tau_model = M(q) ddq + c(q, dq)``, so
 the external joint torque is ``tau_ext = tau_model - tau_J`` (what the environment adds). Its
 discrete generalized-momentum observer (De Luca and Mattone 2005, ``p = M dq``,
@@ -11,10 +13,12 @@ momentum step written out, the first-order low-pass
     r_k = r_{k-1} + a (M (dq_k - dq_{k-1}) / dt + c_{k-1} - tau_J,{k-1} - r_{k-1}),
     a = 1 - exp(-2 pi f_c dt)
 
-(N·m), which is what is implemented (``f_c = wrench_cutoff``; ``M`` includes the rotor inertia,
-whose torque the sensors do not see either way). The TCP wrench is the least-squares solution
-of ``J^T F = r``: ``F = pinv(J^T) r`` (N, N·m, world frame at the TCP), the wrench the
-environment exerts on the tool. The sensors carry white noise of ``torque_noise`` N·m.
+(N·m), which is what is implemented (``f_c = wrench_cutoff``; ``M`` is the links' inertia: the
+full joint-space inertia less the rotors' armature, whose torque the sensors do not see; the
+arithmetic runs compiled every tick, :func:`teachfit.robot.fr3.kernel.observe`). The TCP
+wrench is the least-squares solution of ``J^T F = r``: ``F = pinv(J^T) r`` (N, N·m, world
+frame at the TCP), the wrench the environment exerts on the tool. The sensors carry white
+noise of ``torque_noise`` N·m.
 
 **Wrist F/T sensor**: MuJoCo's force and torque sensors on a site at the flange (the interface
 between link 7 and the hand), filtered by the same first-order low-pass, tared at reset (the
@@ -36,69 +40,42 @@ def lowpass_alpha(cutoff: float, dt: float) -> float:
 
 
 class JointTorqueObserver:
-    """External joint torques from the joint torque sensors and the arm's model (see module)."""
+    """External joint torques from the joint torque sensors and the arm's model (see module).
+
+    ``sensors``: the names of the joint torque sensors, one per dof in dof order.
+    """
 
     def __init__(
         self,
         model: mujoco.MjModel,
         data: mujoco.MjData,
+        sensors: tuple[str, ...],
         cutoff: float,
         noise: float,
         rng: np.random.Generator,
     ) -> None:
         nv = model.nv
-        self.model, self.data = model, data
-        self.dt = float(model.opt.timestep)
-        self.alpha = lowpass_alpha(cutoff, self.dt)
-        self.noise, self.rng = float(noise), rng
+        if nv != model.njnt or len(sensors) != nv:
+            raise ValueError("the observer expects one dof per joint and a sensor per joint")
+        self.alpha = lowpass_alpha(cutoff, float(model.opt.timestep))
+        self.noise_std, self.rng = float(noise), rng
         self.tau_ext = np.zeros(nv)
-        self._dq_prev = np.zeros(nv)
-        self._ddq = np.zeros(nv)
-        self._raw = np.zeros(nv)
-        self._nv = nv
-        self._inv_dt = 1.0 / self.dt
-        self._qvel, self._bias = data.qvel, data.qfrc_bias
-        self._qfrc_actuator = data.qfrc_actuator
-        self._friction = bool(np.all(model.dof_frictionloss > 0))
-        if not self._friction and np.any(model.dof_frictionloss > 0):
-            raise ValueError("the observer expects friction on every joint or on none")
-        if nv != model.njnt:
-            raise ValueError("the observer expects one dof per joint")
-        self._draw_noise()
+        self.noise = np.zeros((_NOISE_BLOCK, nv))
+        ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, s) for s in sensors]
+        adr = np.array([model.sensor_adr[i] for i in ids], dtype=np.int64)
+        axes = np.array([model.jnt_axis[model.dof_jntid[i]] for i in range(nv)])
+        # dq_prev, ddq, M ddq, sensor addresses, joint axes, armature, noise, tau_ext (kernel order)
+        self.bufs = (np.zeros(nv), np.zeros(nv), np.zeros(nv), adr, axes)
+        self.bufs += (model.dof_armature.copy(), self.noise, self.tau_ext)
+        self.draw_noise()
 
     def reset(self) -> None:
         self.tau_ext[:] = 0.0
-        self._draw_noise()
+        self.draw_noise()
 
-    def _draw_noise(self) -> None:
-        self._noise = self.rng.normal(0.0, self.noise, (_NOISE_BLOCK, self._nv))
-        self._noise_i = 0
-
-    def before_step(self) -> None:
-        """Call after ``mj_step1`` and setting ``ctrl``: remembers ``dq_{k-1}``."""
-        mujoco.mju_copy(self._dq_prev, self._qvel)
-
-    def after_step(self) -> None:
-        """Call after ``mj_step2``: ``qM`` and ``qfrc_bias`` still hold tick ``k-1``'s values.
-
-        ``raw = M (dq_k - dq_{k-1}) / dt + c - tau_J`` with the sensed
-        ``tau_J = tau_motor + tau_friction + noise`` (the friction rows' forces oppose motion).
-        """
-        d, raw = self.data, self._raw
-        mujoco.mju_sub(self._ddq, self._qvel, self._dq_prev)
-        mujoco.mj_mulM(self.model, d, raw, self._ddq)
-        mujoco.mju_scl(raw, raw, self._inv_dt)
-        mujoco.mju_addTo(raw, self._bias)
-        mujoco.mju_subFrom(raw, self._qfrc_actuator)
-        if self._friction and d.nf == self._nv:  # a friction row per dof, after the equality rows
-            ne = d.ne
-            mujoco.mju_subFrom(raw, d.efc_force[ne : ne + self._nv])
-        if self._noise_i == _NOISE_BLOCK:
-            self._draw_noise()
-        mujoco.mju_subFrom(raw, self._noise[self._noise_i])
-        self._noise_i += 1
-        mujoco.mju_subFrom(raw, self.tau_ext)
-        mujoco.mju_addToScl(self.tau_ext, raw, self.alpha)
+    def draw_noise(self) -> None:
+        """The next block of sensor noise (the kernel walks through it, ``NOISE_I``)."""
+        self.noise[:] = self.rng.normal(0.0, self.noise_std, self.noise.shape)
 
     def wrench(self, jac: np.ndarray) -> np.ndarray:
         """``F = pinv(J^T) tau_ext`` (6,) for the TCP Jacobian ``jac`` (6, nv)."""
@@ -120,7 +97,7 @@ class WristFT:
         f_adr = int(model.sensor_adr[force_sensor])
         if int(model.sensor_adr[torque_sensor]) != f_adr + 3:
             raise ValueError("force and torque sensors must be adjacent")
-        self.data, self.site = data, site
+        self.data, self.site, self.adr = data, site, f_adr
         self.raw = data.sensordata[f_adr : f_adr + 6]
         self.filt = np.zeros(6)
         self.alpha = lowpass_alpha(cutoff, float(model.opt.timestep))
@@ -131,9 +108,6 @@ class WristFT:
         self.filt[:] = self.raw
         self.tare[:] = 0.0
         self.tare[:] = self.wrench(tcp)
-
-    def after_step(self) -> None:
-        self.filt += self.alpha * (self.raw - self.filt)
 
     def wrench(self, tcp: np.ndarray) -> np.ndarray:
         """Tared environment wrench on the tool at the TCP ``tcp`` (3,) (world frame)."""

@@ -1,0 +1,304 @@
+"""The FR3's 1 kHz tick compiled with numba: no Python between ``mj_step1`` and ``mj_step2``.
+
+Why: the tick is ~40 small operations (Jacobian, Cartesian law, ``J^T F``, null-space
+projector, rate and magnitude limits, the momentum observer) on 6- and 7-vectors. From Python
+each costs a binding call (0.5-4 µs on the project's machine), together more than the physics
+step itself. Here they run as one compiled loop that calls MuJoCo's own C routines
+(``mj_step1``/``mj_step2``, ``mj_jacSite``, ``mj_solveM``, ``mj_mulM``, ``mju_*`` quaternion and
+Cholesky routines) through ``ctypes`` on the very ``libmujoco`` the bindings loaded, with the
+model and data pointers of the Python objects; the arithmetic between them is plain loops.
+numba caches the machine code on disk (``cache=True``), so only the first process compiles.
+
+The law and the torque map are those of :mod:`teachfit.robot.fr3.control` (the module
+docstring there has the equations); the fixed-gain Cartesian law is the one of
+:class:`teachfit.control.CartesianImpedance` (set-point extrapolation and expiry as in its
+``SetpointError``), compiled here so that a whole :meth:`FR3Robot.step` of ``n`` ticks is one
+call; a test checks both give the same torques. Other laws (the adaptive one) run in Python
+between :func:`tick_pre` and :func:`tick_post`.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from functools import cache
+from pathlib import Path
+
+import mujoco
+import numba
+import numpy as np
+
+from teachfit.core.errors import TeachfitError
+
+_P = ctypes.c_size_t  # pointers travel as integers (same register as a pointer on x86-64 / arm64)
+
+
+@cache
+def _libmujoco() -> ctypes.CDLL:
+    """The shared library the ``mujoco`` bindings loaded (dlopen returns that instance)."""
+    folder = Path(mujoco.__file__).parent
+    libs = sorted(folder.glob("libmujoco*.so*")) + sorted(folder.glob("libmujoco*.dylib"))
+    if not libs:
+        raise TeachfitError(f"no libmujoco shared library next to the bindings in {folder}")
+    return ctypes.CDLL(str(libs[0]))
+
+
+def _fn(name: str, *argtypes: object, restype: object = None) -> object:
+    fn = getattr(_libmujoco(), name)
+    fn.argtypes, fn.restype = list(argtypes), restype
+    return fn
+
+
+@cache
+def routines() -> tuple:
+    """The MuJoCo C routines the kernel calls, in the order the kernel's ``fns`` takes them."""
+    i, d = ctypes.c_int, ctypes.c_double
+    return (
+        _fn("mj_step1", _P, _P),
+        _fn("mj_step2", _P, _P),
+        _fn("mj_jacSite", _P, _P, _P, _P, i),
+        _fn("mj_solveM", _P, _P, _P, _P, i),
+        _fn("mj_mulM", _P, _P, _P, _P),
+        _fn("mju_mat2Quat", _P, _P),
+        _fn("mju_subQuat", _P, _P, _P),
+        _fn("mju_rotVecQuat", _P, _P, _P),
+        _fn("mju_quatIntegrate", _P, _P, d),
+        _fn("mju_cholFactor", _P, i, d, restype=i),
+        _fn("mju_cholSolve", _P, _P, _P, i),
+        _clock(),
+        _fn("mj_step", _P, _P),
+    )
+
+
+def _clock() -> object:
+    """libc's ``clock_gettime`` (timing the law per tick inside the compiled loop)."""
+    fn = ctypes.CDLL(None).clock_gettime
+    fn.argtypes, fn.restype = [ctypes.c_int, _P], ctypes.c_int
+    return fn
+
+
+_MONOTONIC = 1  # CLOCK_MONOTONIC on Linux
+
+
+# status codes returned with the number of ticks done
+OK, LIMIT, NOISE_EMPTY = 0, 1, 2
+
+# scalar slots of the ``sc`` array: set-point clock, gains, limits, filter constants
+T0, EXPIRY, SPINNING, LAPSED, MAX_F, MAX_T, K_NULL, D_NULL, DTAU, ALPHA, INV_DT, USE_FT = range(12)
+NOISE_I, DT = 12, 13
+N_SCALARS = 14
+
+
+@numba.njit(cache=True, inline="always")
+def _addr(a: np.ndarray) -> int:
+    return a.ctypes.data
+
+
+@numba.njit(cache=True)
+def kinematics(fns, m, d, site, jac, xmat, quat, twist, qvel):  # noqa: ANN001, ANN201
+    """TCP Jacobian (world, rows ``[v; w]``), orientation and twist from current kinematics."""
+    nv = jac.shape[1]
+    fns[2](m, d, _addr(jac), _addr(jac) + 24 * nv, site)
+    fns[5](_addr(quat), _addr(xmat))
+    for i in range(6):
+        s = 0.0
+        for j in range(nv):
+            s += jac[i, j] * qvel[j]
+        twist[i] = s
+
+
+@numba.njit(cache=True)
+def fixed_law(fns, t, pos, quat, twist, kmat, dmat, ff, xd, qd, vd, sc, err, derr, qtmp, rtmp, w):  # noqa: ANN001, ANN201, E501
+    """``w = K e + D de + f_ff``, clipped: :class:`teachfit.control.CartesianImpedance`."""
+    dt = t - sc[T0]
+    if t > sc[EXPIRY]:  # hold the set-point where the expired command left it
+        dt = sc[EXPIRY] - sc[T0]
+        for i in range(3):
+            xd[i] += vd[i] * dt
+        if sc[SPINNING] != 0.0:
+            fns[8](_addr(qd), _addr(vd) + 24, dt)
+        vd[:] = 0.0
+        sc[SPINNING], sc[T0], sc[EXPIRY], sc[LAPSED] = 0.0, t, np.inf, 1.0
+        dt = 0.0
+    for i in range(3):
+        err[i] = xd[i] - pos[i]
+        err[i] += vd[i] * dt
+    q_target = qd
+    if sc[SPINNING] != 0.0:
+        qtmp[:] = qd
+        fns[8](_addr(qtmp), _addr(vd) + 24, dt)
+        q_target = qtmp
+    fns[6](_addr(rtmp), _addr(q_target), _addr(quat))
+    fns[7](_addr(err) + 24, _addr(rtmp), _addr(quat))
+    for i in range(6):
+        derr[i] = vd[i] - twist[i]
+    for i in range(6):
+        s = 0.0
+        for j in range(6):
+            s += kmat[i, j] * err[j]
+        r = 0.0
+        for j in range(6):
+            r += dmat[i, j] * derr[j]
+        w[i] = s + r + ff[i]
+    for lo, cap in ((0, sc[MAX_F]), (3, sc[MAX_T])):
+        norm = np.sqrt(w[lo] * w[lo] + w[lo + 1] * w[lo + 1] + w[lo + 2] * w[lo + 2])
+        if norm > cap:
+            for i in range(lo, lo + 3):
+                w[i] *= cap / norm
+
+
+@numba.njit(cache=True)
+def torques(fns, m, d, w, dat, ctl, sc):  # noqa: ANN001, ANN201
+    """``tau = J^T w + c + N^T tau_0``, rate- then magnitude-limited (see ``control``).
+
+    ``dat``: the MjData views (qpos, qvel, qfrc_bias, ctrl, sensordata, TCP xmat, TCP xpos);
+    ``ctl``: (J, J M^-1, Lambda^-1, q_null, tau_prev, tau_max, tau, tau_0, y, z) buffers.
+    """
+    qpos, qvel, bias = dat[0], dat[1], dat[2]
+    jac, jminv, lam, q_null, tau_prev, tau_max, tau, tau0, y, z = ctl
+    nv = jac.shape[1]
+    for j in range(nv):
+        s = 0.0
+        for i in range(6):
+            s += jac[i, j] * w[i]
+        tau[j] = s + bias[j]
+    if sc[K_NULL] > 0.0 or sc[D_NULL] > 0.0:
+        for j in range(nv):
+            tau0[j] = (q_null[j] - qpos[j]) * sc[K_NULL] + qvel[j] * -sc[D_NULL]
+        fns[3](m, d, _addr(jminv), _addr(jac), 6)  # rows of J M^-1
+        for i in range(6):
+            for k in range(6):
+                s = 0.0
+                for j in range(nv):
+                    s += jminv[i, j] * jac[k, j]
+                lam[i, k] = s
+        fns[9](_addr(lam), 6, 1e-10)
+        for i in range(6):
+            s = 0.0
+            for j in range(nv):
+                s += jminv[i, j] * tau0[j]
+            y[i] = s
+        fns[10](_addr(z), _addr(lam), _addr(y), 6)  # Lambda J M^-1 tau_0
+        for j in range(nv):
+            s = 0.0
+            for i in range(6):
+                s += jac[i, j] * z[i]
+            tau[j] += tau0[j] - s
+    step = sc[DTAU]
+    for j in range(nv):
+        delta = min(max(tau[j] - tau_prev[j], -step), step)
+        tau[j] = min(max(tau_prev[j] + delta, -tau_max[j]), tau_max[j])
+        tau_prev[j] = tau[j]
+
+
+@numba.njit(cache=True)
+def observe(fns, m, d, dat, obs, sc):  # noqa: ANN001, ANN201
+    """After ``mj_step2``: the momentum observer on the joint torque sensors, or the wrist
+    F/T filter (see ``sensing``). ``qM``, ``qfrc_bias`` still hold the step's start values.
+
+    ``obs``: (dq_prev, ddq, M ddq, sensor addresses, joint axes, armature, noise block,
+    tau_ext, wrist sensor address, wrist filter state).
+    """
+    qvel, bias, sdata = dat[1], dat[2], dat[4]
+    dq_prev, ddq, mddq, tj_adr, axes, armature, noise, tau_ext, ft_adr, ft_filt = obs
+    nv = qvel.shape[0]
+    if sc[USE_FT] != 0.0:
+        for i in range(6):
+            ft_filt[i] += sc[ALPHA] * (sdata[ft_adr + i] - ft_filt[i])
+        return
+    for j in range(nv):
+        ddq[j] = qvel[j] - dq_prev[j]
+    fns[4](m, d, _addr(mddq), _addr(ddq))
+    k = int(sc[NOISE_I])
+    for j in range(nv):
+        a = tj_adr[j]
+        tau_j = sdata[a] * axes[j, 0] + sdata[a + 1] * axes[j, 1] + sdata[a + 2] * axes[j, 2]
+        raw = (mddq[j] - armature[j] * ddq[j]) * sc[INV_DT] + bias[j] - tau_j - noise[k, j]
+        tau_ext[j] += sc[ALPHA] * (raw - tau_ext[j])
+    sc[NOISE_I] = k + 1
+
+
+@numba.njit(cache=True, inline="always")
+def _outside(qpos, qvel, lim) -> bool:  # noqa: ANN001
+    q_min, q_max, dq_max = lim
+    for j in range(qpos.shape[0]):
+        if qpos[j] < q_min[j] or qpos[j] > q_max[j] or abs(qvel[j]) > dq_max[j]:
+            return True
+    return False
+
+
+@numba.njit(cache=True, inline="always")
+def _actuate_and_step(fns, m, d, dat, ctl, obs, lim, sc) -> bool:  # noqa: ANN001
+    """``ctrl = tau``, ``mj_step2``, sensing; True if a joint left its limits."""
+    dat[3][:] = ctl[6]
+    obs[0][:] = dat[1]
+    fns[1](m, d)
+    observe(fns, m, d, dat, obs, sc)
+    return _outside(dat[0], dat[1], lim)
+
+
+@numba.njit(cache=True)
+def tick_pre(fns, m, d, site, dat, ctl, law):  # noqa: ANN001, ANN201
+    """``mj_step1`` and the TCP kinematics: the state a Python law then reads."""
+    fns[0](m, d)
+    kinematics(fns, m, d, site, ctl[0], dat[5], law[11], law[12], dat[1])
+
+
+@numba.njit(cache=True)
+def tick_post(fns, m, d, w, dat, ctl, obs, lim, sc):  # noqa: ANN001, ANN201
+    """Torques for wrench ``w``, ``mj_step2``, sensing; True if a joint left its limits."""
+    torques(fns, m, d, w, dat, ctl, sc)
+    return _actuate_and_step(fns, m, d, dat, ctl, obs, lim, sc)
+
+
+@numba.njit(cache=True)
+def compute_fixed(t, fns, m, d, site, dat, ctl, law, sc):  # noqa: ANN001, ANN201
+    """Kinematics, the fixed-gain law and the torques of one tick, without stepping.
+
+    ``law``: (K, D, f_ff, x_d, q_d, v_d, e, de, q scratch, r scratch, wrench, quat, twist).
+    """
+    kmat, dmat, ff, xd, qd, vd, err, derr, qtmp, rtmp, w, quat, twist = law
+    kinematics(fns, m, d, site, ctl[0], dat[5], quat, twist, dat[1])
+    fixed_law(fns, t, dat[6], quat, twist, kmat, dmat, ff, xd, qd, vd, sc, err, derr, qtmp, rtmp, w)
+    torques(fns, m, d, w, dat, ctl, sc)
+
+
+@numba.njit(cache=True, inline="always")
+def _now(fns, ts) -> int:  # noqa: ANN001
+    fns[11](_MONOTONIC, _addr(ts))
+    return ts[0] * 1_000_000_000 + ts[1]
+
+
+@numba.njit(cache=True)
+def replay(fns, m, d, ctrl, log):  # noqa: ANN001, ANN201
+    """Plain ``mj_step`` with the torques ``log[k]`` (n, nu) written into ``ctrl`` before step
+    ``k``, in a compiled loop: the physics alone of a controlled run, for comparison."""
+    for k in range(log.shape[0]):
+        ctrl[:] = log[k]
+        fns[12](m, d)
+
+
+@numba.njit(cache=True)
+def run_fixed(n, t, fns, m, d, site, dat, ctl, law, obs, lim, sc, times, log):  # noqa: ANN001, ANN201, E501
+    """``n`` whole ticks with the fixed-gain law from time ``t``: ``(ticks done, status)``.
+
+    Stops early after a tick that left the joint limits (``LIMIT``) or before one that has no
+    sensor noise left (``NOISE_EMPTY``: the caller draws more and calls again). When ``times``
+    (int64) is not empty, ``times[k]`` gets tick ``k``'s law and torque compute time (ns), and
+    ``log[k]`` (n, nu) its torques.
+    """
+    noise = obs[6]
+    timed = times.shape[0] >= n
+    ts = np.zeros(2, np.int64)
+    for k in range(n):
+        if sc[USE_FT] == 0.0 and sc[NOISE_I] >= noise.shape[0]:
+            return k, NOISE_EMPTY
+        fns[0](m, d)
+        start = _now(fns, ts) if timed else 0
+        compute_fixed(t, fns, m, d, site, dat, ctl, law, sc)
+        if timed:
+            times[k] = _now(fns, ts) - start
+            log[k] = ctl[6]
+        t += sc[DT]  # as mj_step2 advances d->time
+        if _actuate_and_step(fns, m, d, dat, ctl, obs, lim, sc):
+            return k + 1, LIMIT
+    return n, OK
