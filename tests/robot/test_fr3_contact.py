@@ -68,4 +68,3 @@ def test_the_tasks_stiff_contact_makes_the_part_hop():
     fz, contacts, _ = slide(FR3Robot(task, params=stiff), task, (0.035, -0.012), (0, 0.012, 0))
     assert contacts.min() == 0
     assert fz.std() > 1.0
-
