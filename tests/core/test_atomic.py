@@ -94,6 +94,38 @@ def test_killed_process_leaves_the_old_file_and_no_temporary(tmp_path: Path) -> 
     assert leftovers(tmp_path) == []
 
 
+def test_what_a_kill_9_leaves_is_swept_by_the_next_write(tmp_path: Path) -> None:
+    """SIGKILL cannot be caught: its temporary stays until a later write of the same file
+    finds its writer gone (and the file old): then it is removed."""
+    dest = atomic_write_text(tmp_path / "model.json", "old")
+    code = (
+        "import sys, time\n"
+        "from teachfit.core.atomic import atomic_path\n"
+        "with atomic_path(sys.argv[1]) as tmp, open(tmp, 'xb') as fh:\n"
+        "    fh.write(b'half'); fh.flush(); print('writing', flush=True); time.sleep(30)\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(SRC.parent)}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, str(dest)], stdout=subprocess.PIPE, env=env, text=True
+    )
+    try:
+        assert proc.stdout is not None and proc.stdout.readline() == "writing\n"
+    finally:
+        proc.kill()
+        proc.wait()
+    (left,) = leftovers(tmp_path)
+    assert dest.read_text() == "old"
+    atomic_write_text(dest, "new")  # young: a writer elsewhere may still own it
+    assert leftovers(tmp_path) == [left]
+    old = os.stat(tmp_path / left).st_mtime - 2 * atomic.STALE_AFTER
+    os.utime(tmp_path / left, (old, old))
+    live = atomic.temporary_name(dest)  # this process's own temporary: its writer is alive
+    live.write_bytes(b"x")
+    os.utime(live, (old, old))
+    atomic_write_text(dest, "newer")
+    assert leftovers(tmp_path) == [live.name] and dest.read_text() == "newer"
+
+
 #: calls that write a file; allowed only on a path from atomic_path (named ``tmp``) or in
 #: core/atomic.py itself
 WRITERS = {"savefig", "write_text", "write_bytes", "get_writer", "imwrite", "save", "savez",

@@ -24,15 +24,54 @@ from pathlib import Path
 
 from teachfit.core.errors import OutputError
 
-#: marker in every temporary file's name (``.NAME.<hex>.tmp.SUFFIX``)
+#: marker in every temporary file's name (``.NAME.<pid>-<hex>.tmp.SUFFIX``)
 TMP_MARK = ".tmp"
+#: a left-over temporary is swept only when its writer is gone and it is this old (s): a
+#: writer on another machine sharing the folder has no PID here, so age alone guards it
+STALE_AFTER = 600.0
 
 
 def temporary_name(dest: Path) -> Path:
     """A hidden temporary path next to ``dest`` that keeps its suffix (``.png``, ``.mp4``...),
     so that writers which pick the format from the file name (matplotlib, ffmpeg, numpy) still
-    do."""
-    return dest.with_name(f".{dest.name}.{uuid.uuid4().hex[:12]}{TMP_MARK}{dest.suffix}")
+    do. It carries the writer's PID, so a later write can sweep what a killed one left."""
+    token = f"{os.getpid()}-{uuid.uuid4().hex[:12]}"
+    return dest.with_name(f".{dest.name}.{token}{TMP_MARK}{dest.suffix}")
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def sweep_stale(dest: Path, now: float | None = None) -> list[Path]:
+    """Remove the temporaries of ``dest`` that a killed writer (``kill -9``, power loss) left:
+    its PID is gone and the file is older than :data:`STALE_AFTER`. Returns what was removed."""
+    import time
+
+    now = time.time() if now is None else now
+    removed = []
+    for tmp in dest.parent.glob(f".{glob_escape(dest.name)}.*{TMP_MARK}{dest.suffix}"):
+        token = tmp.name[len(dest.name) + 2 :].split(TMP_MARK)[0]
+        pid_text = token.split("-", 1)[0]
+        try:
+            stale = now - tmp.stat().st_mtime > STALE_AFTER
+        except OSError:
+            continue
+        if stale and pid_text.isdigit() and not _pid_alive(int(pid_text)):
+            tmp.unlink(missing_ok=True)
+            removed.append(tmp)
+    return removed
+
+
+def glob_escape(name: str) -> str:
+    """``name`` with glob's special characters taken literally."""
+    return "".join(f"[{c}]" if c in "*?[" else c for c in name)
 
 
 def ensure_parent(dest: str | Path, what: str = "file") -> Path:
@@ -90,6 +129,7 @@ def atomic_path(dest: str | Path, what: str = "file", mode: int = 0o644) -> Iter
         _fsync(tmp)
         os.replace(tmp, dest)
         _fsync(dest.parent, directory=True)
+        sweep_stale(dest)
     except OSError as exc:
         tmp.unlink(missing_ok=True)
         if isinstance(exc, OutputError):
