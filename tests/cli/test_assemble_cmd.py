@@ -8,6 +8,7 @@ from typer.testing import CliRunner
 from teachfit.cli import app
 from teachfit.cli.assemble_cmd import parse_quantity
 from teachfit.core.errors import TeachfitError
+from teachfit.execution.recording import read_run_log
 from teachfit.tasks import get_task
 
 runner = CliRunner()
@@ -36,12 +37,15 @@ def test_assemble_reports_success_and_plots_the_phases(tmp_path, peg_model):
     png = tmp_path / "phases.png"
     res = invoke(
         "assemble", "--task", "peg2d", "--search", model, "--hole-error", "0mm",
-        "--trials", 1, "--plot", png,
+        "--trials", 1, "--plot", png, "--log", tmp_path / "run.h5",
     )  # fmt: skip
     assert res.exit_code == 0, res.output
     assert "success 1/1 = 100 %" in res.output and "[21, 100] %" in res.output
     assert "lateral" in res.output
     read_png(png)
+    run = read_run_log(tmp_path / "run.h5")  # the run log: one episode, its outcome
+    assert run.info.kind == "assemble" and len(run.episodes) == 1
+    assert run.episodes[0].result.success
 
 
 def test_assemble_bad_input_is_one_line_and_exit_2(peg_model):

@@ -11,6 +11,7 @@ from rich.table import Table
 
 from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
+from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.core.errors import TeachfitError
 
 _UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "deg": 0.017453292519943295, "rad": 1.0}
@@ -62,6 +63,8 @@ def assemble(
         Path | None, typer.Option("--render", help="video (mp4) of that trial")
     ] = None,
     robot: RobotOpt = "floating",
+    log: LogOpt = None,
+    rrd: RrdOpt = None,
 ) -> None:
     """Assemble over trials: taught hole -> approach -> skill -> learned search recovery."""
     from teachfit.metrics.stats import summarize
@@ -81,6 +84,9 @@ def assemble(
         from teachfit.tasks.registry import load_task
 
         load_task(task)  # a bad task (file) before any output
+    if task in ("l-groove", "tenon") and (log is not None or rrd is not None):
+        raise TeachfitError("--log/--rrd record the peg tasks' trials; plans in contact: not yet")
+    check_recording_targets(log, rrd)
     if task in ("l-groove", "tenon"):
         ang = parse_quantity(angle_error, "deg", "--angle-error")
         _assemble_plan(task, demo, err, ang, trials, seed, plot, video)
@@ -107,7 +113,7 @@ def assemble(
     jobs = assembly_jobs(
         task, [method], [err], trials, model, seed=seed, yaw_error=yaw, skill=skill,
         controller=controller, learned=tuple(sorted(learned.items())), robot=robot,
-        keep_log=plot is not None or video is not None,
+        keep_log=any(v is not None for v in (plot, video, log, rrd)),
     )  # fmt: skip
     what = "skill with learned-search recovery" if model else f"{skill} alone (no --search)"
     console.print(f"{task}: {what}; taught hole off by {err * 1e3:g} mm; {trials} trial(s)")
@@ -130,6 +136,14 @@ def assemble(
     s = summarize([t.success for t in out], [t.time for t in out])
     searched = sum("search" in t.nodes for t in out)
     console.print(f"success {s}; the search ran in {searched}/{len(out)} trial(s)")
+    if log is not None or rrd is not None:
+        info = ("assemble", task, robot, seed, f"{method} {skill} {controller}")
+        opts = {
+            "task": task, "search": search, "skill": skill, "hole_error": hole_error,
+            "yaw_error": yaw_error, "trials": trials, "params": params,
+            "controller": controller, "seed": seed, "robot": robot,
+        }  # fmt: skip
+        write_recordings(log, rrd, [t.result for t in out], info, opts)
     if plot is None and video is None:
         return
     pick = next((t for t in out if "search" in t.nodes and t.success), out[0])
