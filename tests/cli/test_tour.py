@@ -34,6 +34,7 @@ ELSEWHERE = (
     ("capture",),
     ("plan",),
     ("search", "figures"),
+    ("assemble", "--task", "l-groove"),  # its demonstration comes from the capture above
 )
 
 

@@ -64,7 +64,7 @@ def test_search_recovers_a_hole_beyond_the_lateral_reach(peg):
     ctx = peg_in_hole.hole_context(task, np.random.default_rng(0))
     est = task.hole2world.compose(Pose.from_xyz_rz(0.0031, 0.0039, 0.0, 0.0))
     start = est.compose(Pose.from_xyz_rz(0.002, 0.001, 0.025, 0.0))
-    learned = {"search_scale": 0.3, "search_points": 30.0}
+    learned = {"search_scale": 0.5, "search_points": 30.0}  # covers the 5 mm error
     out = {}
     for name, sk in (
         ("plain", peg_in_hole.build("adaptive")),

@@ -9,6 +9,7 @@ with ``mj_applyFT``.
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
@@ -228,6 +229,8 @@ class FloatingToolRobot:
         for _ in range(n):
             mujoco.mju_rotVecQuat(angvel, angvel_local, quat)
             w = ctrl.compute(d.time, pos, quat, linvel, angvel)
+            if not math.isfinite(float(w.sum())):
+                self._law_output_fault(pos, quat, linvel, angvel)
             qfrc[:] = 0.0
             mujoco.mj_applyFT(m, d, w[:3], w[3:], point, body, qfrc)
             mujoco.mj_step(m, d)
@@ -283,14 +286,19 @@ class FloatingToolRobot:
     def _warning_count(self) -> int:
         return int(self._warning_numbers.sum())  # a view: no Python loop per tick
 
+    def _law_output_fault(self, *inputs: np.ndarray) -> None:
+        """A non-finite wrench: the law's fault (a :class:`ControlError`) when what it was
+        given was finite, else the state had diverged before it (SimulationDiverged)."""
+        if all(np.all(np.isfinite(x)) for x in inputs):
+            self._fault = law_fault(self._law, float(self.data.time))
+        if self._fault is None:
+            self._fault = SimulationDiverged(
+                f"NaN/inf in the state at t={self.data.time:.3f} s: simulation invalid"
+            )
+        raise self._fault
+
     def _check_divergence(self) -> None:
         count = self._warning_count()
-        finite = np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))
-        if count > self._warnings or not finite:
-            self._fault = law_fault(self._law, float(self.data.time))
-            if self._fault is not None:
-                self._warnings = count
-                raise self._fault
         if count > self._warnings:
             kinds = [
                 mujoco.mjtWarning(i).name for i, w in enumerate(self.data.warning) if w.number > 0
