@@ -84,12 +84,12 @@ def assemble(
         from teachfit.tasks.registry import load_task
 
         load_task(task)  # a bad task (file) before any output
-    if task in ("l-groove", "tenon") and (log is not None or rrd is not None):
-        raise TeachfitError("--log/--rrd record the peg tasks' trials; plans in contact: not yet")
     check_recording_targets(log, rrd)
     if task in ("l-groove", "tenon"):
         ang = parse_quantity(angle_error, "deg", "--angle-error")
-        _assemble_plan(task, demo, err, ang, trials, seed, plot, video)
+        rec = (log, rrd, {"task": task, "demo": demo, "hole_error": hole_error,
+               "angle_error": angle_error, "trials": trials, "seed": seed})  # fmt: skip
+        _assemble_plan(task, demo, err, ang, trials, seed, plot, video, rec)
         return
     from teachfit.execution.assembly import assembly_jobs, run_assembly
     from teachfit.models.search_model import SearchModel
@@ -222,8 +222,10 @@ def _assemble_plan(
     seed: int,
     plot: Path | None,
     video: Path | None,
+    rec: tuple[Path | None, Path | None, dict[str, object]] = (None, None, {}),
 ) -> None:
-    """demonstration -> plan -> path executed in contact -> seating skill, over trials."""
+    """demonstration -> plan -> path executed in contact -> seating skill, over trials;
+    ``rec``: the run log and Rerun targets and the options they record."""
     import numpy as np
 
     from teachfit.execution.plan_contact import (
@@ -281,6 +283,9 @@ def _assemble_plan(
     console.print(
         f"success {s}; ground truth {truth}/{len(out)}; the paper's robot, open loop: {ok}/{n}"
     )
+    if rec[0] is not None or rec[1] is not None:
+        info = ("assemble", part, "floating", seed, "plan in contact + seating")
+        write_recordings(rec[0], rec[1], [t.result for t in out], info, rec[2])
     pick = out[0]
     if plot is not None:
         from teachfit.viz.assembly_figures import plot_phases

@@ -83,7 +83,8 @@ def show_run_log(path: Path, plot: Path | None) -> None:
     )
     for col in ("#", "outcome", "duration", "to success", "final depth", "max force", "nodes"):
         table.add_column(col, justify="left" if col in ("outcome", "nodes") else "right")
-    for r in run_summary(run):
+    rows = run_summary(run)
+    for r in rows:
         ok = r["outcome"] == "success"
         table.add_row(
             str(r["index"]),
@@ -95,7 +96,7 @@ def show_run_log(path: Path, plot: Path | None) -> None:
             r["nodes"],
         )
     console.print(table)
-    n_ok = sum(ep.result.success for ep in run.episodes)
+    n_ok = sum(r["outcome"] == "success" for r in rows)  # as the table shows
     console.print(f"{n_ok}/{len(run.episodes)} episodes succeeded")
     if plot is not None:
         from teachfit.viz.run_figures import plot_run
