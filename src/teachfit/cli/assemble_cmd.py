@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -12,6 +13,7 @@ from rich.table import Table
 from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
 
 _UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "deg": 0.017453292519943295, "rad": 1.0}
@@ -120,19 +122,13 @@ def assemble(
     with progress_bar() as bar:
         job = bar.add_task("assembling", total=len(jobs))
         out = run_assembly(jobs, workers, lambda: bar.advance(job))
-    table = Table(title="trials", title_justify="left")
-    for col in ("#", "taught offset (mm)", "outcome", "time (s)", "truth", "primitives"):
-        table.add_column(col)
-    for tr in out:
-        table.add_row(
-            str(tr.index),
-            f"({tr.offset[0] * 1e3:+.2f}, {tr.offset[1] * 1e3:+.2f})",
-            "[green]success[/]" if tr.success else f"[red]{tr.reason}[/]",
-            f"{tr.time:.2f}",
-            str(tr.ground_truth),
-            " > ".join(tr.nodes),
-        )
-    console.print(table)
+    _print_trials(
+        "taught offset (mm)",
+        [
+            (t, f"({t.offset[0] * 1e3:+.2f}, {t.offset[1] * 1e3:+.2f})", t.reason, t.nodes)
+            for t in out
+        ],
+    )
     s = summarize([t.success for t in out], [t.time for t in out])
     searched = sum("search" in t.nodes for t in out)
     console.print(f"success {s}; the search ran in {searched}/{len(out)} trial(s)")
@@ -213,6 +209,19 @@ def bench_assembly(
             console.print(f"figure -> {plot_success_by_error(rows, path, name)}")
 
 
+def _print_trials(error_col: str, rows: list[tuple[Any, str, str, Sequence[str]]]) -> None:
+    """The per-trial table of both kinds of run: (trial, its error, failure reason, nodes)."""
+    table = Table(title="trials", title_justify="left")
+    for col in ("#", error_col, "outcome", "time (s)", "truth", "primitives"):
+        table.add_column(col)
+    for tr, error, reason, nodes in rows:
+        outcome = "[green]success[/]" if tr.success else f"[red]{reason}[/]"
+        table.add_row(
+            str(tr.index), error, outcome, f"{tr.time:.2f}", str(tr.ground_truth), " > ".join(nodes)
+        )
+    print_table(table)
+
+
 def _assemble_plan(
     part: str,
     demo: str | None,
@@ -264,19 +273,18 @@ def _assemble_plan(
         out = run_plan_trials(
             part, path, trials, seed, on_trial=lambda _t: bar.advance(job), **ranges
         )
-    table = Table(title="trials", title_justify="left")
-    for col in ("#", "error (mm, deg)", "outcome", "time (s)", "truth", "primitives"):
-        table.add_column(col)
-    for tr in out:
-        table.add_row(
-            str(tr.index),
-            f"{tr.error_m * 1e3:.2f}, {np.degrees(tr.error_rad):.2f}",
-            "[green]success[/]" if tr.success else f"[red]{tr.result.reason}[/]",
-            f"{tr.time:.2f}",
-            str(tr.ground_truth),
-            " > ".join(v.node for v in tr.result.visits),
-        )
-    console.print(table)
+    _print_trials(
+        "error (mm, deg)",
+        [
+            (
+                t,
+                f"{t.error_m * 1e3:.2f}, {np.degrees(t.error_rad):.2f}",
+                t.result.reason,
+                [v.node for v in t.result.visits],
+            )
+            for t in out
+        ],
+    )
     s = summarize([t.success for t in out], [t.time for t in out])
     truth = sum(bool(t.ground_truth) for t in out)
     ok, n = PAPER_ROBOT[part]
