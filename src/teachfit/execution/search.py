@@ -101,7 +101,8 @@ def plan_search(
     """
     if not 0 < n_points <= MAX_POINTS:
         raise TeachfitError(
-            f"number of points must be 1 ... {MAX_POINTS} (seed A uses 300-600), got {n_points}"
+            f"number of points must be 1 ... {MAX_POINTS} (Ehlers et al. use 300-600), "
+            f"got {n_points}"
         )
     if passes < 1 or (passes > 1 and method != "tshix"):
         raise TeachfitError(f"passes must be 1, or >= 1 for tshix; got {passes} for {method}")

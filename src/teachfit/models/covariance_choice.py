@@ -59,7 +59,7 @@ class CovarianceChoice:
                 f"per state: {parts})"
             )
         if self.criterion == "single demonstration":
-            return f"{self.covariance} (one demonstration: nothing to hold out; seed A's choice)"
+            return f"{self.covariance} (one demonstration: nothing to hold out; as Ehlers et al.)"
         return f"{self.covariance} (as asked)"
 
     def to_dict(self) -> dict[str, Any]:

@@ -84,5 +84,5 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
         error=base.error,
         pre=base.pre,
         recovery=base.recovery,
-        doc="seed B's peg-in-hole whose recovery is seed A's learned search",
+        doc="Johannsmeier et al.'s peg-in-hole whose recovery is Ehlers et al.'s learned search",
     )

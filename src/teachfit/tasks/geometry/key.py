@@ -112,7 +112,9 @@ class Key(PrismHoleTask):
     """Flat key blade into a narrow chamfered slot; search in x, y and rz."""
 
     name = "key"
-    description = "flat key blade into a narrow chamfered slot; search x-y-rz (seed B)"
+    description = (
+        "flat key blade into a narrow chamfered slot; search x-y-rz (Johannsmeier et al. 2019)"
+    )
     params_type = KeyParams
     scene_type = KeyScene
     params: KeyParams

@@ -88,7 +88,10 @@ class AluminiumPeg(SkillTask):
     """Chamfered round peg into a hole in a free-standing boss; search in x, y."""
 
     name = "peg"
-    description = "chamfered aluminium peg into a hole with no walls around it; x-y (seed B)"
+    description = (
+        "chamfered aluminium peg into a hole with no walls around it; x-y "
+        "(Johannsmeier et al. 2019)"
+    )
     search_dims = ("x", "y")
     params_type = AluminiumPegParams
     scene_type = BossScene

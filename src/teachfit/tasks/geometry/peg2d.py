@@ -71,7 +71,10 @@ class Peg2D(Task):
     """Round peg into a round hole on top of a cylinder; search in x-y, orientation fixed."""
 
     name = "peg2d"
-    description = "round peg into a round hole on a cylinder top; search x-y (seed A, 2D)"
+    description = (
+        "round peg into a round hole on a cylinder top; search x-y "
+        "(Ehlers et al. 2019, Tables I-II)"
+    )
     search_dims = ("x", "y")
     params_type = Peg2DParams
     scene_type = Peg2DScene

@@ -81,7 +81,10 @@ class Puzzle(PrismHoleTask):
     """Triangular puzzle piece into a triangular hole, no chamfer; search in x, y and rz."""
 
     name = "puzzle"
-    description = "triangular puzzle piece into a triangular hole, no chamfer; x-y-rz (seed B)"
+    description = (
+        "triangular puzzle piece into a triangular hole, no chamfer; x-y-rz "
+        "(Johannsmeier et al. 2019)"
+    )
     params_type = PuzzleParams
     scene_type = PuzzleScene
     params: PuzzleParams

@@ -40,7 +40,10 @@ class Socket3D(Task):
     """Two-pin plug into a recessed socket with valleys; search in x, y and rz."""
 
     name = "socket3d"
-    description = "two-pin plug into a recessed socket with valleys; search x-y-rz (seed A, 3D)"
+    description = (
+        "two-pin plug into a recessed socket with valleys; search x-y-rz "
+        "(Ehlers et al. 2019, Table III)"
+    )
     search_dims = ("x", "y", "rz")
     params_type = Socket3DParams
     scene_type = SocketScene
