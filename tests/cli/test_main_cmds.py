@@ -132,11 +132,19 @@ def test_unknown_task_is_a_clear_error(tmp_path):
 
 
 def test_quickstart_small(tmp_path):
-    res = invoke("quickstart", "--out", tmp_path, "--demos", "1", "--starts", "2")
+    res = invoke("quickstart", "--out", tmp_path, "--count", "2", "--starts", "2", "--points", "60")
     assert res.exit_code == 0, res.output
-    assert "What this showed" in res.output
+    out = _flat(res.output)
+    assert "from all 2 demonstrations" in out and "What this showed" in out
+    each = r"replay [01]/1, tshix [01]/1, random-walk [01]/1"  # one start of each kind
+    assert re.search(rf"from new starts: {each}; with the hole moved \d+-\d+ mm: {each}\.", out)
     read_png(tmp_path / "replay.png", min_px=200)
-    assert len(read_dataset(tmp_path / "demos.h5")) == 1
+    assert len(read_dataset(tmp_path / "demos.h5")) == 2
+
+
+def test_quickstart_needs_two_demonstrations(tmp_path):
+    res = invoke("quickstart", "--out", tmp_path, "--count", "1")
+    assert res.exit_code == 2 and "--count must be >= 2" in res.output
 
 
 def test_bench_sim_prints_ratio():

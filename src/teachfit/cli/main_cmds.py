@@ -78,12 +78,14 @@ def quickstart(
     starts: Annotated[int, o.starts("new to the demonstration")] = 10,
     seed: Annotated[int, o.seed("the teacher, the starts and the searches")] = 0,
     robot: RobotOpt = "floating",
+    points: o.Points = 300,
     demos: Annotated[int | None, o.old("--demos", "--count")] = None,
 ) -> None:
     """The main job on the default task: demonstrations -> execution -> success table."""
     from teachfit.quickstart import run_quickstart
 
-    run_quickstart(out, task, o.pick(count, demos), starts, seed, console, robot_name=robot)
+    n_demos = o.pick(count, demos)
+    run_quickstart(out, task, n_demos, starts, seed, console, robot_name=robot, n_points=points)
 
 
 @guarded
