@@ -207,7 +207,7 @@ def collision_check_cost(asm: Assembly, n: int = 2000, repeats: int = 3) -> Chec
     """Time the planner's collision check (``collides_xyzq``) at the goal and the start."""
     if n < 1 or repeats < 1:
         raise PlanningError(f"n and repeats must be >= 1, got {n}, {repeats}")
-    checker = CollisionChecker(asm.moving, asm.fixed)
+    checker = CollisionChecker.of(asm)
     goal_pose = Pose.from_matrix(asm.goal)
     goal, start = (
         tuple(float(v) for v in p.as_array()) for p in (goal_pose, Pose.from_matrix(asm.start))

@@ -21,6 +21,8 @@ kernel (scipy for batches, its MuJoCo-backed matrix routine in the collision che
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -29,7 +31,7 @@ import numpy as np
 import ompl.base as ob
 import ompl.geometric as og
 import ompl.util as ou
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import (
@@ -42,7 +44,7 @@ from teachfit.core.geometry import (
     wxyz_to_rotation,
 )
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
-from teachfit.plans.keyposes import KeyPoses, rank_key_poses
+from teachfit.plans.keyposes import KeyPoses, rank_key_poses, straight_chain
 from teachfit.plans.parts import Assembly
 
 __all__ = [
@@ -92,6 +94,37 @@ def seed_ompl(seed: int) -> None:
         ou.setLogLevel(level)
 
 
+def _slerp(qa: np.ndarray, qb: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """(N, 4) unit quaternions w-x-y-z from ``qa`` (s = 0) to ``qb`` (s = 1) along the shorter
+    arc, as OMPL's SO(3) interpolation. Written out (the textbook formula) because scipy's
+    ``Slerp`` costs ~0.5 ms to build per segment, and densifying runs per straight motion."""
+    qa = qa / np.linalg.norm(qa)
+    qb = qb / np.linalg.norm(qb)
+    dot = float(qa @ qb)
+    if dot < 0.0:
+        qb, dot = -qb, -dot
+    theta = np.arccos(min(dot, 1.0))
+    if theta < 1e-9:
+        return np.tile(qa, (len(s), 1))
+    wa, wb = np.sin((1.0 - s) * theta), np.sin(s * theta)
+    return (wa[:, None] * qa + wb[:, None] * qb) / np.sin(theta)
+
+
+@functools.lru_cache(maxsize=512)
+def _bisection_order(n: int) -> tuple[int, ...]:
+    """Indices ``0 .. n-1`` in bisection order (middle, quarters, eighths, ...), the order in
+    which OMPL's discrete motion validator checks a motion: a colliding stretch anywhere is
+    met after a few checks."""
+    if n <= 0:
+        return ()
+    bits = max(int(np.ceil(np.log2(n + 1))), 1)
+    k = np.arange(1, 2**bits)
+    rev = np.array([int(format(i, f"0{bits}b")[::-1], 2) for i in k])  # van der Corput
+    pos = np.floor(rev / 2**bits * n).astype(int)
+    _, first = np.unique(pos, return_index=True)
+    return tuple(int(i) for i in pos[np.sort(first)])
+
+
 def matrix_to_state(T: np.ndarray) -> np.ndarray:
     """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform (scipy's quaternion sign)."""
     T = np.asarray(T, dtype=float)
@@ -131,6 +164,9 @@ class PlannerConfig:
         Candidate key poses are taken where the demonstrated part is closer than this (m) to
         the fixed part (the paper's "important area"); 0 takes them anywhere, None uses the
         assembly's ``key_region``.
+    chain_resolution : float
+        Step (m, as ``resolution``) of the coarse straight-motion checks that rank the key
+        poses (:func:`~teachfit.plans.keyposes.straight_chain`).
     """
 
     planner: str = "RRTConnect"
@@ -143,12 +179,14 @@ class PlannerConfig:
     first_key_poses: int = 0
     key_region: float | None = None
     max_checks: int | None = None
+    chain_resolution: float = 0.002
 
     def __post_init__(self) -> None:
         if self.planner not in PLANNERS:
             raise PlanningError(f"unknown planner {self.planner!r}; known: {', '.join(PLANNERS)}")
-        if not self.te > 0 or not self.resolution > 0 or not self.verify_resolution > 0:
-            raise PlanningError("te, resolution and verify_resolution must be > 0")
+        steps = (self.te, self.resolution, self.verify_resolution, self.chain_resolution)
+        if not all(v > 0 for v in steps):
+            raise PlanningError("te, resolution, verify_resolution, chain_resolution must be > 0")
         if self.max_checks is not None and self.max_checks < 1:
             raise PlanningError(f"max_checks must be >= 1 or None, got {self.max_checks}")
         if (
@@ -235,10 +273,10 @@ class MotionPlanner:
     def __init__(self, asm: Assembly, config: PlannerConfig | None = None) -> None:
         self.asm = asm
         self.config = config or PlannerConfig()
-        self.checker = CollisionChecker(asm.moving, asm.fixed)
+        self.checker = CollisionChecker.of(asm)
         region = self.config.key_region
         self.key_region = asm.key_region if region is None else region
-        self._near = CollisionChecker(asm.moving, asm.fixed, margin=self.key_region)
+        self._near = CollisionChecker.of(asm, margin=self.key_region)
         self.start = matrix_to_state(asm.start)
         self.goal = matrix_to_state(asm.goal)
         for label, state in (("start", self.start), ("goal", self.goal)):
@@ -402,18 +440,17 @@ class MotionPlanner:
         seed_ompl(seed)
         rng = np.random.default_rng(seed)
         keys: KeyPoses | None = None
+        repaired: dict[int, np.ndarray | None] = {}
         if demo is not None:
             keys = self._rank(demo)
+            repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+            keys = self._chain_first(keys, repaired)
         n_cand = 0 if keys is None else len(keys.indices)
-        repaired: dict[int, np.ndarray | None] = {}
         solved: dict[tuple[int, int], np.ndarray] = {}
         failed: dict[tuple[int, int], float] = {}
         attempts = 0
         for k in range(min(self.config.first_key_poses, n_cand), n_cand + 1):
             chosen = [] if keys is None else sorted(int(i) for i in keys.order[:k])
-            for i in chosen:
-                if i not in repaired:
-                    repaired[i] = self.repair(matrix_to_state(keys.L2G[i]), rng)
             ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
             states = {-1: self.start, n_cand: self.goal} | {i: repaired[i] for i in ids[1:-1]}
             if self.approach is not None:  # the goal is reached by the straight insertion
@@ -489,9 +526,11 @@ class MotionPlanner:
         quat = np.asarray(demo.quat, dtype=float)  # type: ignore[attr-defined]
         eligible = None
         if self.key_region > 0 and pos.shape == (len(t), 3) and quat.shape == (len(t), 4):
-            eligible = np.array(
-                [self._near.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True)]
-            )
+            # every third sample, each standing for its neighbours (a 30 Hz demonstration moves
+            # ~1 mm a sample): the region is a coarse mask, and this is a third of the checks
+            step = 3
+            near = [self._near.collides_xyzq(*pos[i], *quat[i]) for i in range(0, len(t), step)]
+            eligible = np.repeat(np.array(near, dtype=bool), step)[: len(t)]
         return rank_key_poses(
             t,
             pos,
@@ -501,6 +540,24 @@ class MotionPlanner:
             char_length=self.radius,
             eligible=eligible,
         )
+
+    def _chain_first(self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]) -> KeyPoses:
+        """``keys`` reordered: the straight chain (:func:`straight_chain`) first, then the rest
+        by the derivative rule. Straight motions are checked at ``config.chain_resolution``."""
+        n = len(keys.indices)
+        last = self.goal if self.approach is None else self.approach
+        nodes = {-1: self.start, n: last} | repaired
+
+        def connects(a: int, b: int) -> bool:
+            sa, sb = nodes[a], nodes[b]
+            if sa is None or sb is None:
+                return False
+            dense = self.densify(np.stack([sa, sb]), self.config.chain_resolution)[1:-1]
+            return not any(self._collides(dense[i]) for i in _bisection_order(len(dense)))
+
+        chain = straight_chain(n, connects)
+        rest = [int(i) for i in keys.order if int(i) not in chain]
+        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int))
 
     def _finish(self, path: np.ndarray) -> np.ndarray | None:
         """Shortcut and smooth ``path`` with OMPL, then verify densely; None if unverifiable."""
@@ -529,8 +586,7 @@ class MotionPlanner:
         for a, b in zip(path[:-1], path[1:], strict=True):
             n = max(int(np.ceil(self._distance(a, b[None])[0] / res)), 1)
             s = np.linspace(0.0, 1.0, n + 1)[1:]
-            rots = wxyz_to_rotation(np.stack([a[3:], b[3:]]))
-            q = rotation_to_wxyz(Slerp([0.0, 1.0], rots)(s), canonical=False)
+            q = _slerp(a[3:], b[3:], s)
             out.append(np.concatenate([a[:3] + s[:, None] * (b[:3] - a[:3]), q], axis=1))
         return np.concatenate(out)
 

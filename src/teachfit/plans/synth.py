@@ -166,7 +166,7 @@ def synth_demo(
         span = slice(i0, min(i0 + 4, n - 1))
         pos[span, 1] += rng.choice([-1.0, 1.0]) * (asm.dimensions["clearance"] + 0.0008)
     quat = rotation_to_wxyz(Rotation.from_euler("xyz", rpy, degrees=True))  # w >= 0
-    checker = CollisionChecker(asm.moving, asm.fixed)
+    checker = CollisionChecker.of(asm)
     colliding = sum(checker.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True))
     return Demonstration(
         t=t,
