@@ -113,12 +113,17 @@ def _box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> mani
     return manifold3d.Manifold.cube(size).translate(list(lo))
 
 
-def _union(boxes: list[tuple[tuple[float, ...], tuple[float, ...]]]) -> tuple[np.ndarray, trimesh.Trimesh]:
+Corners = tuple[tuple[float, float, float], tuple[float, float, float]]
+
+
+def _union(boxes: list[Corners]) -> tuple[np.ndarray, trimesh.Trimesh]:
     """(N, 2, 3) corners and the mesh of a union of boxes given as (low, high) corners (m)."""
     corners = np.asarray(boxes, dtype=float)
-    return corners, _to_trimesh(manifold3d.Manifold.batch_boolean(
-        [_box(tuple(lo), tuple(hi)) for lo, hi in corners], manifold3d.OpType.Add
-    ))
+    return corners, _to_trimesh(
+        manifold3d.Manifold.batch_boolean(
+            [_box(tuple(lo), tuple(hi)) for lo, hi in corners], manifold3d.OpType.Add
+        )
+    )
 
 
 def _to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
