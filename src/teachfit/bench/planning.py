@@ -68,7 +68,7 @@ class PlanningBenchConfig:
 
     tasks: tuple[str, ...] = ("l-groove", "tenon")
     seeds: int = 50
-    te: float = 0.01
+    te: float = 0.005
     max_checks: int | None = None
     planner: str = "RRTConnect"
     no_demo_seeds: int = 5

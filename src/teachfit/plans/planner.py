@@ -143,7 +143,7 @@ class PlannerConfig:
     te : float
         Time budget (s) of one attempt; when exceeded the next key pose is inserted. The paper
         used 5 s with Panda3D's collision checks in Python; t_e is in effect a budget of
-        samples, and our coal checks are orders of magnitude faster, so the default is 0.02 s.
+        samples, and our coal checks are orders of magnitude faster, so the default is 0.005 s.
     max_checks : int or None
         Budget of one attempt in collision checks instead of ``te`` seconds (``te`` is then
         ignored): the result of a query no longer depends on the machine's speed or load.
@@ -170,7 +170,7 @@ class PlannerConfig:
     """
 
     planner: str = "RRTConnect"
-    te: float = 0.02
+    te: float = 0.005
     resolution: float = 0.0005
     verify_resolution: float = 0.0005
     shortcut: bool = True
@@ -375,12 +375,26 @@ class MotionPlanner:
 
     # -- segments -----------------------------------------------------------------------------
     def _plan_segment(
-        self, a: np.ndarray, b: np.ndarray, budget: float, by_checks: bool
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        budget: float,
+        by_checks: bool,
+        via: np.ndarray | None = None,
     ) -> np.ndarray | None:
-        """Path from ``a`` to ``b`` within ``budget`` (collision checks or seconds), or None."""
+        """Path from ``a`` to ``b`` within ``budget`` (collision checks or seconds), or None.
+
+        Tries the straight motion, then the demonstrated motion ``via`` ((M, 7) states between
+        the two key poses, when given) if each of its steps is free, then RRT-Connect.
+        """
         sa, sb = self._to_ompl(a), self._to_ompl(b)
         if self.si.checkMotion(sa, sb):
             return np.stack([a, b])
+        if via is not None and len(via) > 0:
+            demo_path = np.concatenate([a[None], via, b[None]])
+            states = [self._to_ompl(q) for q in demo_path]
+            if all(self.si.checkMotion(p, q) for p, q in zip(states[:-1], states[1:], strict=True)):
+                return demo_path
         if budget < (1.0 if by_checks else 1e-3):
             return None
         ss = og.SimpleSetup(self.si)
@@ -446,6 +460,7 @@ class MotionPlanner:
             repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
             keys = self._chain_first(keys, repaired)
         n_cand = 0 if keys is None else len(keys.indices)
+        via = self._demonstrated(demo, keys)
         solved: dict[tuple[int, int], np.ndarray] = {}
         failed: dict[tuple[int, int], float] = {}
         attempts = 0
@@ -467,7 +482,7 @@ class MotionPlanner:
                 budget = budget_of_attempt - spent
                 if failed.get((a, b), -1.0) * 1.5 >= budget:
                     break  # failed before with as much budget: insert another key pose
-                seg = self._plan_segment(states[a], states[b], budget, by_checks)
+                seg = self._plan_segment(states[a], states[b], budget, by_checks, via(a, b))
                 if seg is None:
                     failed[(a, b)] = budget
                     break
@@ -540,6 +555,29 @@ class MotionPlanner:
             char_length=self.radius,
             eligible=eligible,
         )
+
+    def _demonstrated(
+        self, demo: object | None, keys: KeyPoses | None
+    ) -> Callable[[int, int], np.ndarray | None]:
+        """``via(a, b)``: the demonstrated states strictly between neighbouring nodes ``a`` and
+        ``b = a + 1`` (-1 the start, ``0 .. K-1`` the candidates, ``K`` the goal); None for
+        other pairs (the key poses between them are what the planner inserts), for the
+        approach of a mesh task, or without a demonstration."""
+        if demo is None or keys is None:
+            return lambda a, b: None
+        demo_states = np.concatenate(
+            [np.asarray(demo.pos, dtype=float), np.asarray(demo.quat, dtype=float)], axis=1
+        )  # type: ignore[attr-defined]
+        n, last = len(keys.indices), len(demo_states) - 1
+
+        def via(a: int, b: int) -> np.ndarray | None:
+            if b > n or b != a + 1:
+                return None
+            ia = 0 if a < 0 else int(keys.indices[a])
+            ib = last if b == n else int(keys.indices[b])
+            return demo_states[ia + 1 : ib]
+
+        return via
 
     def _chain_first(self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]) -> KeyPoses:
         """``keys`` reordered: the straight chain (:func:`straight_chain`) first, then the rest
