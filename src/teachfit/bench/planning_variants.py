@@ -39,8 +39,8 @@ SCALE_RANGE: tuple[float, float] = (0.9, 1.1)
 
 
 def sample_variants(task: str, n: int, seed: int = 0) -> list[dict[str, float]]:
-    """``n`` seeded variants of ``task`` as dimension overrides (m); the first two are the
-    grid's corners of most concern: the tightest clearance, and the smallest parts with it."""
+    """``n`` seeded variants of ``task`` as dimension overrides (m); the first three are the
+    tightest clearance on the default, the smallest and the largest parts."""
     if task not in PARTS:
         raise PlanningError(f"unknown task {task!r}; known: {', '.join(PARTS)}")
     if n < 1:
@@ -49,7 +49,7 @@ def sample_variants(task: str, n: int, seed: int = 0) -> list[dict[str, float]]:
     names = [f.name for f in dataclasses.fields(base) if f.name != "clearance"]
     default_clearance = float(base.clearance)  # type: ignore[union-attr]
     rng = np.random.default_rng(seed)
-    picks = [(CLEARANCE_RANGE[0], 1.0), (CLEARANCE_RANGE[0], SCALE_RANGE[0])]
+    picks = [(CLEARANCE_RANGE[0], s) for s in (1.0, SCALE_RANGE[0], SCALE_RANGE[1])]
     while len(picks) < n:
         c = rng.uniform(CLEARANCE_RANGE[0], default_clearance * CLEARANCE_RANGE[1])
         picks.append((float(c), float(rng.uniform(*SCALE_RANGE))))
