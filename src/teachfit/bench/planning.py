@@ -70,7 +70,7 @@ class PlanningBenchConfig:
 
     tasks: tuple[str, ...] = ("l-groove", "tenon")
     seeds: int = 50
-    te: float = 0.005
+    te: float = 0.002
     max_checks: int | None = None
     planner: str = "RRTConnect"
     no_demo_seeds: int = 5

@@ -119,7 +119,7 @@ def plan(
         str | None, typer.Option(help="demonstration FILE.h5:INDEX (FILE.h5: its first)")
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
-    te: Annotated[float, typer.Option(min=0, help="budget per attempt (s)")] = 0.005,
+    te: Annotated[float, typer.Option(min=0, help="budget per attempt (s)")] = 0.002,
     max_checks: Annotated[
         int | None,
         typer.Option(
@@ -192,7 +192,7 @@ def bench_planning_cmd(
     ] = 50,
     te: Annotated[
         float, typer.Option(min=0, help="budget per attempt (s) with demonstration")
-    ] = 0.005,
+    ] = 0.002,
     max_checks: Annotated[
         int | None,
         typer.Option(

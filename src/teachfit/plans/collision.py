@@ -17,6 +17,8 @@ Distances (reports only) always use the meshes.
 
 from __future__ import annotations
 
+import math
+
 import coal
 import numpy as np
 import trimesh
@@ -152,6 +154,7 @@ class CollisionChecker:
         self._L2G = coal.Transform3s()
         self._q = np.zeros(4)  # buffers of the hot path: quaternion and rotation (row-major)
         self._R9 = np.zeros(9)
+        self._t = np.zeros(3)
         self._G = coal.Transform3s()
         self.n_checks = 0
         self._margin = float(margin)
@@ -164,6 +167,10 @@ class CollisionChecker:
             self._manager.setup()
             offsets = [coal.Transform3s(np.eye(3), (lo + hi) / 2) for lo, hi in mov]
             self._boxes = list(zip(_box_objects(mov), offsets, strict=True))
+            self._moving_tree = coal.DynamicAABBTreeCollisionManager()
+            for obj, _ in self._boxes:
+                self._moving_tree.registerObject(obj)
+            self._moving_tree.setup()
             self._callback = coal.CollisionCallBackDefault()
             self._callback.data.request.enable_contact = False
             self._callback.data.request.security_margin = self._margin
@@ -181,15 +188,20 @@ class CollisionChecker:
         self, x: float, y: float, z: float, w: float, qx: float, qy: float, qz: float
     ) -> bool:
         """Collision test for ``L2G`` given as position (m) and quaternion w-x-y-z (hot path)."""
-        q = self._q
-        q[0], q[1], q[2], q[3] = w, qx, qy, qz
-        if quat_normalize_into(q) == 0.0:
-            raise PlanningError("zero quaternion")
-        if self._boxes is not None:
-            self._L2G.setQuatRotation(coal.Quaternion(q[0], q[1], q[2], q[3]))
+        t = self._t
+        t[0], t[1], t[2] = x, y, z
+        if self._boxes is not None:  # scalar arithmetic: no array round trip on this path
+            norm = math.sqrt(w * w + qx * qx + qy * qy + qz * qz)
+            if not norm > 1e-15:
+                raise PlanningError("zero quaternion")
+            self._L2G.setQuatRotation(coal.Quaternion(w / norm, qx / norm, qy / norm, qz / norm))
         else:
+            q = self._q
+            q[0], q[1], q[2], q[3] = w, qx, qy, qz
+            if quat_normalize_into(q) == 0.0:
+                raise PlanningError("zero quaternion")
             self._L2G.setRotation(quat_to_matrix_into(self._R9, q).reshape(3, 3))
-        self._L2G.setTranslation(np.array((x, y, z)))
+        self._L2G.setTranslation(t)
         return self._check()
 
     def collides(self, L2G: np.ndarray) -> bool:
@@ -204,17 +216,15 @@ class CollisionChecker:
             self._cres.clear()
             self._collide(self._L2G, self._G, self._creq, self._cres)
             return self._cres.isCollision()
-        callback = self._callback
         for obj, offset in self._boxes:
             obj.setTransform(self._L2G * offset)
             obj.computeAABB()
             if self._margin > 0:  # the broad phase must see pairs up to the margin apart
                 obj.getAABB().expand(self._widen)
-            callback.init()
-            self._manager.collide(obj, callback)
-            if callback.data.result.isCollision():
-                return True
-        return False
+        self._moving_tree.update()
+        self._callback.init()
+        self._manager.collide(self._moving_tree, self._callback)  # one call: tree against tree
+        return self._callback.data.result.isCollision()
 
     def distance(self, L2G: np.ndarray) -> float:
         """Minimum distance (m) between the parts at pose ``L2G``; <= 0 when they touch."""

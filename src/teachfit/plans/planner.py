@@ -22,7 +22,6 @@ kernel (scipy for batches, its MuJoCo-backed matrix routine in the collision che
 from __future__ import annotations
 
 import dataclasses
-import functools
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -110,21 +109,6 @@ def _slerp(qa: np.ndarray, qb: np.ndarray, s: np.ndarray) -> np.ndarray:
     return (wa[:, None] * qa + wb[:, None] * qb) / np.sin(theta)
 
 
-@functools.lru_cache(maxsize=512)
-def _bisection_order(n: int) -> tuple[int, ...]:
-    """Indices ``0 .. n-1`` in bisection order (middle, quarters, eighths, ...), the order in
-    which OMPL's discrete motion validator checks a motion: a colliding stretch anywhere is
-    met after a few checks."""
-    if n <= 0:
-        return ()
-    bits = max(int(np.ceil(np.log2(n + 1))), 1)
-    k = np.arange(1, 2**bits)
-    rev = np.array([int(format(i, f"0{bits}b")[::-1], 2) for i in k])  # van der Corput
-    pos = np.floor(rev / 2**bits * n).astype(int)
-    _, first = np.unique(pos, return_index=True)
-    return tuple(int(i) for i in pos[np.sort(first)])
-
-
 def matrix_to_state(T: np.ndarray) -> np.ndarray:
     """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform (scipy's quaternion sign)."""
     T = np.asarray(T, dtype=float)
@@ -143,7 +127,8 @@ class PlannerConfig:
     te : float
         Time budget (s) of one attempt; when exceeded the next key pose is inserted. The paper
         used 5 s with Panda3D's collision checks in Python; t_e is in effect a budget of
-        samples, and our coal checks are orders of magnitude faster, so the default is 0.005 s.
+        samples, and our box checks (~10 us) are orders of magnitude faster, so the default is
+        0.002 s (~200 checks): RRT-Connect's short detours; the key poses do the rest.
     max_checks : int or None
         Budget of one attempt in collision checks instead of ``te`` seconds (``te`` is then
         ignored): the result of a query no longer depends on the machine's speed or load.
@@ -164,13 +149,10 @@ class PlannerConfig:
         Candidate key poses are taken where the demonstrated part is closer than this (m) to
         the fixed part (the paper's "important area"); 0 takes them anywhere, None uses the
         assembly's ``key_region``.
-    chain_resolution : float
-        Step (m, as ``resolution``) of the coarse straight-motion checks that rank the key
-        poses (:func:`~teachfit.plans.keyposes.straight_chain`).
     """
 
     planner: str = "RRTConnect"
-    te: float = 0.005
+    te: float = 0.002
     resolution: float = 0.0005
     verify_resolution: float = 0.0005
     shortcut: bool = True
@@ -179,14 +161,12 @@ class PlannerConfig:
     first_key_poses: int = 0
     key_region: float | None = None
     max_checks: int | None = None
-    chain_resolution: float = 0.002
 
     def __post_init__(self) -> None:
         if self.planner not in PLANNERS:
             raise PlanningError(f"unknown planner {self.planner!r}; known: {', '.join(PLANNERS)}")
-        steps = (self.te, self.resolution, self.verify_resolution, self.chain_resolution)
-        if not all(v > 0 for v in steps):
-            raise PlanningError("te, resolution, verify_resolution, chain_resolution must be > 0")
+        if not self.te > 0 or not self.resolution > 0 or not self.verify_resolution > 0:
+            raise PlanningError("te, resolution and verify_resolution must be > 0")
         if self.max_checks is not None and self.max_checks < 1:
             raise PlanningError(f"max_checks must be >= 1 or None, got {self.max_checks}")
         if (
@@ -381,14 +361,16 @@ class MotionPlanner:
         budget: float,
         by_checks: bool,
         via: np.ndarray | None = None,
+        try_straight: bool = True,
     ) -> np.ndarray | None:
         """Path from ``a`` to ``b`` within ``budget`` (collision checks or seconds), or None.
 
-        Tries the straight motion, then the demonstrated motion ``via`` ((M, 7) states between
-        the two key poses, when given) if each of its steps is free, then RRT-Connect.
+        Tries the straight motion (unless ``try_straight`` is False: known to collide), then
+        the demonstrated motion ``via`` ((M, 7) states between the two key poses, when given)
+        if each of its steps is free, then RRT-Connect.
         """
         sa, sb = self._to_ompl(a), self._to_ompl(b)
-        if self.si.checkMotion(sa, sb):
+        if try_straight and self.si.checkMotion(sa, sb):
             return np.stack([a, b])
         if via is not None and len(via) > 0:
             demo_path = np.concatenate([a[None], via, b[None]])
@@ -455,10 +437,11 @@ class MotionPlanner:
         rng = np.random.default_rng(seed)
         keys: KeyPoses | None = None
         repaired: dict[int, np.ndarray | None] = {}
+        straight: dict[tuple[int, int], bool] = {}
         if demo is not None:
             keys = self._rank(demo)
             repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
-            keys = self._chain_first(keys, repaired)
+            keys, straight = self._chain_first(keys, repaired)
         n_cand = 0 if keys is None else len(keys.indices)
         via = self._demonstrated(demo, keys)
         solved: dict[tuple[int, int], np.ndarray] = {}
@@ -482,7 +465,12 @@ class MotionPlanner:
                 budget = budget_of_attempt - spent
                 if failed.get((a, b), -1.0) * 1.5 >= budget:
                     break  # failed before with as much budget: insert another key pose
-                seg = self._plan_segment(states[a], states[b], budget, by_checks, via(a, b))
+                if straight.get((a, b)):  # found free while ranking
+                    seg = np.stack([states[a], states[b]])
+                else:
+                    seg = self._plan_segment(
+                        states[a], states[b], budget, by_checks, via(a, b), (a, b) not in straight
+                    )
                 if seg is None:
                     failed[(a, b)] = budget
                     break
@@ -579,23 +567,28 @@ class MotionPlanner:
 
         return via
 
-    def _chain_first(self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]) -> KeyPoses:
+    def _chain_first(
+        self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]
+    ) -> tuple[KeyPoses, dict[tuple[int, int], bool]]:
         """``keys`` reordered: the straight chain (:func:`straight_chain`) first, then the rest
-        by the derivative rule. Straight motions are checked at ``config.chain_resolution``."""
+        by the derivative rule; and the straight motions tested meanwhile (OMPL's motion check,
+        the attempts' own), by pair of the attempts' node ids, for the attempts to reuse."""
         n = len(keys.indices)
-        last = self.goal if self.approach is None else self.approach
-        nodes = {-1: self.start, n: last} | repaired
+        end = n if self.approach is None else n + 1  # the attempts' id of the chain's last node
+        nodes = {-1: self.start, n: self.goal if self.approach is None else self.approach}
+        nodes |= repaired
+        straight: dict[tuple[int, int], bool] = {}
 
         def connects(a: int, b: int) -> bool:
             sa, sb = nodes[a], nodes[b]
-            if sa is None or sb is None:
-                return False
-            dense = self.densify(np.stack([sa, sb]), self.config.chain_resolution)[1:-1]
-            return not any(self._collides(dense[i]) for i in _bisection_order(len(dense)))
+            ok = sa is not None and sb is not None
+            ok = ok and bool(self.si.checkMotion(self._to_ompl(sa), self._to_ompl(sb)))
+            straight[(a, end if b == n else b)] = ok
+            return ok
 
         chain = straight_chain(n, connects)
         rest = [int(i) for i in keys.order if int(i) not in chain]
-        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int))
+        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int)), straight
 
     def _finish(self, path: np.ndarray) -> np.ndarray | None:
         """Shortcut and smooth ``path`` with OMPL, then verify densely; None if unverifiable."""
