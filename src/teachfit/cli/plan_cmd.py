@@ -119,7 +119,12 @@ def plan(
         str | None, typer.Option(help="demonstration FILE.h5:INDEX (FILE.h5: its first)")
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
-    te: Annotated[float, typer.Option(min=0, help="budget per attempt (s)")] = 0.002,
+    te: Annotated[
+        float | None,
+        typer.Option(
+            min=0, help="budget per attempt (s); default 0.002 (box parts), 0.02 (meshes)"
+        ),
+    ] = None,
     max_checks: Annotated[
         int | None,
         typer.Option(

@@ -176,6 +176,11 @@ class CollisionChecker:
             self._callback.data.request.security_margin = self._margin
             self._widen = np.full(3, self._margin)
 
+    @property
+    def on_boxes(self) -> bool:
+        """True when the collision tests use the parts' boxes (else their meshes)."""
+        return self._boxes is not None
+
     @classmethod
     def of(cls, asm: object, *, margin: float = 0.0) -> CollisionChecker:
         """The checker of an assembly (``moving``, ``fixed`` meshes), on its boxes where it has
