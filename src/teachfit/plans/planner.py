@@ -1,11 +1,15 @@
 """Motion planning of the moving part's 6-DOF pose guided by demonstrated key poses.
 
 The loop of the paper (METHODS.md C, Fig. 7): plan from the initial to the final pose with
-RRT-Connect (OMPL, SE(3), mesh-mesh validity in Python); when an attempt finds no path within
-``te`` seconds, insert the next ranked key pose and plan segment by segment. Each segment first
-tries the straight motion, and solved segments are reused by later attempts. A key pose in
-collision is replaced by the nearest collision-free pose sampled around it. The final path is
-shortcut and smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
+RRT-Connect (OMPL, SE(3), validity by coal in Python: box or mesh checks, see
+:mod:`.collision`); when an attempt finds no path within ``te`` seconds, insert the next ranked
+key pose and plan segment by segment. A key pose in collision is first replaced by the nearest
+collision-free pose sampled around it. The ranking puts first the chain of key poses joined by
+free straight motions (:func:`~teachfit.plans.keyposes.straight_chain`; its motion checks are
+reused by the attempts), then the rest by the paper's derivative. Each segment tries the
+straight motion, then, between neighbouring key poses, the demonstrated motion, then
+RRT-Connect; solved segments are reused by later attempts. The final path is shortcut and
+smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
 
 Every query seeds OMPL's global RNG from its ``seed`` (:func:`seed_ompl`), so the samplers of
 the planners and of the path simplifier it creates draw the same numbers whatever ran before in
