@@ -128,3 +128,14 @@ def test_task_param_overrides_reach_the_parts_and_bad_ones_exit_2(tmp_path):
     params.write_text("clearance = 'tight'\n", encoding="utf-8")
     res = runner.invoke(app, both)
     assert res.exit_code == 2 and str(params) in _flat(res.output)
+
+
+def test_bench_planning_runs_a_variant_sweep_into_the_markdown(tmp_path):
+    md = tmp_path / "b.md"
+    args = ["bench", "planning", "--tasks", "tenon", "--runs", "1", "--no-demo-runs", "0"]
+    res = runner.invoke(app, [*args, "--variants", "1", "--markdown", str(md)])
+    assert res.exit_code == 0, res.output
+    text = md.read_text(encoding="utf-8")
+    assert "--variants 1" in text and "| tenon | 0.50 | x1.000 | 1 |" in text
+    bad = runner.invoke(app, [*args, "--task-param", "bar_side=-1"])
+    assert bad.exit_code == 2 and "bar_side" in bad.output

@@ -260,7 +260,8 @@ def bench_planning_cmd(
     print_table(table)
     for line in bp.report_notes(results):
         console.print(line)
-    text = bp.to_markdown(results, command=cfg.command())
+    command = cfg.command() + (f" --variants {variants}" if variants else "")
+    text = bp.to_markdown(results, command=command)
     if variants:
         text += _variant_sweep(cfg, variants)
     if markdown is not None:
