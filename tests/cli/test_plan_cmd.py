@@ -112,3 +112,30 @@ def test_bench_planning_prints_and_appends_what_the_library_computes(tmp_path):
     assert check is not None and float(check.group(1)) > 0
     bad = runner.invoke(app, ["bench", "planning", "--tasks", "peg"])
     assert bad.exit_code == 2 and "unknown or no task(s) ['peg']" in bad.output
+
+
+def test_task_param_overrides_reach_the_parts_and_bad_ones_exit_2(tmp_path):
+    ok = runner.invoke(app, ["parts", "show", "tenon", "--task-param", "clearance=0.0005"])
+    assert ok.exit_code == 0, ok.output
+    assert any("clearance" in ln and "0.5" in ln for ln in ok.output.splitlines())
+    params = tmp_path / "p.toml"
+    params.write_text("clearance = 0.0007\n", encoding="utf-8")
+    both = ["parts", "show", "tenon", "--task-params", str(params)]
+    assert any("0.7" in ln for ln in runner.invoke(app, both).output.splitlines() if "clear" in ln)
+    for bad in (["--task-param", "bogus=1"], ["--task-param", "clearance"]):
+        res = runner.invoke(app, ["parts", "show", "tenon", *bad])
+        assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1, res.output
+    params.write_text("clearance = 'tight'\n", encoding="utf-8")
+    res = runner.invoke(app, both)
+    assert res.exit_code == 2 and str(params) in _flat(res.output)
+
+
+def test_bench_planning_runs_a_variant_sweep_into_the_markdown(tmp_path):
+    md = tmp_path / "b.md"
+    args = ["bench", "planning", "--tasks", "tenon", "--runs", "1", "--no-demo-runs", "0"]
+    res = runner.invoke(app, [*args, "--variants", "1", "--markdown", str(md)])
+    assert res.exit_code == 0, res.output
+    text = md.read_text(encoding="utf-8")
+    assert "--variants 1" in text and "| tenon | 0.50 | x1.000 | 1 |" in text
+    bad = runner.invoke(app, [*args, "--task-param", "bar_side=-1"])
+    assert bad.exit_code == 2 and "bar_side" in bad.output

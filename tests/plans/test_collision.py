@@ -70,3 +70,38 @@ def test_degenerate_meshes_raise(lgroove):
         CollisionChecker(bad, asm.fixed)
     with pytest.raises(PlanningError, match="margin"):
         CollisionChecker(asm.moving, asm.fixed, margin=-1.0)
+
+
+@pytest.mark.parametrize("task", ["l-groove", "tenon"])
+def test_box_checks_agree_with_the_mesh_checks(task):
+    # the parametric parts are unions of boxes: the planner tests the boxes, the meshes are
+    # those unions; both must call the same poses colliding (near contact included)
+    asm = build_assembly(task)
+    boxes = CollisionChecker.of(asm)
+    meshes = CollisionChecker(asm.moving, asm.fixed)
+    rng = np.random.default_rng(1)
+    lo, hi = asm.bounds
+    near = np.linspace(0.0, 1.0, 100)[:, None] * (asm.start[:3, 3] - asm.goal[:3, 3])
+    positions = np.concatenate([rng.uniform(lo, hi, (200, 3)), asm.goal[:3, 3] + near])
+    hits = 0
+    for p in positions:
+        T = pose_from_xyz_rpy(p, rng.normal(0.0, 4.0, 3))
+        hits += boxes.collides(T)
+        assert boxes.collides(T) == meshes.collides(T), p
+    assert 0 < hits < len(positions)
+
+
+def test_box_margin_counts_near_poses_as_colliding():
+    asm = build_assembly("l-groove")
+    lifted = asm.goal.copy()
+    lifted[2, 3] += 0.004  # still in the cavity, free, a few mm from the floor and lip
+    assert not CollisionChecker.of(asm).collides(lifted)
+    gap = CollisionChecker(asm.moving, asm.fixed).distance(lifted)
+    assert CollisionChecker.of(asm, margin=gap + 1e-4).collides(lifted)
+    assert not CollisionChecker.of(asm, margin=gap - 1e-4).collides(lifted)
+
+
+def test_bad_boxes_raise():
+    asm = build_assembly("tenon")
+    with pytest.raises(PlanningError, match="boxes"):
+        CollisionChecker(asm.moving, asm.fixed, boxes=(np.zeros((1, 2, 3)), asm.fixed_boxes))

@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import PlanningError
 from teachfit.plans import build_assembly, rank_key_poses, synth_demo
+from teachfit.plans.keyposes import straight_chain
 
 
 def _pitch_demo(pitch):
@@ -67,3 +68,13 @@ def test_bad_parameter_or_motionless_demo_raises():
         rank_key_poses(t, pos, q, 4, param="speed")
     with pytest.raises(PlanningError, match="does not move"):
         rank_key_poses(t, np.zeros_like(pos), np.tile([1.0, 0, 0, 0], (20, 1)), 4)
+
+
+def test_straight_chain_takes_the_farthest_reachable_candidate():
+    # 5 candidates; straight motions reach at most 2 nodes ahead, except 1 -> 4
+    def connects(a, b):
+        return b - a <= 2 or (a, b) == (1, 4)
+
+    assert straight_chain(5, connects) == [1, 4]
+    assert straight_chain(5, lambda a, b: True) == []  # start sees the goal
+    assert straight_chain(3, lambda a, b: False) == [0, 1, 2]  # nothing connects: all of them

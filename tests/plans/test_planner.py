@@ -62,7 +62,8 @@ def test_l_groove_with_demonstration_succeeds(lgroove):
 
 def test_same_seed_same_path_whatever_ran_before(lgroove):
     asm, planner = lgroove
-    demo = synth_demo(asm, 0)
+    demo = synth_demo(asm, 1)  # a demonstration whose plan needs OMPL's sampler (not only
+    # straight motions between key poses), so that the seed shows in the path
     first, other, again = (planner.plan(demo, seed=s) for s in (0, 1, 0))
     assert first.success and other.success and again.success
     # exactly the same path and the same work, though another query ran in between
@@ -157,4 +158,27 @@ def test_planner_selection_and_bad_config():
         planner.plan(None, seed=-1)
     result = planner.plan(synth_demo(asm, 2), seed=2)
     assert result.planner == "RRT"
+    assert result.success, result.message
+
+
+def test_l_groove_uses_no_more_key_poses_than_the_paper(lgroove):
+    asm, planner = lgroove
+    for seed in (2, 5):
+        result = planner.plan(synth_demo(asm, seed), seed=seed)
+        assert result.success, result.message
+        lo, hi = asm.paper.used
+        assert result.used_key_poses <= hi
+        # the straight-motion chain comes first in the ranking
+        assert result.key_poses is not None and len(result.key_poses.order) == 6
+
+
+@pytest.mark.parametrize(
+    ("task", "overrides"),
+    [("l-groove", {"clearance": 0.0005}), ("tenon", {"clearance": 0.0005})],
+)
+def test_tight_variants_plan_from_collision_free_demonstrations(task, overrides):
+    asm = build_assembly(task, **overrides)
+    demo = synth_demo(asm, 0, p_penetrate=0.0)
+    assert demo.meta["n_colliding"] == 0  # the tremor stays within the clearance
+    result = MotionPlanner(asm, PlannerConfig(max_checks=CHECKS)).plan(demo, seed=0)
     assert result.success, result.message

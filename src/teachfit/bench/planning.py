@@ -64,15 +64,18 @@ class PlanningBenchConfig:
         How many of the same seeds the unguided planner runs (0 skips it).
     no_demo_budget : float
         Budget (s) of each unguided run.
+    overrides : tuple of (name, value)
+        Dimension overrides (m) applied to every task (``build_assembly``).
     """
 
     tasks: tuple[str, ...] = ("l-groove", "tenon")
     seeds: int = 50
-    te: float = 0.01
+    te: float = 0.002
     max_checks: int | None = None
     planner: str = "RRTConnect"
     no_demo_seeds: int = 5
     no_demo_budget: float = 30.0
+    overrides: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if self.seeds < 1:
@@ -100,6 +103,7 @@ class PlanningBenchConfig:
     def command(self) -> str:
         """The ``teachfit bench planning`` command line that runs this configuration."""
         checks = "" if self.max_checks is None else f" --max-checks {self.max_checks}"
+        checks += "".join(f" --task-param {k}={v:g}" for k, v in self.overrides)
         return (
             f"teachfit bench planning --tasks {','.join(self.tasks)} --runs {self.seeds} "
             f"--te {self.te:g}{checks} --planner {self.planner} --no-demo-runs "
@@ -207,7 +211,7 @@ def collision_check_cost(asm: Assembly, n: int = 2000, repeats: int = 3) -> Chec
     """Time the planner's collision check (``collides_xyzq``) at the goal and the start."""
     if n < 1 or repeats < 1:
         raise PlanningError(f"n and repeats must be >= 1, got {n}, {repeats}")
-    checker = CollisionChecker(asm.moving, asm.fixed)
+    checker = CollisionChecker.of(asm)
     goal_pose = Pose.from_matrix(asm.goal)
     goal, start = (
         tuple(float(v) for v in p.as_array()) for p in (goal_pose, Pose.from_matrix(asm.start))
@@ -224,7 +228,7 @@ def collision_check_cost(asm: Assembly, n: int = 2000, repeats: int = 3) -> Chec
 def _task_bench(
     task: str, cfg: PlanningBenchConfig, progress: Callable[[str, int], None] | None
 ) -> TaskBench:
-    asm = build_assembly(task)
+    asm = build_assembly(task, **dict(cfg.overrides))
     mp = MotionPlanner(
         asm, PlannerConfig(planner=cfg.planner, te=cfg.te, max_checks=cfg.max_checks)
     )

@@ -23,20 +23,11 @@ from teachfit.cli.tables import print_markdown, print_table
 from teachfit.core.params import LearningError
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
-_TASK_PARAM = typer.Option("--task-param", help="task parameter override NAME=VALUE (SI units)")
+_TASK_PARAM = o.TASK_PARAM
 
 
 def _overrides(items: list[str] | None) -> tuple[tuple[str, float], ...]:
-    out = []
-    for item in items or []:
-        name, sep, value = item.partition("=")
-        try:
-            out.append((name.strip(), float(value)))
-        except ValueError:
-            sep = ""
-        if not sep or not name.strip():
-            raise LearningError(f"--task-param wants NAME=VALUE with a number, got {item!r}")
-    return tuple(out)
+    return o.task_overrides(items, LearningError)
 
 
 def _worker_counts(workers: str) -> list[int]:

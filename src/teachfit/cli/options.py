@@ -19,6 +19,8 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
+from teachfit.core.errors import TeachfitError
+
 T = TypeVar("T")
 
 #: option name -> (kind, how its help starts); kinds: int, float, text, path, flag
@@ -51,6 +53,7 @@ CANONICAL: dict[str, tuple[str, str]] = {
     "--runs": ("int", "planning runs"),
     "--view": ("flag", "watch the run in MuJoCo's viewer"),
     "--skill": ("text", "skill: built-in name or skill .toml"),
+    "--task-params": ("path", "task parameter overrides from a TOML file"),
 }
 
 
@@ -84,6 +87,48 @@ def task(choices: str = "a built-in name (teachfit tasks) or a task .toml") -> A
 def starts(what: str = "") -> Any:
     """``--starts N``: how many start poses."""
     return typer.Option("--starts", min=1, help="start poses" + (f" {what}" if what else ""))
+
+
+#: ``--task-param NAME=VALUE`` (repeatable): one task parameter override, SI units
+TASK_PARAM = typer.Option("--task-param", help="task parameter override NAME=VALUE (SI units)")
+TaskParams = Annotated[
+    Path | None,
+    typer.Option(
+        "--task-params",
+        help="task parameter overrides from a TOML file of NAME = VALUE lines (SI units; "
+        "--task-param wins)",
+    ),
+]
+
+
+def task_overrides(
+    items: list[str] | None,
+    error: type[Exception] = TeachfitError,
+    path: Path | None = None,
+) -> tuple[tuple[str, float], ...]:
+    """``--task-params FILE`` then ``--task-param NAME=VALUE`` items as ``(name, value)``
+    pairs, later names winning; ``error`` (one line) for a malformed item or file."""
+    out: dict[str, float] = {}
+    if path is not None:
+        import tomllib
+
+        try:
+            table = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            raise error(f"{path}: cannot read the task parameters ({exc})") from None
+        for name, value in table.items():
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise error(f"{path}: {name} must be a number (SI units), got {value!r}")
+            out[name] = float(value)
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep or not name.strip():
+            raise error(f"--task-param wants NAME=VALUE with a number, got {item!r}")
+    return tuple(out.items())
 
 
 Seed = Annotated[int, seed()]
@@ -136,6 +181,8 @@ __all__ = [
     "PointsOld",
     "Render",
     "Seed",
+    "TASK_PARAM",
+    "TaskParams",
     "View",
     "Width",
     "Workers",
@@ -146,4 +193,5 @@ __all__ = [
     "seed",
     "starts",
     "task",
+    "task_overrides",
 ]

@@ -46,11 +46,11 @@ app.add_typer(bench_app, name="bench")
 def parts_show(
     task: Annotated[str, typer.Argument(help="l-groove or tenon")],
     plot: Annotated[Path | None, o.plot("the parts at their start and goal poses")] = None,
+    task_param: Annotated[list[str] | None, o.TASK_PARAM] = None,
+    task_params: o.TaskParams = None,
 ) -> None:
     """Print the parts' dimensions, start and goal poses; optionally plot them."""
-    from teachfit.plans.parts import build_assembly
-
-    asm = build_assembly(task)
+    asm = _assembly(task, task_param, task_params)
     table = Table(title=f"{task} dimensions")
     table.add_column("dimension")
     table.add_column("mm", justify="right")
@@ -75,13 +75,14 @@ def demo_synth(
     seed: Annotated[int, o.seed("the tremor and contacts (demonstration i: seed + i)")] = 0,
     count: Annotated[int, typer.Option(min=1, help="number of demonstrations to write")] = 1,
     overwrite: o.Overwrite = False,
+    task_param: Annotated[list[str] | None, o.TASK_PARAM] = None,
+    task_params: o.TaskParams = None,
 ) -> None:
     """Write synthetic human demonstrations of the pose sequence to HDF5."""
     from teachfit.demonstrations.dataset import write_dataset
-    from teachfit.plans.parts import build_assembly
     from teachfit.plans.synth import synth_demo
 
-    asm = build_assembly(task)
+    asm = _assembly(task, task_param, task_params)
     demos = [synth_demo(asm, seed + i) for i in range(count)]
     write_dataset(out, demos, overwrite=overwrite)
     for demo in demos:
@@ -90,6 +91,13 @@ def demo_synth(
             f"{demo.meta['n_colliding']} in collision"
         )
     console.print(f"wrote {out}")
+
+
+def _assembly(task: str, items: list[str] | None, path: Path | None) -> object:
+    """The task's parts with the ``--task-params`` file and ``--task-param`` overrides."""
+    from teachfit.plans.parts import build_assembly
+
+    return build_assembly(task, **dict(o.task_overrides(items, PlanningError, path)))
 
 
 def _load_demo(spec: str) -> object:
@@ -111,7 +119,12 @@ def plan(
         str | None, typer.Option(help="demonstration FILE.h5:INDEX (FILE.h5: its first)")
     ] = None,
     no_demo: Annotated[bool, typer.Option("--no-demo", help="plan without demonstration")] = False,
-    te: Annotated[float, typer.Option(min=0, help="budget per attempt (s)")] = 0.02,
+    te: Annotated[
+        float | None,
+        typer.Option(
+            min=0, help="budget per attempt (s); default 0.002 (box parts), 0.02 (meshes)"
+        ),
+    ] = None,
     max_checks: Annotated[
         int | None,
         typer.Option(
@@ -130,17 +143,18 @@ def plan(
     save: Annotated[
         Path | None, typer.Option(help="write the path (N, 7) x,y,z,qw,qx,qy,qz as .npy")
     ] = None,
+    task_param: Annotated[list[str] | None, o.TASK_PARAM] = None,
+    task_params: o.TaskParams = None,
 ) -> None:
     """Plan the moving part from its initial to its final pose."""
     import numpy as np
 
     from teachfit.core.geometry import poses_to_array
-    from teachfit.plans.parts import build_assembly
     from teachfit.plans.planner import MotionPlanner, PlannerConfig
 
     if (demo is None) == (not no_demo):
         raise PlanningError("give exactly one of --demo FILE and --no-demo")
-    asm = build_assembly(task)
+    asm = _assembly(task, task_param, task_params)
     mp = MotionPlanner(asm, PlannerConfig(planner=planner, te=te, max_checks=max_checks))
     result = mp.plan(None if no_demo else _load_demo(demo), seed=seed)
     status = "[green]success[/green]" if result.success else "[red]failure[/red]"
@@ -183,7 +197,7 @@ def bench_planning_cmd(
     ] = 50,
     te: Annotated[
         float, typer.Option(min=0, help="budget per attempt (s) with demonstration")
-    ] = 0.01,
+    ] = 0.002,
     max_checks: Annotated[
         int | None,
         typer.Option(
@@ -202,6 +216,16 @@ def bench_planning_cmd(
     no_demo_seeds: Annotated[int | None, o.old("--no-demo-seeds", "--no-demo-runs")] = None,
     write: o.WriteOld = False,
     benchmarks: Annotated[Path | None, o.old("--benchmarks", "--markdown")] = None,
+    task_param: Annotated[list[str] | None, o.TASK_PARAM] = None,
+    task_params: o.TaskParams = None,
+    variants: Annotated[
+        int,
+        typer.Option(
+            min=0,
+            help="also run this many seeded parameter variants per task (clearance 0.5 mm to "
+            "the default, sizes x0.9-1.1), --runs seeds each; 0: none",
+        ),
+    ] = 0,
 ) -> None:
     """Table I of the planning paper (Wang et al. 2019) over many seeds, with and without
     demonstration."""
@@ -219,7 +243,10 @@ def bench_planning_cmd(
         planner=planner,
         no_demo_seeds=no_demo_runs,
         no_demo_budget=no_demo_budget,
+        overrides=o.task_overrides(task_param, PlanningError, task_params),
     )
+    for task in cfg.tasks:  # bad overrides: one line before any run
+        _assembly(task, task_param, task_params)
     with progress_bar() as bar:
         job = bar.add_task("planning", total=cfg.n_runs)
         results = bp.run_planning_bench(
@@ -233,6 +260,41 @@ def bench_planning_cmd(
     print_table(table)
     for line in bp.report_notes(results):
         console.print(line)
+    command = cfg.command() + (f" --variants {variants}" if variants else "")
+    text = bp.to_markdown(results, command=command)
+    if variants:
+        text += _variant_sweep(cfg, variants)
     if markdown is not None:
-        path = append_markdown(markdown, bp.to_markdown(results, command=cfg.command()))
+        path = append_markdown(markdown, text)
         console.print(f"markdown appended to {path}")
+
+
+def _variant_sweep(cfg: object, n: int) -> str:
+    """Run and print the variant sweep; its markdown table."""
+    from teachfit.bench import planning_variants as pv
+    from teachfit.plans.planner import PlannerConfig
+
+    planner = PlannerConfig(planner=cfg.planner, te=cfg.te, max_checks=cfg.max_checks)  # type: ignore[attr-defined]
+    tasks = cfg.tasks  # type: ignore[attr-defined]
+    with progress_bar() as bar:
+        job = bar.add_task("variants", total=len(tasks) * n * cfg.seeds)  # type: ignore[attr-defined]
+        results = pv.run_variants(
+            tasks,
+            n,
+            cfg.seeds,  # type: ignore[attr-defined]
+            planner,
+            progress=lambda label, _done: bar.update(job, advance=1, description=label),
+        )
+    table = Table(title="Guided planning on parameter variants (same settings)")
+    for col in pv.VARIANT_COLUMNS:
+        table.add_column(col)
+    rows = pv.variant_rows(results)
+    for row in rows:
+        table.add_row(*row)
+    print_table(table)
+    lines = [
+        "",
+        "| " + " | ".join(pv.VARIANT_COLUMNS) + " |",
+        "|" + "---|" * len(pv.VARIANT_COLUMNS),
+    ]
+    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows]) + "\n"

@@ -1,12 +1,22 @@
 """Candidate key poses from a demonstration and their ranking (METHODS.md C, paper Fig. 6).
 
-The demonstration's most violently changing pose parameter (pitch, for the L) is fitted with a
-polynomial over time; its derivative at each candidate key pose ranks the candidates by
-descending magnitude, so the most decisive poses are inserted into the planner first.
+The paper's rule (:func:`rank_key_poses`): the demonstration's most violently changing pose
+parameter (pitch, for the L) is fitted with a polynomial over time; its derivative at each
+candidate key pose ranks the candidates by descending magnitude, so the most decisive poses
+are inserted into the planner first.
+
+That rule misses poses where the part moves without turning: on the L-groove the tilted poses
+that carry the part through the opening have a near-zero pitch derivative and rank last, yet
+no plan exists without them (4-6 of 6 poses used, paper 2-3). :func:`straight_chain` ranks by
+what makes a pose decisive for a planner that first tries straight motions: the greedy chain
+of candidates, each the farthest one (in demonstration order) that a straight, collision-free
+motion reaches from the previous. The planner inserts the chain first (in its order), then the
+other candidates by the derivative rule.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,7 +24,14 @@ import numpy as np
 from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 
-__all__ = ["PARAMS", "KeyPoses", "pose_parameters", "rank_key_poses", "select_candidates"]
+__all__ = [
+    "PARAMS",
+    "KeyPoses",
+    "pose_parameters",
+    "rank_key_poses",
+    "select_candidates",
+    "straight_chain",
+]
 
 PARAMS: tuple[str, ...] = ("x", "y", "z", "roll", "pitch", "yaw")
 """Pose parameters: position of ``L`` in ``G`` (m) and extrinsic x-y-z Euler angles (rad)."""
@@ -200,3 +217,22 @@ def rank_key_poses(
         demo_t=t,
         demo_values=column,
     )
+
+
+def straight_chain(n: int, connects: Callable[[int, int], bool]) -> list[int]:
+    """Greedy chain of candidates ``0 .. n-1`` from the start (``-1``) to the goal (``n``).
+
+    From the current node, the chain steps to the farthest later node ``j`` (goal first, then
+    candidates backwards) with ``connects(current, j)`` true (a free straight motion); where
+    none connects, it steps to the next candidate. Returns the candidates in the chain, in
+    demonstration order (the goal is not listed): the smallest set of candidates that such a
+    greedy walk needs, ranked first by the planner.
+    """
+    chain: list[int] = []
+    current = -1
+    while current < n:
+        step = next((j for j in range(n, current + 1, -1) if connects(current, j)), current + 1)
+        if step < n:
+            chain.append(step)
+        current = step
+    return chain

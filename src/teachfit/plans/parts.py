@@ -86,6 +86,11 @@ class Assembly:
         Named dimensions in m, for figures and reports.
     paper : PaperResult
         The paper's Table I numbers for this task.
+    moving_boxes, fixed_boxes : np.ndarray or None
+        (N, 2, 3) low/high corners (m) of axis-aligned boxes whose union is the moving part
+        (in ``L``) and the fixed part (in ``G``): the meshes are built as these unions, and
+        the collision checks test the boxes (:class:`~teachfit.plans.collision.CollisionChecker`).
+        None for parts given only as meshes.
     """
 
     task: str
@@ -99,11 +104,26 @@ class Assembly:
     key_region: float
     dimensions: Mapping[str, float]
     paper: PaperResult
+    moving_boxes: np.ndarray | None = None
+    fixed_boxes: np.ndarray | None = None
 
 
 def _box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> manifold3d.Manifold:
     size = [h - low for low, h in zip(lo, hi, strict=True)]
     return manifold3d.Manifold.cube(size).translate(list(lo))
+
+
+Corners = tuple[tuple[float, float, float], tuple[float, float, float]]
+
+
+def _union(boxes: list[Corners]) -> tuple[np.ndarray, trimesh.Trimesh]:
+    """(N, 2, 3) corners and the mesh of a union of boxes given as (low, high) corners (m)."""
+    corners = np.asarray(boxes, dtype=float)
+    return corners, _to_trimesh(
+        manifold3d.Manifold.batch_boolean(
+            [_box(tuple(lo), tuple(hi)) for lo, hi in corners], manifold3d.OpType.Add
+        )
+    )
 
 
 def _to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
@@ -175,19 +195,25 @@ class LGrooveParams:
     def build(self) -> Assembly:
         """Meshes, start/goal poses and bounds of the L-groove task."""
         b, t, w = self.base_length, self.base_thickness, self.width
-        base = _box((0.0, -w / 2, 0.0), (b, w / 2, t))
-        leg = _box((b - self.leg_thickness, -w / 2, t), (b, w / 2, t + self.leg_height))
-        moving = _to_trimesh(base + leg)
-
-        lc, d, wc = self.cavity_length, self.cavity_depth, w + 2 * self.clearance
-        top = d + self.lip_thickness
-        outer = _box(
-            (-lc / 2 - self.wall, -wc / 2 - self.wall, -self.wall),
-            (lc / 2 + self.wall, wc / 2 + self.wall, top),
+        moving_boxes, moving = _union(
+            [
+                ((0.0, -w / 2, 0.0), (b, w / 2, t)),  # base
+                ((b - self.leg_thickness, -w / 2, t), (b, w / 2, t + self.leg_height)),  # leg
+            ]
         )
-        cavity = _box((-lc / 2, -wc / 2, 0.0), (lc / 2, wc / 2, d))
-        opening = _box((self.opening_start, -wc / 2, d - 1e-4), (lc / 2, wc / 2, top + 1e-3))
-        fixed = _to_trimesh(outer - cavity - opening)
+        lc, d, wc = self.cavity_length, self.cavity_depth, w + 2 * self.clearance
+        top, e, y = d + self.lip_thickness, self.wall, wc / 2
+        # a block with the cavity and, above its +x end, the opening cut out, as six boxes
+        fixed_boxes, fixed = _union(
+            [
+                ((-lc / 2 - e, -y - e, -e), (lc / 2 + e, y + e, 0.0)),  # floor
+                ((-lc / 2 - e, y, 0.0), (lc / 2 + e, y + e, top)),  # side walls
+                ((-lc / 2 - e, -y - e, 0.0), (lc / 2 + e, -y, top)),
+                ((-lc / 2 - e, -y, 0.0), (-lc / 2, y, top)),  # end walls
+                ((lc / 2, -y, 0.0), (lc / 2 + e, y, top)),
+                ((-lc / 2, -y, d), (self.opening_start, y, top)),  # lip
+            ]
+        )
 
         z_rest = (d - t) / 2
         goal = pose_from_xyz_rpy(
@@ -222,6 +248,8 @@ class LGrooveParams:
             key_region=0.005,
             dimensions=MappingProxyType(dims),
             paper=PaperResult(candidates=6, used=(2, 3), time_s=(1.43, 3.03)),
+            moving_boxes=moving_boxes,
+            fixed_boxes=fixed_boxes,
         )
 
 
@@ -254,12 +282,15 @@ class TenonParams:
     def build(self) -> Assembly:
         """Meshes, start/goal poses and bounds of the tenon task."""
         a, s = self.bar_side, self.shoulder_side
-        bar = _box((0.0, -a / 2, -a / 2), (self.bar_length, a / 2, a / 2))
-        shoulder = _box(
-            (self.bar_length, -s / 2, -s / 2),
-            (self.bar_length + self.shoulder_length, s / 2, s / 2),
+        moving_boxes, moving = _union(
+            [
+                ((0.0, -a / 2, -a / 2), (self.bar_length, a / 2, a / 2)),  # bar
+                (
+                    (self.bar_length, -s / 2, -s / 2),
+                    (self.bar_length + self.shoulder_length, s / 2, s / 2),
+                ),  # shoulder
+            ]
         )
-        moving = _to_trimesh(bar + shoulder)
 
         m, gap, side, zc = (
             self.mortise_thickness,
@@ -267,13 +298,17 @@ class TenonParams:
             self.mortise_side,
             self.hole_height,
         )
-        h = a + 2 * self.clearance
-        solid = None
-        for x0 in (0.0, m + gap):
-            block = _box((x0, -side / 2, 0.0), (x0 + m, side / 2, side))
-            hole = _box((x0 - 1e-3, -h / 2, zc - h / 2), (x0 + m + 1e-3, h / 2, zc + h / 2))
-            solid = block - hole if solid is None else solid + (block - hole)
-        fixed = _to_trimesh(solid)
+        h, y = (a + 2 * self.clearance) / 2, side / 2
+        boxes = []
+        for x0 in (0.0, m + gap):  # each mortise: a block with a square hole, as four boxes
+            x1 = x0 + m
+            boxes += [
+                ((x0, -y, 0.0), (x1, y, zc - h)),  # below the hole
+                ((x0, -y, zc + h), (x1, y, side)),  # above it
+                ((x0, -y, zc - h), (x1, -h, zc + h)),  # beside it
+                ((x0, h, zc - h), (x1, y, zc + h)),
+            ]
+        fixed_boxes, fixed = _union(boxes)
 
         near_face = 2 * m + gap
         goal = pose_from_xyz_rpy(np.array([-0.006, 0.0, zc]), [0, 0, 0])
@@ -300,6 +335,8 @@ class TenonParams:
             key_region=0.02,
             dimensions=MappingProxyType(dims),
             paper=PaperResult(candidates=11, used=(2, 5), time_s=(1.26, 2.66)),
+            moving_boxes=moving_boxes,
+            fixed_boxes=fixed_boxes,
         )
 
 

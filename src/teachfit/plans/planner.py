@@ -1,11 +1,15 @@
 """Motion planning of the moving part's 6-DOF pose guided by demonstrated key poses.
 
 The loop of the paper (METHODS.md C, Fig. 7): plan from the initial to the final pose with
-RRT-Connect (OMPL, SE(3), mesh-mesh validity in Python); when an attempt finds no path within
-``te`` seconds, insert the next ranked key pose and plan segment by segment. Each segment first
-tries the straight motion, and solved segments are reused by later attempts. A key pose in
-collision is replaced by the nearest collision-free pose sampled around it. The final path is
-shortcut and smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
+RRT-Connect (OMPL, SE(3), validity by coal in Python: box or mesh checks, see
+:mod:`.collision`); when an attempt finds no path within ``te`` seconds, insert the next ranked
+key pose and plan segment by segment. A key pose in collision is first replaced by the nearest
+collision-free pose sampled around it. The ranking puts first the chain of key poses joined by
+free straight motions (:func:`~teachfit.plans.keyposes.straight_chain`; its motion checks are
+reused by the attempts), then the rest by the paper's derivative. Each segment tries the
+straight motion, then, between neighbouring key poses, the demonstrated motion, then
+RRT-Connect; solved segments are reused by later attempts. The final path is shortcut and
+smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
 
 Every query seeds OMPL's global RNG from its ``seed`` (:func:`seed_ompl`), so the samplers of
 the planners and of the path simplifier it creates draw the same numbers whatever ran before in
@@ -21,6 +25,7 @@ kernel (scipy for batches, its MuJoCo-backed matrix routine in the collision che
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -29,7 +34,7 @@ import numpy as np
 import ompl.base as ob
 import ompl.geometric as og
 import ompl.util as ou
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import (
@@ -42,7 +47,7 @@ from teachfit.core.geometry import (
     wxyz_to_rotation,
 )
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
-from teachfit.plans.keyposes import KeyPoses, rank_key_poses
+from teachfit.plans.keyposes import KeyPoses, rank_key_poses, straight_chain
 from teachfit.plans.parts import Assembly
 
 __all__ = [
@@ -92,6 +97,22 @@ def seed_ompl(seed: int) -> None:
         ou.setLogLevel(level)
 
 
+def _slerp(qa: np.ndarray, qb: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """(N, 4) unit quaternions w-x-y-z from ``qa`` (s = 0) to ``qb`` (s = 1) along the shorter
+    arc, as OMPL's SO(3) interpolation. Written out (the textbook formula) because scipy's
+    ``Slerp`` costs ~0.5 ms to build per segment, and densifying runs per straight motion."""
+    qa = qa / np.linalg.norm(qa)
+    qb = qb / np.linalg.norm(qb)
+    dot = float(qa @ qb)
+    if dot < 0.0:
+        qb, dot = -qb, -dot
+    theta = np.arccos(min(dot, 1.0))
+    if theta < 1e-9:
+        return np.tile(qa, (len(s), 1))
+    wa, wb = np.sin((1.0 - s) * theta), np.sin(s * theta)
+    return (wa[:, None] * qa + wb[:, None] * qb) / np.sin(theta)
+
+
 def matrix_to_state(T: np.ndarray) -> np.ndarray:
     """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform (scipy's quaternion sign)."""
     T = np.asarray(T, dtype=float)
@@ -107,10 +128,12 @@ class PlannerConfig:
     ----------
     planner : str
         OMPL planner, a key of :data:`PLANNERS` (paper: a RRT-Connect variant).
-    te : float
+    te : float or None
         Time budget (s) of one attempt; when exceeded the next key pose is inserted. The paper
         used 5 s with Panda3D's collision checks in Python; t_e is in effect a budget of
-        samples, and our coal checks are orders of magnitude faster, so the default is 0.02 s.
+        samples, ~200 of our checks by default (None): 0.002 s on parts made of boxes (~10 us
+        a check), 0.02 s on meshes (~0.1 ms): RRT-Connect's short detours; the key poses do
+        the rest.
     max_checks : int or None
         Budget of one attempt in collision checks instead of ``te`` seconds (``te`` is then
         ignored): the result of a query no longer depends on the machine's speed or load.
@@ -134,7 +157,7 @@ class PlannerConfig:
     """
 
     planner: str = "RRTConnect"
-    te: float = 0.02
+    te: float | None = None
     resolution: float = 0.0005
     verify_resolution: float = 0.0005
     shortcut: bool = True
@@ -147,7 +170,8 @@ class PlannerConfig:
     def __post_init__(self) -> None:
         if self.planner not in PLANNERS:
             raise PlanningError(f"unknown planner {self.planner!r}; known: {', '.join(PLANNERS)}")
-        if not self.te > 0 or not self.resolution > 0 or not self.verify_resolution > 0:
+        te_ok = self.te is None or self.te > 0
+        if not te_ok or not self.resolution > 0 or not self.verify_resolution > 0:
             raise PlanningError("te, resolution and verify_resolution must be > 0")
         if self.max_checks is not None and self.max_checks < 1:
             raise PlanningError(f"max_checks must be >= 1 or None, got {self.max_checks}")
@@ -235,10 +259,10 @@ class MotionPlanner:
     def __init__(self, asm: Assembly, config: PlannerConfig | None = None) -> None:
         self.asm = asm
         self.config = config or PlannerConfig()
-        self.checker = CollisionChecker(asm.moving, asm.fixed)
+        self.checker = CollisionChecker.of(asm)
         region = self.config.key_region
         self.key_region = asm.key_region if region is None else region
-        self._near = CollisionChecker(asm.moving, asm.fixed, margin=self.key_region)
+        self._near = CollisionChecker.of(asm, margin=self.key_region)
         self.start = matrix_to_state(asm.start)
         self.goal = matrix_to_state(asm.goal)
         for label, state in (("start", self.start), ("goal", self.goal)):
@@ -337,12 +361,28 @@ class MotionPlanner:
 
     # -- segments -----------------------------------------------------------------------------
     def _plan_segment(
-        self, a: np.ndarray, b: np.ndarray, budget: float, by_checks: bool
+        self,
+        a: np.ndarray,
+        b: np.ndarray,
+        budget: float,
+        by_checks: bool,
+        via: np.ndarray | None = None,
+        try_straight: bool = True,
     ) -> np.ndarray | None:
-        """Path from ``a`` to ``b`` within ``budget`` (collision checks or seconds), or None."""
+        """Path from ``a`` to ``b`` within ``budget`` (collision checks or seconds), or None.
+
+        Tries the straight motion (unless ``try_straight`` is False: known to collide), then
+        the demonstrated motion ``via`` ((M, 7) states between the two key poses, when given)
+        if each of its steps is free, then RRT-Connect.
+        """
         sa, sb = self._to_ompl(a), self._to_ompl(b)
-        if self.si.checkMotion(sa, sb):
+        if try_straight and self.si.checkMotion(sa, sb):
             return np.stack([a, b])
+        if via is not None and len(via) > 0:
+            demo_path = np.concatenate([a[None], via, b[None]])
+            states = [self._to_ompl(q) for q in demo_path]
+            if all(self.si.checkMotion(p, q) for p, q in zip(states[:-1], states[1:], strict=True)):
+                return demo_path
         if budget < (1.0 if by_checks else 1e-3):
             return None
         ss = og.SimpleSetup(self.si)
@@ -377,7 +417,7 @@ class MotionPlanner:
             Demonstration of ``L2G`` for this task (``frame="G"``, ``child_frame="L"``); None
             plans without one (a single attempt of ``te`` seconds).
         te : float, optional
-            Budget (s) per attempt; defaults to ``config.te``.
+            Budget (s) per attempt; defaults to ``config.te`` (see :class:`PlannerConfig`).
         max_checks : int, optional
             Budget per attempt in collision checks instead of seconds; defaults to
             ``config.max_checks`` (None: the budget is ``te``).
@@ -391,7 +431,9 @@ class MotionPlanner:
         """
         t0 = time.perf_counter()
         checks0 = self.checker.n_checks
-        te = self.config.te if te is None else float(te)
+        if te is None:
+            te = self.config.te or (0.002 if self.checker.on_boxes else 0.02)
+        te = float(te)
         if not te > 0:
             raise PlanningError(f"te must be > 0 s, got {te!r}")
         checks = self.config.max_checks if max_checks is None else max_checks
@@ -402,18 +444,19 @@ class MotionPlanner:
         seed_ompl(seed)
         rng = np.random.default_rng(seed)
         keys: KeyPoses | None = None
+        repaired: dict[int, np.ndarray | None] = {}
+        straight: dict[tuple[int, int], bool] = {}
         if demo is not None:
             keys = self._rank(demo)
+            repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+            keys, straight = self._chain_first(keys, repaired)
         n_cand = 0 if keys is None else len(keys.indices)
-        repaired: dict[int, np.ndarray | None] = {}
+        via = self._demonstrated(demo, keys)
         solved: dict[tuple[int, int], np.ndarray] = {}
         failed: dict[tuple[int, int], float] = {}
         attempts = 0
         for k in range(min(self.config.first_key_poses, n_cand), n_cand + 1):
             chosen = [] if keys is None else sorted(int(i) for i in keys.order[:k])
-            for i in chosen:
-                if i not in repaired:
-                    repaired[i] = self.repair(matrix_to_state(keys.L2G[i]), rng)
             ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
             states = {-1: self.start, n_cand: self.goal} | {i: repaired[i] for i in ids[1:-1]}
             if self.approach is not None:  # the goal is reached by the straight insertion
@@ -430,7 +473,12 @@ class MotionPlanner:
                 budget = budget_of_attempt - spent
                 if failed.get((a, b), -1.0) * 1.5 >= budget:
                     break  # failed before with as much budget: insert another key pose
-                seg = self._plan_segment(states[a], states[b], budget, by_checks)
+                if straight.get((a, b)):  # found free while ranking
+                    seg = np.stack([states[a], states[b]])
+                else:
+                    seg = self._plan_segment(
+                        states[a], states[b], budget, by_checks, via(a, b), (a, b) not in straight
+                    )
                 if seg is None:
                     failed[(a, b)] = budget
                     break
@@ -489,9 +537,11 @@ class MotionPlanner:
         quat = np.asarray(demo.quat, dtype=float)  # type: ignore[attr-defined]
         eligible = None
         if self.key_region > 0 and pos.shape == (len(t), 3) and quat.shape == (len(t), 4):
-            eligible = np.array(
-                [self._near.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True)]
-            )
+            # every third sample, each standing for its neighbours (a 30 Hz demonstration moves
+            # ~1 mm a sample): the region is a coarse mask, and this is a third of the checks
+            step = 3
+            near = [self._near.collides_xyzq(*pos[i], *quat[i]) for i in range(0, len(t), step)]
+            eligible = np.repeat(np.array(near, dtype=bool), step)[: len(t)]
         return rank_key_poses(
             t,
             pos,
@@ -501,6 +551,52 @@ class MotionPlanner:
             char_length=self.radius,
             eligible=eligible,
         )
+
+    def _demonstrated(
+        self, demo: object | None, keys: KeyPoses | None
+    ) -> Callable[[int, int], np.ndarray | None]:
+        """``via(a, b)``: the demonstrated states strictly between neighbouring nodes ``a`` and
+        ``b = a + 1`` (-1 the start, ``0 .. K-1`` the candidates, ``K`` the goal); None for
+        other pairs (the key poses between them are what the planner inserts), for the
+        approach of a mesh task, or without a demonstration."""
+        if demo is None or keys is None:
+            return lambda a, b: None
+        demo_states = np.concatenate(
+            [np.asarray(demo.pos, dtype=float), np.asarray(demo.quat, dtype=float)], axis=1
+        )  # type: ignore[attr-defined]
+        n, last = len(keys.indices), len(demo_states) - 1
+
+        def via(a: int, b: int) -> np.ndarray | None:
+            if b > n or b != a + 1:
+                return None
+            ia = 0 if a < 0 else int(keys.indices[a])
+            ib = last if b == n else int(keys.indices[b])
+            return demo_states[ia + 1 : ib]
+
+        return via
+
+    def _chain_first(
+        self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]
+    ) -> tuple[KeyPoses, dict[tuple[int, int], bool]]:
+        """``keys`` reordered: the straight chain (:func:`straight_chain`) first, then the rest
+        by the derivative rule; and the straight motions tested meanwhile (OMPL's motion check,
+        the attempts' own), by pair of the attempts' node ids, for the attempts to reuse."""
+        n = len(keys.indices)
+        end = n if self.approach is None else n + 1  # the attempts' id of the chain's last node
+        nodes = {-1: self.start, n: self.goal if self.approach is None else self.approach}
+        nodes |= repaired
+        straight: dict[tuple[int, int], bool] = {}
+
+        def connects(a: int, b: int) -> bool:
+            sa, sb = nodes[a], nodes[b]
+            ok = sa is not None and sb is not None
+            ok = ok and bool(self.si.checkMotion(self._to_ompl(sa), self._to_ompl(sb)))
+            straight[(a, end if b == n else b)] = ok
+            return ok
+
+        chain = straight_chain(n, connects)
+        rest = [int(i) for i in keys.order if int(i) not in chain]
+        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int)), straight
 
     def _finish(self, path: np.ndarray) -> np.ndarray | None:
         """Shortcut and smooth ``path`` with OMPL, then verify densely; None if unverifiable."""
@@ -529,8 +625,7 @@ class MotionPlanner:
         for a, b in zip(path[:-1], path[1:], strict=True):
             n = max(int(np.ceil(self._distance(a, b[None])[0] / res)), 1)
             s = np.linspace(0.0, 1.0, n + 1)[1:]
-            rots = wxyz_to_rotation(np.stack([a[3:], b[3:]]))
-            q = rotation_to_wxyz(Slerp([0.0, 1.0], rots)(s), canonical=False)
+            q = _slerp(a[3:], b[3:], s)
             out.append(np.concatenate([a[:3] + s[:, None] * (b[:3] - a[:3]), q], axis=1))
         return np.concatenate(out)
 

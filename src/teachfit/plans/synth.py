@@ -138,7 +138,8 @@ def synth_demo(
     rate_hz : float
         Sampling rate (Hz) of the capture.
     tremor_mm, tremor_deg : float
-        Standard deviation of the tremor in position (mm) and angle (deg).
+        Standard deviation of the tremor in position (mm) and angle (deg); each is capped so
+        that twice it moves the part's farthest point at most half the clearance.
     p_penetrate : float
         Probability that the demonstration contains a short push into contact.
 
@@ -146,11 +147,18 @@ def synth_demo(
     -------
     Demonstration
         ``frame="G"``, ``child_frame="L"``, ``source="synthetic"``, no wrench; ``meta`` holds
-        the seed and the number of colliding samples.
+        the seed, the number of colliding samples, whether the deliberate push happened and
+        the tremors used.
     """
     if rate_hz <= 0 or tremor_mm < 0 or tremor_deg < 0 or not 0 <= p_penetrate <= 1:
         raise TaskError("rate_hz must be > 0, tremors >= 0 and p_penetrate in [0, 1]")
     rng = np.random.default_rng(seed)
+    # a steady hand keeps its tremor within the fit: 2 sigma of either tremor moves the part's
+    # farthest point at most half the clearance, so tight variants get collision-free scripts
+    room = 0.25 * float(asm.dimensions["clearance"])
+    radius = float(np.linalg.norm(asm.moving.vertices, axis=1).max())
+    tremor_mm = min(tremor_mm, 1e3 * room)
+    tremor_deg = min(tremor_deg, float(np.degrees(room / radius)))
     t, pos, rpy = keyframes_to_poses(nominal_keyframes(asm), rate_hz)
     n = len(t)
     # tremor: white noise low-passed at 2 Hz (physiological tremor and slow drift of a hand)
@@ -160,13 +168,14 @@ def synth_demo(
     taper = np.minimum(1.0, np.minimum(np.arange(n), np.arange(n)[::-1]) / 5.0)[:, None]
     pos = pos + 1e-3 * tremor_mm * noise[:, :3] * taper
     rpy = rpy + tremor_deg * noise[:, 3:] * taper
-    if rng.random() < p_penetrate:
+    pushed = rng.random() < p_penetrate
+    if pushed:
         # a short push sideways into the fixed part, a typical capture artefact
         i0 = int(rng.integers(n // 3, max(n // 3 + 1, n - 8)))
         span = slice(i0, min(i0 + 4, n - 1))
         pos[span, 1] += rng.choice([-1.0, 1.0]) * (asm.dimensions["clearance"] + 0.0008)
     quat = rotation_to_wxyz(Rotation.from_euler("xyz", rpy, degrees=True))  # w >= 0
-    checker = CollisionChecker(asm.moving, asm.fixed)
+    checker = CollisionChecker.of(asm)
     colliding = sum(checker.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True))
     return Demonstration(
         t=t,
@@ -178,5 +187,12 @@ def synth_demo(
         frame="G",
         child_frame="L",
         name=f"{asm.task}-synth-{seed}",
-        meta={"seed": int(seed), "n_colliding": int(colliding), "generator": "teachfit.plans"},
+        meta={
+            "seed": int(seed),
+            "n_colliding": int(colliding),
+            "pushed": bool(pushed),
+            "tremor_mm": float(tremor_mm),
+            "tremor_deg": float(tremor_deg),
+            "generator": "teachfit.plans",
+        },
     )
