@@ -206,7 +206,8 @@ def bench_assembly(
             from teachfit.viz.assembly_figures import plot_success_by_error
 
             path = plot.with_name(f"{plot.stem}-{name}{plot.suffix}")
-            console.print(f"figure -> {plot_success_by_error(rows, path, name)}")
+            title = f"{name}: success against the taught-hole error, {trials} trials, seed {seed}"
+            console.print(f"figure -> {plot_success_by_error(rows, path, title)}")
 
 
 def _print_trials(error_col: str, rows: list[tuple[Any, str, str, Sequence[str]]]) -> None:

@@ -60,6 +60,15 @@ def plot_phases(trace: ExecutionResult, path: str | Path, title: str = "") -> Pa
     return _save(fig, path)
 
 
+#: legend labels of the benchmark's methods (other names are shown as they are)
+_METHOD_LABELS = {
+    "skill": "(a) skill alone",
+    "search": "(b) learned search alone",
+    "open-loop": "(c) plan, open loop",
+    "joined": "(d) joined pipeline",
+}
+
+
 def plot_success_by_error(
     rows: Mapping[str, Sequence[tuple[float, SuccessSummary]]], path: str | Path, title: str = ""
 ) -> Path:
@@ -71,11 +80,12 @@ def plot_success_by_error(
         rate = np.array([p[1].rate for p in pts])
         lo = np.clip(rate - np.array([p[1].low for p in pts]), 0.0, None)  # rounding
         hi = np.clip(np.array([p[1].high for p in pts]) - rate, 0.0, None)
-        ax.errorbar(e, rate, yerr=[lo, hi], marker="o", ms=4, capsize=3, lw=1.2, label=method)
+        label = _METHOD_LABELS.get(method, method)
+        ax.errorbar(e, rate, yerr=[lo, hi], marker="o", ms=4, capsize=3, lw=1.2, label=label)
     ax.set_xlabel("taught-hole error (mm)")
     ax.set_ylabel("success rate")
     ax.set_ylim(-0.05, 1.05)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, title="bars: Wilson 95 % interval", title_fontsize=7)
     ax.set_title(title, fontsize=9)
     return _save(fig, path)

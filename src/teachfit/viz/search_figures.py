@@ -56,6 +56,10 @@ def samples_over_distribution(
         ax.plot(s[:, 0] * _MM, s[:, 1] * _MM, ".", color="crimson", ms=2.5)
         ax.set_title(f"N = {n}")
         ax.set_xlabel("x (mm)")
+        # the density's grid, not the samples, frames every panel (an outlier outside it
+        # would widen one panel and leave a blank margin)
+        ax.set_xlim(gx[0, 0], gx[0, -1])
+        ax.set_ylim(gy[0, 0], gy[-1, 0])
         ax.set_aspect("equal")
     axes[0, 0].set_ylabel("y (mm)")
     fig.legend(
@@ -142,7 +146,12 @@ def feedforward_arrows(traj: SearchTrajectory, wrench: np.ndarray, every: int = 
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_aspect("equal")
-    ax.set_title(f"{traj.method}: GMR feed-forward force along the trajectory", fontsize=10)
+    n = "" if traj.samples is None else f", N = {len(traj.samples)}"
+    ax.set_title(
+        f"{traj.method.replace('tshix', 'TSHIX')}{n}: GMR feed-forward force along the trajectory\n"
+        f"(search frame; an arrow every {int(every)} set-points)",
+        fontsize=10,
+    )
     fig.tight_layout()
     return fig
 
