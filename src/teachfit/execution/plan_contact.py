@@ -76,7 +76,7 @@ L_RETRY = (0.06, 0.002, 0.015, 3)
 #: under twice its 1 mm clearance), speed (m/s), radius (m, the capture error moved to the
 #: first mortise by the rotation error), push (N), advance that ends it (m), time (s); and
 #: the resistance along the insertion (N) that stops the tracking as stuck on a mortise face
-SPIRAL = (0.0015, 0.01, 0.005, 8.0, 0.003, 20.0)
+SPIRAL = (0.0015, 0.01, 0.005, 5.0, 0.003, 20.0)
 F_STUCK = 25.0
 #: seating push (s) before a recovery
 T_SEAT = 2.5

@@ -5,10 +5,10 @@ The recovery nodes of :mod:`teachfit.execution.plan_contact`, when the part stop
 - :class:`RetryPath` (the L resting on the groove's lip because the capture error put the
   opening elsewhere, or jammed pitched): backs the part out along the path it came
   (collision-free by construction, unlike a straight retreat), shifts the path's remainder
-  across the insertion (task x-y) by the next offset of :data:`RING` times ``radius`` (the
-  centre first: a plain second try; then opposite directions, then the diagonals) and
-  follows it again to its end. Plain geometry on the plan's own poses: no library plans
-  "the same path, back and shifted".
+  across the insertion (task x-y) by ``radius`` -- first where the contact pushed the part
+  off its set-point, else (and then) along :data:`RING` (the centre: a plain second try;
+  opposite directions; the diagonals) -- and follows it again to its end. Plain geometry on
+  the plan's own poses: no library plans "the same path, back and shifted".
 - :class:`SpiralPush` (a tenon's face on a mortise): presses the part along the insertion
   (task -z, force-controlled: the z set-point follows the part) while its set-point runs an
   outward Archimedean spiral across it, until the part has advanced ``advance`` (the hole
@@ -39,6 +39,11 @@ RING = ((0.0, 0.0),) + tuple(
     (math.cos(math.radians(a)), math.sin(math.radians(a)))
     for a in (90, 270, 0, 180, 45, 225, 135, 315)
 )
+
+
+#: lateral deflection (m) of the part from its set-point that gives the first retry its
+#: direction: above the tracking noise, below a part lifted onto a wall
+DEFLECTION = (0.0005, 0.005)
 
 
 def time_poses(pos: np.ndarray, quat: np.ndarray, speed: float, angular_speed: float) -> np.ndarray:
@@ -129,18 +134,30 @@ class _RetryRun(PrimitiveRun):
         self.path, self.back, self.radius, self.speed, self.ang = path, back, radius, speed, ang
         self.cfg = cfg
         self.entries = 0
+        self.skip = 0  # 1 once the first retry went where the contact pushed the part
         self.follow: _FollowRun | None = None
 
     def enter(self, pc: Percept) -> None:
-        d = RING[self.entries % len(RING)]
+        offset = self.radius * self._direction(pc)
         self.entries += 1
-        offset = self.radius * np.asarray(d)
         setpoint = (pc.p_d.copy(), pc.q_d.copy())
         pos, quat = retry_poses(self.path, pc.p.copy(), setpoint, self.back, offset)
         t = time_poses(pos, quat, self.speed, self.ang)
         traj = SetpointTrajectory.from_path(t, pos, quat, name=f"retry {self.entries}")
         self.follow = _FollowRun(traj, self.cfg)
         self.follow.enter(pc)
+
+    def _direction(self, pc: Percept) -> np.ndarray:
+        """The first retry goes where the contact pushed the part off its set-point across
+        the insertion (if by :data:`DEFLECTION`); the next ones, or all when the part was
+        lifted farther (on top of a wall: no direction), follow :data:`RING`."""
+        if self.entries == 0:
+            dev = pc.p[:2] - pc.p_d[:2]
+            norm = float(np.linalg.norm(dev))
+            if DEFLECTION[0] <= norm <= DEFLECTION[1]:
+                self.skip = 1
+                return dev / norm
+        return np.asarray(RING[(self.entries - self.skip) % len(RING)])
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         assert self.follow is not None, "enter() first"
@@ -159,8 +176,10 @@ class SpiralPush(Primitive):
     radius: Value = "spiral_radius"
     push: Value = "spiral_push"
     advance: Value = "spiral_advance"
+    #: stiff across (the friction of the pressed face lags the part ~ mu push / k behind the
+    #: spiral), soft in rotation (the part aligns itself with the hole once it is caught)
     stiffness: tuple[float, float, float, float, float, float] = (
-        1000.0, 1000.0, 300.0, 40.0, 40.0, 40.0,
+        3000.0, 3000.0, 300.0, 30.0, 30.0, 30.0,
     )  # fmt: skip
     kind: ClassVar[str] = "spiral_push"
 
