@@ -26,3 +26,23 @@ def test_bench_task_runs_each_method_on_the_same_trials():
     for pts in rows.values():
         ((err, summary),) = pts
         assert err == 0.0 and summary.trials == 1 and summary.successes == 1
+
+
+def test_learned_parameters_add_a_joined_learned_row(tmp_path):
+    import pytest
+
+    from teachfit.bench.assembly import bench_inputs
+    from teachfit.core.errors import TeachfitError
+
+    task = get_task("peg2d")
+    model = raster_model(task)
+    path = tmp_path / "peg.model"
+    model.save(path)
+    params = tmp_path / "best.toml"
+    params.write_text("[params]\nt_switch = 0.4\nsearch_points = 30\n", encoding="utf-8")
+    got, learned = bench_inputs(["peg2d"], path, params)
+    assert got is not None and (learned["t_switch"], learned["search_points"]) == (0.4, 30.0)
+    with pytest.raises(TeachfitError, match="exactly one"):
+        bench_inputs(["peg2d", "socket3d"], path, None)
+    rows = bench_task("peg2d", [0.0], 1, workers=0, methods=(), model=got, learned=learned)
+    assert list(rows) == ["joined-learned"] and rows["joined-learned"][0][1].successes == 1

@@ -59,3 +59,12 @@ def test_assemble_bad_input_is_one_line_and_exit_2(peg_model):
 def test_assemble_l_groove_with_a_missing_demo_is_one_line(tmp_path):
     res = invoke("assemble", "--task", "l-groove", "--demo", tmp_path / "none.h5", "--trials", 1)
     assert res.exit_code == 2 and "none.h5" in res.output and "Traceback" not in res.output
+
+
+def test_bench_assembly_params_are_checked_before_any_trial(tmp_path, peg_model):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("t_switch = 99.0\n", encoding="utf-8")
+    res = invoke("bench", "assembly", "--tasks", "peg2d", "--search", peg_model, "--params", bad)
+    assert res.exit_code == 2 and "bad.toml" in res.output and "Traceback" not in res.output
+    res = invoke("bench", "assembly", "--tasks", "peg2d,socket3d", "--search", peg_model)
+    assert res.exit_code == 2 and "exactly one peg-type task" in res.output

@@ -38,7 +38,13 @@ def _final_slide(part: str, back: float = 0.005) -> SetpointTrajectory:
 def test_seating_skill_and_open_loop_graphs():
     path = _final_slide("l-groove")
     joined = contact_skill(path, "l-groove", "joined")
-    assert [n.name for n in joined.nodes] == ["path", "seat"]
+    assert [n.name for n in joined.nodes] == ["path", "seat", "retry"]
+    assert [n.name for n in contact_skill(path, "l-groove", retries=0).nodes] == ["path", "seat"]
+    ctx = joined.params.context
+    assert (
+        ctx["t_max"].value
+        > contact_skill(path, "l-groove", retries=0).params.context["t_max"].value
+    )
     assert [n.name for n in contact_skill(path, "l-groove", "open-loop").nodes] == ["path"]
     assert contact_skill(path, "tenon").params.context["seat_depth"].value == pytest.approx(0.006)
 

@@ -78,3 +78,24 @@ def test_mesh_task_scales_the_teacher_to_its_fit(mesh_examples):
     assert task.params.demo_offset + style.sweep_halfwidth < task.detection_radius
     demos, discarded = BlindTeacher(task, seed=0).record(1, max_attempts=1)
     assert discarded == [] and task.ground_truth_inserted(Pose(demos[0].pos[-1], demos[0].quat[-1]))
+
+
+def test_unchamfered_yaw_task_gets_a_fine_spiral_inside_its_yaw_tolerance():
+    puzzle = get_task("puzzle")
+    style = style_for(puzzle)
+    assert style.pattern == "spiral"
+    assert style.spiral_pitch == pytest.approx(puzzle.params.clearance)
+    assert style.rz_wiggle < puzzle.rz_tolerance and style.rz_belief_sigma < puzzle.rz_tolerance
+    # an asked-for pattern and asked-for fields stay; chamfered or yaw-free tasks are unchanged
+    zigzag = style_for(puzzle, TeacherStyle(pattern="zigzag", rz_wiggle=0.3))
+    assert zigzag.pattern == "zigzag" and zigzag.rz_wiggle == 0.3
+    assert zigzag.spiral_pitch == pytest.approx(puzzle.params.clearance)
+    for name in ("key", "peg", "peg2d", "socket3d"):
+        assert style_for(get_task(name)) == TeacherStyle()
+
+
+def test_blind_teacher_inserts_the_unchamfered_puzzle_piece():
+    task = get_task("puzzle")  # 0/10 demonstrations with the default sweep
+    demo, why = BlindTeacher(task, seed=0).demonstrate()
+    assert demo is not None, why
+    assert task.ground_truth_inserted(Pose(demo.pos[-1], demo.quat[-1]))

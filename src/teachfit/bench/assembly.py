@@ -8,24 +8,37 @@ runs the same ``trials`` trials (taught hole, start, seeds from
 blind teacher's demonstrations, as in seed A's benchmarks: one worst-case demonstration on
 ``peg2d`` and on other x-y tasks, two from opposite ends on ``socket3d`` and other x-y-rz tasks.
 Rows give success (Wilson 95 % interval) and the median time to insertion (s from the start,
-the approach included).
+the approach included). With ``learned`` parameters (e.g. ``teachfit learn skill --skill
+peg-in-hole+search:MODEL``) a fifth row, ``"joined-learned"``, runs the joined graph with them
+on the same trials.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 
 from teachfit.bench.search import ROBOT, _peg_demo, _socket_demos
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.assembly import METHODS, AssemblyTrial, assembly_jobs, run_assembly
+from teachfit.execution.assembly import (
+    JOINED_LEARNED,
+    METHODS,
+    AssemblyTrial,
+    assembly_jobs,
+    method_skill,
+    run_assembly,
+)
 from teachfit.execution.teacher import BlindTeacher
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
+from teachfit.skills.params import read_params_toml
 from teachfit.tasks.registry import get_task
 
 Rows = dict[str, list[tuple[float, SuccessSummary]]]
+#: the planned-path cells (``bench_plan_task``); every other task is peg-type (``bench_task``)
+PLAN_CELLS = ("l-groove", "tenon")
 
 
 def task_model(name: str, seed: int = 0) -> SearchModel:
@@ -38,6 +51,24 @@ def task_model(name: str, seed: int = 0) -> SearchModel:
     n = 2 if task.has_rz else 1
     demos, _ = BlindTeacher(task, seed=seed, robot=ROBOT[0]).record(n)
     return SearchModel.fit(demos, name, covariance="diag" if n > 1 else "full")
+
+
+def bench_inputs(
+    names: Sequence[str], search: str | Path | None, params: str | Path | None, seed: int = 0
+) -> tuple[SearchModel | None, dict[str, float]]:
+    """The search model file ``search`` (default: :func:`task_model`) and the joined skill's
+    ``params`` (TOML, e.g. from ``learn skill``) for ``bench assembly``; both need exactly one
+    peg-type task in ``names`` and are checked before any trial runs."""
+    if search is None and params is None:
+        return None, {}
+    pegs = [n for n in names if n not in PLAN_CELLS]
+    if len(pegs) != 1:
+        raise TeachfitError("--search/--params: give exactly one peg-type task in --tasks")
+    model = SearchModel.load(search, task=pegs[0]) if search else task_model(pegs[0], seed)
+    if params is None:
+        return model, {}
+    sk = method_skill(JOINED_LEARNED, model, "peg-in-hole", "adaptive")
+    return model, read_params_toml(params, sk.params, sk.users())
 
 
 def summarise(
@@ -62,12 +93,20 @@ def bench_task(
     progress: Callable[[], None] | None = None,
     methods: Sequence[str] = METHODS,
     model: SearchModel | None = None,
+    learned: Mapping[str, float] | None = None,
 ) -> Rows:
-    """Run every method at every taught-hole error on task ``name``; see the module docstring."""
+    """Run every method at every taught-hole error on task ``name`` (and ``"joined-learned"``
+    with ``learned`` parameters, when given); see the module docstring."""
     if not errors:
         raise TeachfitError("give at least one taught-hole error")
     model = model if model is not None else task_model(name, seed)
     jobs = assembly_jobs(name, methods, errors, trials, model, seed=seed, robot=ROBOT[0])
+    if learned:
+        values = tuple(sorted((k, float(v)) for k, v in learned.items()))
+        jobs += assembly_jobs(
+            name, [JOINED_LEARNED], errors, trials, model, seed=seed, robot=ROBOT[0], learned=values
+        )
+        methods = (*methods, JOINED_LEARNED)
     return summarise(run_assembly(jobs, workers, progress), methods, errors)
 
 

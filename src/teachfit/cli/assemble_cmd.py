@@ -172,12 +172,28 @@ def bench_assembly(
     plot: Annotated[
         Path | None, typer.Option(help="figure: success against error (one per task)")
     ] = None,
+    search: Annotated[
+        Path | None, typer.Option(help="search model (default: learned from the teacher)")
+    ] = None,
+    params: Annotated[
+        Path | None,
+        typer.Option(help="joined-skill parameters (TOML from learn skill): adds joined-learned"),
+    ] = None,
+    methods: Annotated[
+        str, typer.Option(help="peg-type methods, comma-separated (may be empty with --params)")
+    ] = "skill,search,open-loop,joined",
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
-    from teachfit.bench.assembly import bench_plan_task, bench_task, losses
+    from teachfit.bench.assembly import bench_inputs, bench_plan_task, bench_task, losses
+    from teachfit.execution.assembly import METHODS
 
     errs = [parse_quantity(e) for e in errors.split(",") if e.strip()]
-    for name in [t.strip() for t in tasks.split(",") if t.strip()]:
+    names = [t.strip() for t in tasks.split(",") if t.strip()]
+    model, learned = bench_inputs(names, search, params, seed)
+    chosen = tuple(m.strip() for m in methods.split(",") if m.strip())
+    if not set(chosen) <= set(METHODS) or not (chosen or learned):
+        raise TeachfitError(f"--methods: choose from {', '.join(METHODS)} (got {methods!r})")
+    for name in names:
         if name in ("l-groove", "tenon"):
             with progress_bar() as bar:
                 job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
@@ -192,7 +208,10 @@ def bench_assembly(
             continue
         with progress_bar() as bar:
             job = bar.add_task(f"{name}: demonstrations, then trials")
-            rows = bench_task(name, errs, trials, seed, workers, lambda j=job: bar.advance(j))
+            rows = bench_task(
+                name, errs, trials, seed, workers, lambda j=job: bar.advance(j),
+                model=model, learned=learned, methods=chosen,
+            )  # fmt: skip
         table = Table(title=f"{name}: success [Wilson 95 %], median time", title_justify="left")
         table.add_column("error (mm)", justify="right")
         for method in rows:
@@ -200,8 +219,10 @@ def bench_assembly(
         for i, e in enumerate(errs):
             table.add_row(f"{e * 1e3:g}", *(str(rows[m][i][1]) for m in rows))
         console.print(table)
-        for line in losses(rows):
+        for line in losses(rows) if "joined" in rows else ():
             console.print(f"  [yellow]joined does not beat[/] {line}")
+        for line in losses(rows, "joined-learned") if learned else ():
+            console.print(f"  [yellow]joined-learned does not beat[/] {line}")
         if plot is not None:
             from teachfit.viz.assembly_figures import plot_success_by_error
 

@@ -14,7 +14,9 @@ truth, recorded beside the measured outcome). Methods (:data:`METHODS`):
 - ``"open-loop"``: the plan executed open loop: move above the taught hole, then straight down
   to the insertion depth, stiff, whatever the contact says;
 - ``"joined"``: the skill whose recovery is the learned search
-  (:mod:`teachfit.skills.peg_in_hole_search`).
+  (:mod:`teachfit.skills.peg_in_hole_search`);
+- ``"joined-learned"`` (:data:`JOINED_LEARNED`): the same graph, meant to run with learned
+  parameters (``bench assembly --params``) beside the defaults' ``"joined"``.
 
 Jobs carry plain values (the model as its JSON document) so they run in worker processes.
 """
@@ -46,6 +48,8 @@ from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task
 
 METHODS = ("skill", "search", "open-loop", "joined")
+#: the joined skill run with learned parameters (not in :data:`METHODS`: it needs them)
+JOINED_LEARNED = "joined-learned"
 #: start height above the taught hole's surface (m)
 START_HEIGHT = 0.025
 
@@ -117,9 +121,10 @@ def method_skill(method: str, model: SearchModel | None, skill: str, controller:
         raise TeachfitError(f"method {method!r} needs a search model (--search MODEL)")
     if method == "search":
         return search_skill(model, controller)
-    if method == "joined":
+    if method in ("joined", JOINED_LEARNED):
         return peg_in_hole_search.build(model, controller)
-    raise TeachfitError(f"unknown assembly method {method!r}; choose from {METHODS}")
+    known = (*METHODS, JOINED_LEARNED)
+    raise TeachfitError(f"unknown assembly method {method!r}; choose from {known}")
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,11 @@ believes the captured pose:
   within the capture tolerance of the believed goal, the tenon (which nothing stops there) when
   it reaches the believed goal depth; both only when the part is near the insertion axis (not
   resting on top of the lip or a mortise) and level (:data:`SEAT_PITCH`);
+  if the part is not seated after ``t_seat`` (or, the tenon, stuck on the way), a recovery
+  (:mod:`teachfit.skills.contact_recovery`), then ``seat`` again: the L's ``retry`` backs out
+  along the path, shifts its end across the insertion by the next offset of a ring and
+  follows it again (:data:`L_RETRY`); the tenon's ``spiral`` presses its face on the mortise
+  and spirals across until the hole catches it (:data:`SPIRAL`);
 - ``"open-loop"``: the same path tracked stiffly to its end, as seed C did.
 
 Task frame ``T`` of both: the captured fixed-part frame turned so that ``T``'s z is ``G``'s x,
@@ -46,6 +51,7 @@ from teachfit.skills.conditions import (
     TiltBelow,
     TimeAbove,
 )
+from teachfit.skills.contact_recovery import RetryPath, SpiralPush, time_poses
 from teachfit.skills.follow import FollowConfig, FollowSetpoints
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, SkillParams
@@ -61,6 +67,19 @@ PAPER_ROBOT = {"l-groove": (4, 5), "tenon": (3, 5)}
 TRACK = FollowConfig(3000.0, 3000.0, 3000.0, (150.0, 150.0, 150.0), 0.0, False, 0.0, 200.0)
 STIFF = FollowConfig(3000.0, 3000.0, 3000.0, (150.0, 150.0, 150.0), 0.0, False, 0.5, 200.0)
 
+
+#: the L's retries (:class:`~teachfit.skills.contact_recovery.RetryPath`): path length backed
+#: out (m, to above the opening), offset radius across the insertion (m, beyond its 1.5 mm
+#: clearance), speed (m/s), number of retries
+L_RETRY = (0.06, 0.002, 0.015, 3)
+#: the tenon's spiral push (:class:`~teachfit.skills.contact_recovery.SpiralPush`): pitch (m,
+#: under twice its 1 mm clearance), speed (m/s), radius (m, the capture error moved to the
+#: first mortise by the rotation error), push (N), advance that ends it (m), time (s); and
+#: the resistance along the insertion (N) that stops the tracking as stuck on a mortise face
+SPIRAL = (0.0015, 0.01, 0.005, 5.0, 0.003, 20.0)
+F_STUCK = 25.0
+#: seating push (s) before a recovery
+T_SEAT = 2.5
 
 #: largest pitch (rad) of a seated part
 SEAT_PITCH = np.radians(4.0)
@@ -86,19 +105,19 @@ def timed_path(
     rel = [T2G.inverse().compose(Pose(s[:3], s[3:])) for s in dense]
     pos = np.array([p.pos for p in rel])
     quat = np.array([p.quat for p in rel])
-    step = np.maximum(
-        np.linalg.norm(np.diff(pos, axis=0), axis=1) / speed,
-        2 * np.arccos(np.clip(np.abs(np.sum(quat[:-1] * quat[1:], axis=1)), 0, 1)) / angular_speed,
-    )
-    t = np.concatenate([[0.0], np.cumsum(np.maximum(step, 1e-3))])
+    t = time_poses(pos, quat, speed, angular_speed)
     return SetpointTrajectory.from_path(t, pos, quat, name=f"{part} plan")
 
 
-def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -> Skill:
-    """The path as a skill: compliant tracking then ``seat`` (``"joined"``), or stiff tracking
-    only (``"open-loop"``); success and error as in the module docstring."""
+def contact_skill(
+    path: SetpointTrajectory, part: str, method: str = "joined", retries: int | None = None
+) -> Skill:
+    """The path as a skill: tracking, ``seat`` and the cell's recovery (``"joined"``; the L's
+    ``retries``, default :data:`L_RETRY`'s; ``0``: no recovery), or stiff tracking only
+    (``"open-loop"``); success and error as in the module docstring."""
     goal = build_assembly(part).goal[:3, 3]
     goal_x = float(goal[0])
+    recover, extra, rec_nodes, rec_tr = _recovery(path, part, method, retries)
     ctx = {
         "t_path": ContextParam(float(path.duration), "s", "duration of the planned path"),
         "f_seat": ContextParam(4.0, "N", "resistance that marks the part seated"),
@@ -108,8 +127,9 @@ def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -
         "seat_lateral": ContextParam(
             float(np.hypot(goal[1], goal[2])) + 0.012, "m", "off the insertion axis: not inside"
         ),
-        "t_max": ContextParam(float(path.duration) + 8.0, "s", "time limit"),
-    }
+        "t_max": ContextParam(float(path.duration) + 8.0 + extra, "s", "time limit"),
+        "t_seat": ContextParam(T_SEAT, "s", "seating push before a recovery"),
+    } | recover
     # near the axis (not on top of the lip or a mortise) and level: the part's z (G's z at the
     # goal) stays at 90 deg from T's z (G's x) within "seat_pitch" (pitch left from the pivot)
     level = TiltBelow(np.pi / 2 + SEAT_PITCH) & ~TiltBelow(np.pi / 2 - SEAT_PITCH)
@@ -135,6 +155,8 @@ def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -
         )
         nodes.append(Node("seat", seat, TimeAbove(6.0), "push along the insertion until seated"))
         transitions.append(Transition("path", "seat", Done()))
+    nodes += rec_nodes
+    transitions += rec_tr
     return Skill(
         f"{part} {method}",
         tuple(nodes),
@@ -145,6 +167,44 @@ def contact_skill(path: SetpointTrajectory, part: str, method: str = "joined") -
         TimeAbove("t_max", scope="skill") | ForceAbove(150.0, axis="norm"),
         frame="captured fixed-part frame, z along G's x",
     )
+
+
+def _recovery(
+    path: SetpointTrajectory, part: str, method: str, retries: int | None
+) -> tuple[dict[str, ContextParam], float, list[Node], list[Transition]]:
+    """The recovery of ``"joined"`` on ``part`` (``retries=0``: none): context, the time it
+    may add (s), its node and transitions (see the module docstring)."""
+    if method != "joined" or retries == 0:
+        return {}, 0.0, [], []
+    if part == "tenon":
+        t_spiral = SPIRAL[-1]
+        names = ("pitch", "speed", "radius", "push", "advance")
+        units = ("m", "m/s", "m", "N", "m")
+        ctx = {
+            f"spiral_{n}": ContextParam(v, u, f"spiral push: {n}")
+            for n, v, u in zip(names, SPIRAL, units, strict=False)
+        }
+        stuck = ForceAbove(F_STUCK, axis="+z")
+        doc = "press along the insertion, spiral across it until the part advances"
+        node = Node("spiral", SpiralPush(), TimeAbove(t_spiral), doc)
+        tr = [
+            Transition("path", "spiral", stuck),
+            Transition("seat", "spiral", TimeAbove("t_seat")),
+            Transition("spiral", "seat", Done()),
+        ]
+        return ctx, 2 * t_spiral, [node], tr
+    back, radius, speed, n = L_RETRY
+    n = n if retries is None else retries
+    ctx = {
+        "retry_back": ContextParam(back, "m", "path length backed out by a retry"),
+        "retry_radius": ContextParam(radius, "m", "offset across the insertion of a retry"),
+        "retry_speed": ContextParam(speed, "m/s", "speed of a retry"),
+    }
+    t_retry = (3 * back + 0.01) / speed + T_SEAT  # out, across, in again (<= 3 back), seat
+    doc = "back out along the path, across by the next offset of a ring, the path's end again"
+    node = Node("retry", RetryPath(path, config=TRACK), TimeAbove(2 * t_retry), doc)
+    tr = [Transition("seat", "retry", TimeAbove("t_seat")), Transition("retry", "seat", Done())]
+    return ctx, n * t_retry, [node], tr
 
 
 def capture_error(
