@@ -177,10 +177,15 @@ def bench_assembly(
     ] = None,
     params: Annotated[
         Path | None,
-        typer.Option(help="joined-skill parameters (TOML from learn skill): adds joined-learned"),
+        typer.Option(
+            help="skill parameters of the joined skill (TOML from learn skill): adds joined-learned"
+        ),
     ] = None,
     methods: Annotated[
-        str, typer.Option(help="peg-type methods, comma-separated (may be empty with --params)")
+        str,
+        typer.Option(
+            help="methods, comma-separated: skill, search, open-loop, joined (none: only --params)"
+        ),
     ] = "skill,search,open-loop,joined",
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""

@@ -246,7 +246,9 @@ def bench_learning(
     tasks: Annotated[
         str, typer.Option("--tasks", "--task", help="tasks, comma-separated (names or .toml)")
     ] = "puzzle,key,peg",
-    methods: Annotated[str, typer.Option(help="comma-separated methods")] = "cmaes,pso,bo,lhs",
+    methods: Annotated[
+        str, typer.Option(help="methods, comma-separated: cmaes, pso, bo, lhs")
+    ] = "cmaes,pso,bo,lhs",
     experiments: Annotated[int, typer.Option(min=1, help="learning runs per task and method")] = 2,
     trials: Annotated[int, typer.Option(min=1, help="trials per experiment")] = 60,
     workers: o.Workers = None,

@@ -50,6 +50,7 @@ CANONICAL: dict[str, tuple[str, str]] = {
     "--trials": ("int", "trials"),
     "--method": ("text", ""),
     "--params": ("path", "skill parameters"),
+    "--methods": ("text", "methods, comma-separated"),
     "--runs": ("int", "planning runs"),
     "--view": ("flag", "watch the run in MuJoCo's viewer"),
     "--skill": ("text", "skill: built-in name or skill .toml"),
