@@ -60,12 +60,9 @@ class KeyParams(PrismHoleParams):
     block_half_width: float = doc_field("half side of the square lock face (m)", 0.020, above=0)
     success_depth: float = doc_field("insertion depth that counts as success (m)", 0.012, above=0)
     start_offset: float = doc_field(
-        "lateral offset of the skill starts from the hole (m)", 0.0005, at_least=0
+        "lateral offset of the skill starts from the hole (m)", 0.0, at_least=0
     )
-    hole_pos_sigma: float = doc_field(
-        "std of the taught hole position, per axis (m)", 0.0003, at_least=0
-    )
-    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0087, at_least=0)
+    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0175, at_least=0)
     demo_offset: float = doc_field(
         "distance of the blind teacher's start from the hole (m)", 0.008, above=0
     )

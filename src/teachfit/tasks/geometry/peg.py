@@ -54,6 +54,11 @@ class AluminiumPegParams(SkillProtocolParams, RoundPegParams):
     demo_offset: float = doc_field(
         "distance of the blind teacher's start from the hole (m)", 0.003, above=0
     )
+    start_deviation: float = doc_field(
+        "deliberate deviation of each start's hole estimate from the taught one (m)",
+        0.002,
+        at_least=0,
+    )
     n_sectors: int = doc_field("convex sectors forming the boss wall", 32)
 
     def check(self) -> None:

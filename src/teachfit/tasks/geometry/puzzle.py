@@ -46,6 +46,11 @@ class PuzzleParams(PrismHoleParams):
         "skill starts draw yaw within +-start_yaw of the hole (rad)", 0.05, at_least=0
     )
     hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0175, at_least=0)
+    start_deviation: float = doc_field(
+        "deliberate deviation of each start's hole estimate from the taught one (m)",
+        0.002,
+        at_least=0,
+    )
 
     def check(self) -> None:
         self.require(

@@ -125,7 +125,7 @@ class SkillProtocol(Protocol):
 
     def start_frames(self, around: Pose, starts: list[Pose]) -> list[Pose]:
         """Per start, the hole estimate the skill runs with: ``around`` (the taught hole)
-        moved ``start_deviation`` along the start's own direction from the hole axis.
+        moved ``start_deviation`` along the start's own direction from the (true) hole axis.
 
         Seed B applies a "deliberate initial pose deviation" to the four starts of a trial
         (none on the key, "due to the very small hole"): the skill then looks for the hole
@@ -135,7 +135,7 @@ class SkillProtocol(Protocol):
         dev = self.task.params.start_deviation
         out = []
         for s in starts:
-            rel = around.inverse().compose(s).pos[:2]
+            rel = self.task.hole2world.inverse().compose(s).pos[:2]
             norm = float(np.hypot(*rel))
             if dev == 0 or norm < 1e-12:
                 out.append(around)
