@@ -197,3 +197,21 @@ def test_search_pose_and_registry(name: str) -> None:
     )
     rows = [r[0] for r in t.param_table()]
     assert rows[-1] == "friction"  # the shared protocol parameters come last
+
+
+@pytest.mark.parametrize("name", SEED_B_TASKS)
+def test_each_start_runs_with_its_own_deliberately_deviated_hole_estimate(name: str) -> None:
+    from teachfit.execution.skill_trial import peg_in_hole_setup
+
+    t = get_task(name, start_deviation=0.001, start_offset=0.002)
+    setup = peg_in_hole_setup(t, seed=4)
+    assert len(setup.frames) == len(setup.starts) == 4
+    for i, (start, frame) in enumerate(zip(setup.starts, setup.frames, strict=True)):
+        shift = setup.task2world.inverse().compose(frame).pos
+        toward = setup.task2world.inverse().compose(start).pos[:2]
+        assert np.hypot(*shift[:2]) == pytest.approx(0.001) and shift[2] == pytest.approx(0)
+        assert float(shift[:2] @ toward) > 0  # moved towards the start's own side
+        assert setup.frame(i) is frame
+    default = peg_in_hole_setup(get_task(name), seed=4)
+    moved = [np.hypot(*default.task2world.inverse().compose(f).pos[:2]) for f in default.frames]
+    assert moved == pytest.approx([get_task(name).params.start_deviation] * 4, abs=1e-12)

@@ -284,6 +284,14 @@ def bench_learning(
     scaling_trials: Annotated[
         int, typer.Option(min=1, help="trials per worker of each --scaling count")
     ] = 6,
+    random_rate: Annotated[
+        int,
+        typer.Option(
+            min=0,
+            help="only measure how often N random (Latin hypercube) parameter sets per "
+            "experiment succeed on each task, and the throughput (0: run the grid)",
+        ),
+    ] = 0,
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
     import os
@@ -297,6 +305,9 @@ def bench_learning(
         return
 
     task_list = [t for t in tasks.split(",") if t]
+    if random_rate:
+        _bench_random(task_list, random_rate, experiments, starts, seed, task_param, workers)
+        return
     method_list = [m for m in methods.split(",") if m]
     total = len(task_list) * len(method_list) * experiments * trials
     with progress_bar() as bar:
@@ -390,3 +401,42 @@ def _bench_scaling(
     print_markdown(text)
     if markdown is not None:
         console.print(f"markdown appended to {append_markdown(markdown, text)}")
+
+
+def _bench_random(
+    tasks: list[str],
+    trials: int,
+    experiments: int,
+    starts: int,
+    seed: int,
+    task_param: list[str] | None,
+    workers: int | None,
+) -> None:
+    """``bench learning --random-rate N``: success of random parameters, and throughput."""
+    import os
+
+    from teachfit.bench import learning_random as lr
+
+    rates = []
+    with progress_bar() as bar:
+        job = bar.add_task("random parameters", total=len(tasks) * experiments * trials)
+        for task in tasks:
+            rates.append(
+                lr.random_rate(
+                    task,
+                    trials,
+                    experiments,
+                    n_starts=starts,
+                    seed=seed,
+                    overrides=dict(_overrides(task_param)),
+                    workers=workers,
+                    on_trial=lambda _r, t=task: bar.update(job, advance=1, description=t),
+                )
+            )
+    extra = "".join(f" --task-param {p}" for p in task_param or [])
+    print_markdown(
+        f"`teachfit bench learning --random-rate {trials} --tasks {','.join(tasks)} "
+        f"--experiments {experiments} --starts {starts}{extra}` (1-min load average "
+        f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n\n"
+        + lr.random_rate_markdown(rates, workers or os.cpu_count() or 1)
+    )

@@ -38,6 +38,9 @@ def clipped_twist(cmd: ImpedanceCommand, limits: ImpedanceLimits) -> np.ndarray:
 def critical_damping(stiffness: np.ndarray, mass: np.ndarray, ratio: float) -> np.ndarray:
     """Damping ``D = 2 ratio M^1/2 sqrtm(M^-1/2 K M^-1/2) M^1/2`` for (6, 6) ``K``, (6,) ``M``."""
     sm = np.sqrt(mass)
+    diag = np.diagonal(stiffness)
+    if np.count_nonzero(stiffness) == np.count_nonzero(diag):  # diagonal: per axis, no eigh
+        return np.diag(2.0 * ratio * np.sqrt(np.clip(diag, 0.0, None)) * sm)
     scaled = stiffness / np.outer(sm, sm)
     w, v = np.linalg.eigh(scaled)
     root = (v * np.sqrt(np.clip(w, 0.0, None))) @ v.T

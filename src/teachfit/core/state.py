@@ -36,6 +36,13 @@ def _gain(value: object, name: str) -> np.ndarray:
         raise ControlError(f"{name} must be a scalar, (6,) or (6, 6), got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ControlError(f"{name} contains NaN or inf")
+    diag = np.diagonal(arr)
+    if np.count_nonzero(arr) == np.count_nonzero(diag):  # diagonal (skills send these each
+        # command period): symmetric, and positive semi-definite iff no diagonal entry < 0
+        if diag.min() < -1e-9 * max(1.0, np.abs(diag).max()):
+            raise ControlError(f"{name} must be positive semi-definite")
+        arr.setflags(write=False)
+        return arr
     if not np.allclose(arr, arr.T, atol=1e-9 * max(1.0, np.abs(arr).max())):
         raise ControlError(f"{name} must be symmetric")
     if np.linalg.eigvalsh(arr).min() < -1e-9 * max(1.0, np.abs(arr).max()):

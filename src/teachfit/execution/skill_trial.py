@@ -31,13 +31,23 @@ from teachfit.tasks.base import Task
 @dataclass(frozen=True)
 class SkillSetup:
     """Everything fixed within an experiment: the skill (context set), the task, the
-    estimated hole frame (task frame), the true goal pose and the start poses."""
+    estimated hole frame (task frame), the true goal pose and the start poses.
+
+    ``frames``: per start, the task frame the skill runs in (the estimate moved by the task's
+    deliberate start deviation, :meth:`~teachfit.tasks.protocols.skill.SkillProtocol.
+    start_frames`); empty: ``task2world`` for every start.
+    """
 
     skill: Skill
     task: Task
     task2world: Pose
     goal2world: Pose
     starts: tuple[Pose, ...]
+    frames: tuple[Pose, ...] = ()
+
+    def frame(self, i: int) -> Pose:
+        """The task frame of start ``i``."""
+        return self.frames[i] if self.frames else self.task2world
 
 
 def peg_in_hole_setup(
@@ -52,8 +62,15 @@ def peg_in_hole_setup(
     ctx = peg_in_hole.hole_context(task, rng)
     base = skill if skill is not None else peg_in_hole.build(controller)
     starts = peg_in_hole.default_starts(task, n_starts, rng)
+    deviate = getattr(task.protocol, "start_frames", None)
+    frames = tuple(deviate(ctx.hole2world_est, starts)) if callable(deviate) else ()
     return SkillSetup(
-        base.with_context(ctx.values), task, ctx.hole2world_est, ctx.goal2world, tuple(starts)
+        base.with_context(ctx.values),
+        task,
+        ctx.hole2world_est,
+        ctx.goal2world,
+        tuple(starts),
+        frames,
     )
 
 
@@ -104,15 +121,18 @@ class SkillTrial:
         self.config = config or ExecConfig()
         self.robot = make_robot(robot, setup.task, seed=seed, **robot_options)
 
-    def run(self, learned: Mapping[str, float] | None, start: Pose) -> ExecutionResult:
-        """One execution from ``start`` (values validated; defaults fill gaps)."""
+    def run(
+        self, learned: Mapping[str, float] | None, start: Pose, frame: Pose | None = None
+    ) -> ExecutionResult:
+        """One execution from ``start`` in the task frame ``frame`` (default: the set-up's
+        estimate); values validated, defaults fill gaps."""
         s = self.setup
         values = s.skill.resolve(learned)
         return execute(
             s.skill,
             self.robot,
             start,
-            s.task2world,
+            s.task2world if frame is None else frame,
             {k: values[k] for k in s.skill.params.learned},
             task=s.task,
             goal2world=s.goal2world,
@@ -123,6 +143,11 @@ class SkillTrial:
     def __call__(
         self, learned: Mapping[str, float] | None = None, starts: Sequence[Pose] | None = None
     ) -> TrialOutcome:
-        traces = tuple(self.run(learned, st) for st in (starts or self.setup.starts))
+        if starts is None:
+            s = self.setup
+            runs = [(st, s.frame(i)) for i, st in enumerate(s.starts)]
+        else:
+            runs = [(st, None) for st in starts]
+        traces = tuple(self.run(learned, st, fr) for st, fr in runs)
         scored = [self.metric.evaluate(tr) for tr in traces]
         return TrialOutcome(tuple(s for s, _ in scored), tuple(c for _, c in scored), traces)

@@ -10,7 +10,8 @@ Cost (seed B, Sec. V): the mean over the starts of the learning metric
 (:class:`~teachfit.execution.metric.LearningMetric`): the time from first contact to full
 insertion (s) on success, ``t_max + k_d * remaining distance`` on failure. A trial is
 feasible if any start succeeded. ``info`` carries ``success_rate``, ``sim_s`` (simulated robot
-seconds of all executions, recovery included) and ``wall_s``.
+seconds of all executions; on a simulated robot the recovery retract after a failure is
+skipped, as every execution starts from a reset) and ``wall_s``.
 """
 
 from __future__ import annotations
@@ -78,8 +79,16 @@ class SkillObjective:
             task = get_task(self.task, **dict(self.task_overrides))
             skill = get_skill(self.skill, self.controller)
             setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
+            from teachfit.execution.engine import ExecConfig
+
             options = {"host": self.host, "realtime": self.realtime} if self.host else {}
-            found = SkillTrial(setup, self.controller, robot=self.robot, seed=self.seed, **options)
+            # a simulated robot is reset before every execution: the recovery retract after a
+            # failure would only cost compute (its robot time is not in the cost), a real one
+            # needs it
+            config = None if self.host else ExecConfig(recovery_time=0.0)
+            found = SkillTrial(
+                setup, self.controller, robot=self.robot, seed=self.seed, config=config, **options
+            )
             _CACHE.clear()  # one experiment per worker at a time: keep memory flat
             _CACHE[self] = found
         return found

@@ -249,6 +249,41 @@ class SpeedBelow(_Threshold):
 
 
 @dataclass(frozen=True)
+class DepthStalled(_Threshold):
+    """For ``duration`` (s) within the current node the TCP has not got ``value`` (m) deeper
+    than where it last did: pushing on makes no progress (a jammed or missed part)."""
+
+    duration: Value = 1.0
+    kind: ClassVar[str] = "depth_stalled"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        ref_name(self.duration)
+
+    def _values(self) -> tuple[Value, ...]:
+        return (self.value, self.duration)
+
+    def compile(self, values: Mapping[str, float]) -> Check:
+        gain, hold = resolve(self.value, values), resolve(self.duration, values)
+        state = {"ref": -math.inf, "since": 0.0, "last": -math.inf}
+
+        def check(pc: Percept) -> bool:
+            depth = -float(pc.p[2])
+            if pc.t_node < state["last"] or depth >= state["ref"] + gain:  # (re-)entered, deeper
+                state["ref"], state["since"] = depth, pc.t_node
+            state["last"] = pc.t_node
+            return pc.t_node - state["since"] >= hold
+
+        return check
+
+    def describe(self) -> str:
+        return f"depth gains < {_fmt(self.value, 'm')} in {_fmt(self.duration, 's')}"
+
+    def to_toml(self) -> dict[str, Any]:
+        return {"kind": self.kind, "value": self.value, "duration": self.duration}
+
+
+@dataclass(frozen=True)
 class Done(Condition):
     """The active primitive finished its own motion (e.g. its velocity profile)."""
 
@@ -356,6 +391,7 @@ _LEAVES: dict[str, type[Condition]] = {
         RemainingBelow,
         TiltBelow,
         SpeedBelow,
+        DepthStalled,
         Done,
         Detected,
     )

@@ -19,8 +19,12 @@ surface); the lateral move runs along its +x. Five primitives:
 
 Success: ``depth`` reached below the estimated entry. Error: the time limit ``t_max`` (from
 the skill start), a force above ``f_max``, per-node time limits, leaving the region of
-interest ``roi`` around the estimated hole axis. Recovery: retract ``retract_height`` up.
-Speeds scale with the learned ``speed_factor`` (accelerations with its square).
+interest ``roi`` around the estimated hole axis, and an insert that stalls (less than
+``stall_depth`` deeper for ``stall_time``: a jammed or missed part, which pushing on until
+``t_max`` would not insert; it ends such hopeless executions early, which is most of a
+learning run's robot time when random parameters mostly fail). Recovery: retract
+``retract_height`` up. Speeds scale with the learned ``speed_factor`` (accelerations with
+its square).
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ from teachfit.core.params import ParamDomain
 from teachfit.skills.conditions import (
     Any_,
     DepthAbove,
+    DepthStalled,
     Done,
     ForceAbove,
     LateralAbove,
@@ -75,6 +80,8 @@ CONTEXT: dict[str, ContextParam] = {
     "t_contact": ContextParam(1.5, "s", "time limit of contact"),
     "t_lateral": ContextParam(1.5, "s", "time limit of the lateral move"),
     "t_align": ContextParam(1.0, "s", "time limit of align"),
+    "stall_depth": ContextParam(5e-4, "m", "insert: least depth gain that counts as progress"),
+    "stall_time": ContextParam(1.5, "s", "insert: error after this long without progress"),
     "retract_height": ContextParam(0.01, "m", "recovery: retract this far up"),
 }
 
@@ -163,7 +170,7 @@ def build(controller: str = "adaptive") -> Skill:
                 f_r="f_r",
                 stiffness=(400.0, 400.0, 200.0, 30.0, 30.0, 20.0),
             ),
-            roi,
+            roi | DepthStalled("stall_depth", "stall_time"),
             "push with oscillations",
         ),
     )

@@ -6,6 +6,15 @@ numbers are lost in the extracted text, so the defaults are plausible ones: a 7 
 blade 30 mm long with 0.5 mm tip chamfers, a slot 0.3 mm wider in both directions, 20 mm deep,
 with 0.8 mm entry chamfers, in a 40 mm square lock face.
 
+How hard (issue 16, part 4), from the paper's words (Sec. V): chamfers on blade and slot ("the
+hole and the key itself have chamfers to make the initial insertion very easy"); no start
+deviation and all four starts on the hole axis (``start_offset = start_deviation = 0``: "due
+to the very small hole no deliberate initial pose deviation was applied"); the same taught
+hole error as the other two tasks (0.5 mm per axis, 1 degree: one teaching routine, "accuracy
+below [1] mm"). The paper counts the key among the easier tasks; here its failures come from
+the parameters (align time limit, force limit), not from the taught error, which its chamfers
+absorb (BENCHMARKS.md, seed B).
+
 Geometry (:mod:`teachfit.tasks.geometry.prism_hole`). The slot is a rectangle
 ``blade_width + clearance`` (along the hole frame's x) by ``blade_thickness + clearance``
 (along y) with a 45-degree chamfer of ``slot_chamfer`` along each entry edge. The held part is
@@ -60,12 +69,9 @@ class KeyParams(PrismHoleParams):
     block_half_width: float = doc_field("half side of the square lock face (m)", 0.020, above=0)
     success_depth: float = doc_field("insertion depth that counts as success (m)", 0.012, above=0)
     start_offset: float = doc_field(
-        "lateral offset of the skill starts from the hole (m)", 0.0005, at_least=0
+        "lateral offset of the skill starts from the hole (m)", 0.0, at_least=0
     )
-    hole_pos_sigma: float = doc_field(
-        "std of the taught hole position, per axis (m)", 0.0003, at_least=0
-    )
-    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0087, at_least=0)
+    hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0175, at_least=0)
     demo_offset: float = doc_field(
         "distance of the blind teacher's start from the hole (m)", 0.008, above=0
     )

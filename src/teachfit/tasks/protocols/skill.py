@@ -50,6 +50,11 @@ class SkillProtocolParams(TaskParams):
         "std of the taught hole position, per axis (m)", 0.0005, at_least=0
     )
     hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0, at_least=0)
+    start_deviation: float = doc_field(
+        "deliberate deviation of each start's hole estimate from the taught one (m)",
+        0.0,
+        at_least=0,
+    )
     demo_offset: float = doc_field(
         "distance of the blind teacher's start from the hole (m)", 0.02, above=0
     )
@@ -117,6 +122,27 @@ class SkillProtocol(Protocol):
         dx, dy = rng.normal(0.0, ps, 2) if ps > 0 else (0.0, 0.0)
         dyaw = float(rng.normal(0.0, ys)) if ys > 0 else 0.0
         return self.task.hole2world.compose(Pose.from_xyz_rz(dx, dy, 0.0, dyaw))
+
+    def start_frames(self, around: Pose, starts: list[Pose]) -> list[Pose]:
+        """Per start, the hole estimate the skill runs with: ``around`` (the taught hole)
+        moved ``start_deviation`` along the start's own direction from the (true) hole axis.
+
+        Seed B applies a "deliberate initial pose deviation" to the four starts of a trial
+        (none on the key, "due to the very small hole"): the skill then looks for the hole
+        that far from where it is, in a different direction each start. Without deviation
+        (or for a start on the axis) every start gets ``around``.
+        """
+        dev = self.task.params.start_deviation
+        out = []
+        for s in starts:
+            rel = self.task.hole2world.inverse().compose(s).pos[:2]
+            norm = float(np.hypot(*rel))
+            if dev == 0 or norm < 1e-12:
+                out.append(around)
+                continue
+            d = dev * rel / norm
+            out.append(around.compose(Pose.from_xyz_rz(float(d[0]), float(d[1]), 0.0, 0.0)))
+        return out
 
     def spread_starts(self, n: int, rng: np.random.Generator, around: Pose | None) -> list[Pose]:
         """``n`` starts evenly spread around the frame ``around`` (default: the true hole)."""
