@@ -13,7 +13,9 @@ belief about where the hole is is off by ``belief_sigma``. Patterns:
 - ``"zigzag"``: straight towards the belief, then a zig-zag raster around it.
  Human-like noise is a slow random
 wander (an Ornstein-Uhlenbeck process) plus a small physiological tremor; for tasks with a
-rotational search DOF the teacher also wiggles the part about z around its belief. What is
+rotational search DOF the teacher also wiggles the part about z around its belief. The press
+is not constant either: it wanders slowly around ``push_force`` (another Ornstein-Uhlenbeck
+process, ``press_wander`` N over ``press_timescale`` s; see :meth:`BlindTeacher.press`). What is
 recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench at
 ``record_rate``. Demonstrations that end at once or never are discarded, as in seed A.
 """
@@ -56,6 +58,8 @@ class TeacherStyle:
     rz_wiggle: float = 0.2
     rz_wiggle_frequency: float = 0.4
     push_force: float = 6.0
+    press_wander: float = 0.3
+    press_timescale: float = 1.0
     arm_stiffness: float = 600.0
     max_duration: float = 60.0
     min_duration: float = 0.5
@@ -65,9 +69,11 @@ class TeacherStyle:
         if self.pattern not in PATTERNS:
             raise TeachfitError(f"teacher pattern must be one of {PATTERNS}, got {self.pattern!r}")
         positive = ("speed", "spiral_pitch", "sweep_halfwidth", "max_duration", "record_rate")
-        for name in (*positive, "wander_timescale"):
+        for name in (*positive, "wander_timescale", "press_timescale"):
             if not getattr(self, name) > 0:
                 raise TeachfitError(f"teacher {name} must be > 0")
+        if not 0 <= self.press_wander < self.push_force:
+            raise TeachfitError("teacher press_wander must be within [0, push_force)")
         if self.min_duration >= self.max_duration:
             raise TeachfitError("teacher min_duration must be below max_duration")
 
@@ -99,6 +105,8 @@ class BlindTeacher:
         self.style = style_for(task, style)
         self.seed, self.robot_name = int(seed), robot
         self.rng = np.random.default_rng(seed)
+        # the press's own stream: the plans' other draws stay what they were without it
+        self._press_rng = np.random.default_rng([int(seed), 0x70726573])
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
         self._fresh = True  # nothing recorded yet: a recording depends on the seed alone
         self._replayed = False
@@ -155,6 +163,25 @@ class BlindTeacher:
         tremor = st.tremor_amplitude * np.sin(2 * np.pi * st.tremor_frequency * t[:, None] + phase)
         return w + tremor
 
+    def press(self, n: int, dt: float) -> np.ndarray:
+        """(n,) the press's slow deviation from ``push_force`` (N, positive presses harder).
+
+        An assumption, not a measurement we can cite for kinesthetic teaching: a person
+        holding a steady push of a few newtons drifts by a few percent of it, slowly (the
+        force-steadiness literature reports coefficients of variation of a few percent at low
+        forces with most of the fluctuation's power below 1-2 Hz). Modelled as a stationary
+        Ornstein-Uhlenbeck process of standard deviation ``press_wander`` and time constant
+        ``press_timescale``, seeded by the teacher's seed.
+        """
+        st = self.style
+        a = np.exp(-dt / st.press_timescale)
+        kicks = self._press_rng.normal(0.0, st.press_wander * np.sqrt(1 - a * a), n)
+        dev = np.empty(n)
+        dev[0] = self._press_rng.normal(0.0, st.press_wander)  # started stationary
+        for i in range(1, n):
+            dev[i] = a * dev[i - 1] + kicks[i]
+        return dev
+
     def plan(self, start: Pose) -> SetpointTrajectory:
         """The path the teacher's hand intends, world frame, for ``max_duration``."""
         st, task = self.style, self.task
@@ -189,7 +216,9 @@ class BlindTeacher:
         else:
             quat = np.tile(start.quat, (n, 1))
         pos = np.column_stack([xy, np.full(n, task.surface_z)])
-        return SetpointTrajectory.from_path(t, pos, quat, name="teacher-plan")
+        ff = np.zeros((n, 6))
+        ff[:, 2] = -self.press(n, dt)  # added to the follow skill's constant -push_force
+        return SetpointTrajectory.from_path(t, pos, quat, wrench_ff=ff, name="teacher-plan")
 
     # ----------------------------------------------------------------------- recording
     def demonstrate(self, start: Pose | None = None) -> tuple[Demonstration | None, str]:
