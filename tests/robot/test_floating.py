@@ -44,12 +44,12 @@ def test_sensor_noise_and_bias_are_applied():
     assert np.array_equal(robot.state().wrench, robot.state().wrench)  # noise enters per tick
     samples = np.array([robot.step(10).wrench for _ in range(400)])  # in free space, 100 Hz
     assert samples[:, 0].mean() == pytest.approx(1.0, abs=0.1)
-    # the gauges' white noise (0.5 N per 1 kHz sample) leaves the 35 Hz Butterworth scaled by
-    # the root of its impulse response's energy (about 0.26)
+    # the gauges' white noise (0.5 N per 1 kHz sample) leaves the 18 Hz Butterworth scaled by
+    # the root of its impulse response's energy (about 0.19)
     b0, b1, b2, a1, a2 = butterworth2(params.ft_cutoff, params.timestep)
     impulse = signal.lfilter([b0, b1, b2], [1.0, a1, a2], np.eye(1, 2000)[0])
     gain = float(np.sqrt(np.sum(impulse**2)))
-    assert 0.2 < gain < 0.35
+    assert 0.15 < gain < 0.25
     assert samples[:, 1].std() == pytest.approx(0.5 * gain, rel=0.15)
 
 

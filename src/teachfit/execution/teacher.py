@@ -40,6 +40,10 @@ from teachfit.tasks.base import Task
 
 PATTERNS = ("sweep", "spiral", "zigzag")
 
+#: per-robot style defaults: on the arm, joint friction loads the open-loop press (f_z swings
+#: 4.5-7.5 N with the sweep's direction), which a person pressing by feel corrects
+ROBOT_STYLE: dict[str, dict[str, float]] = {"fr3": {"press_feel": 0.3}}
+
 
 @dataclass(frozen=True)
 class TeacherStyle:
@@ -60,6 +64,7 @@ class TeacherStyle:
     push_force: float = 6.0
     press_wander: float = 0.3
     press_timescale: float = 1.0
+    press_feel: float = 0.0
     arm_stiffness: float = 600.0
     max_duration: float = 60.0
     min_duration: float = 0.5
@@ -76,6 +81,14 @@ class TeacherStyle:
             raise TeachfitError("teacher press_wander must be within [0, push_force)")
         if self.min_duration >= self.max_duration:
             raise TeachfitError("teacher min_duration must be below max_duration")
+
+
+def robot_style(style: TeacherStyle, robot: str) -> TeacherStyle:
+    """``style`` with :data:`ROBOT_STYLE`'s defaults for ``robot`` on fields left at theirs."""
+    default = TeacherStyle(pattern=style.pattern)
+    hints = ROBOT_STYLE.get(robot, {})
+    keep = {k: v for k, v in hints.items() if getattr(style, k) == getattr(default, k)}
+    return dataclasses.replace(style, **keep) if keep else style
 
 
 def style_for(task: Task, style: TeacherStyle | None = None) -> TeacherStyle:
@@ -102,7 +115,7 @@ class BlindTeacher:
         robot: str = "floating",
     ) -> None:
         self.task = task
-        self.style = style_for(task, style)
+        self.style = robot_style(style_for(task, style), robot)
         self.seed, self.robot_name = int(seed), robot
         self.rng = np.random.default_rng(seed)
         # the press's own stream: the plans' other draws stay what they were without it
@@ -164,23 +177,8 @@ class BlindTeacher:
         return w + tremor
 
     def press(self, n: int, dt: float) -> np.ndarray:
-        """(n,) the press's slow deviation from ``push_force`` (N, positive presses harder).
-
-        An assumption, not a measurement we can cite for kinesthetic teaching: a person
-        holding a steady push of a few newtons drifts by a few percent of it, slowly (the
-        force-steadiness literature reports coefficients of variation of a few percent at low
-        forces with most of the fluctuation's power below 1-2 Hz). Modelled as a stationary
-        Ornstein-Uhlenbeck process of standard deviation ``press_wander`` and time constant
-        ``press_timescale``, seeded by the teacher's seed.
-        """
-        st = self.style
-        a = np.exp(-dt / st.press_timescale)
-        kicks = self._press_rng.normal(0.0, st.press_wander * np.sqrt(1 - a * a), n)
-        dev = np.empty(n)
-        dev[0] = self._press_rng.normal(0.0, st.press_wander)  # started stationary
-        for i in range(1, n):
-            dev[i] = a * dev[i - 1] + kicks[i]
-        return dev
+        """(n,) the press's slow deviation from ``push_force`` (N): :func:`press_wander`."""
+        return press_wander(self.style, n, dt, self._press_rng)
 
     def plan(self, start: Pose) -> SetpointTrajectory:
         """The path the teacher's hand intends, world frame, for ``max_duration``."""
@@ -232,13 +230,7 @@ class BlindTeacher:
             )
         self._fresh = False
         start = start or self.task.protocol.teacher_start(self.rng)
-        cfg = FollowConfig(
-            stiffness_along=st.arm_stiffness,
-            stiffness_across=st.arm_stiffness,
-            aligned=False,
-            push_force=st.push_force,
-            settle_time=0.0,
-        )
+        cfg = follow_config(st)
         plan = self.plan(start)
         rate = min(st.record_rate, 100.0)
         outcome = run_trajectory(self.robot, self.task, plan, start, cfg, log_rate=rate)
@@ -319,6 +311,38 @@ class BlindTeacher:
                 f"discarded: {discarded}"
             )
         return demos, discarded
+
+
+def follow_config(style: TeacherStyle) -> FollowConfig:
+    """How the teacher's hand drives the compliant robot: its arm's stiffness in x-y, the
+    follow skill's default z stiffness, its press (and ``press_feel`` loop), no settling."""
+    return FollowConfig(
+        stiffness_along=style.arm_stiffness,
+        stiffness_across=style.arm_stiffness,
+        aligned=False,
+        push_force=style.push_force,
+        settle_time=0.0,
+        press_feel=style.press_feel,
+    )
+
+
+def press_wander(style: TeacherStyle, n: int, dt: float, rng: np.random.Generator) -> np.ndarray:
+    """(n,) a teacher's press deviation from ``style.push_force`` every ``dt`` s (N, positive
+    presses harder).
+
+    An assumption, not a measurement we can cite for kinesthetic teaching: a person holding a
+    steady push of a few newtons drifts by a few percent of it, slowly (force-steadiness
+    studies report coefficients of variation of a few percent at low forces, most of the
+    fluctuation's power below 1-2 Hz). Modelled as a stationary Ornstein-Uhlenbeck process of
+    standard deviation ``style.press_wander`` and time constant ``style.press_timescale``.
+    """
+    a = np.exp(-dt / style.press_timescale)
+    kicks = rng.normal(0.0, style.press_wander * np.sqrt(1 - a * a), n)
+    dev = np.empty(n)
+    dev[0] = rng.normal(0.0, style.press_wander)  # started stationary
+    for i in range(1, n):
+        dev[i] = a * dev[i - 1] + kicks[i]
+    return dev
 
 
 def _along_polyline(corners: np.ndarray, s: np.ndarray) -> np.ndarray:

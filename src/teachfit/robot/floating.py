@@ -47,7 +47,7 @@ class FloatingToolParams:
     inertia: tuple[float, float, float] = (0.004, 0.004, 0.004)
     ft_noise: tuple[float, float] = (0.05, 0.002)
     ft_bias: tuple[float, float, float, float, float, float] = (0.0,) * 6
-    ft_cutoff: float = 35.0
+    ft_cutoff: float = 18.0
     timestep: float = 0.001
     contact: ContactParams = field(default_factory=ContactParams)
 

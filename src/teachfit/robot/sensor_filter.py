@@ -7,8 +7,10 @@ F/T (seed A's wrist sensor) samples its gauges at 7 kHz and applies a user-selec
 estimate (cutoff not documented). A 100 Hz log of a first-order 80 Hz filter point-samples
 everything up to 500 Hz: the floating tool's 200-500 Hz contact micro-impacts folded into the
 0-50 Hz band and read as white noise (std 1.6 N, lag-1 autocorrelation 0). A second-order
-Butterworth at 35 Hz falls off 40 dB/decade: the same impacts leave 0.06 N at 100 Hz, so the
-decimation to the log rate no longer aliases the kHz content.
+Butterworth falls off 40 dB/decade: at 35 Hz the same impacts leave 0.06 N at 100 Hz, at
+18 Hz (the default here) 0.02 N, so the decimation to the log rate no longer aliases the kHz
+content. 18 Hz keeps the slow press (0-2 Hz) untouched and delays a force step by about
+12 ms, about what a 10 ms averaging window (the other way to decimate) would.
 
 The coefficients come from :func:`scipy.signal.butter` (bilinear transform); the recurrence
 itself (transposed direct form II) is written here because it runs inside the simulator's
@@ -21,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal
 
-#: the Net F/T's selectable low-pass cutoffs (Hz); 35 Hz is the default used here
+#: the Net F/T's selectable low-pass cutoffs (Hz); 18 Hz is the default used here
 ATI_NETFT_CUTOFFS = (838.0, 326.0, 152.0, 73.0, 35.0, 18.0, 8.0)
 
 

@@ -71,7 +71,7 @@ class FR3Params:
     flange). ``wrench_cutoff`` (Hz) is the first-order low-pass of either estimate (the
     momentum observer's gain, the wrist sensor's analogue stage), ``output_cutoff`` (Hz) the
     second-order Butterworth both then pass before anyone reads them (the 100 Hz log's
-    anti-alias filter; 35 Hz is one of the ATI Net F/T's options, see
+    anti-alias filter; 18 Hz is one of the ATI Net F/T's options, see
     :mod:`teachfit.robot.sensor_filter`); ``torque_noise`` (N·m) and ``ft_noise`` (N, N·m)
     the white noise per tick of the joint torque sensors and of the wrist sensor's gauges.
     ``null_stiffness`` (N·m/rad) and ``null_damping`` (N·m·s/rad) pull the redundant joint
@@ -89,7 +89,7 @@ class FR3Params:
     mount_offset: float = 0.066
     sensor: str = "joint-torques"
     wrench_cutoff: float = 30.0
-    output_cutoff: float = 35.0
+    output_cutoff: float = 18.0
     torque_noise: float = 0.02
     ft_noise: tuple[float, float] = (0.05, 0.002)
     null_stiffness: float = 10.0

@@ -60,7 +60,7 @@ class JointTorqueObserver:
         cutoff: float,
         noise: float,
         rng: np.random.Generator,
-        output_cutoff: float = 35.0,
+        output_cutoff: float = 18.0,
     ) -> None:
         nv = model.nv
         if nv != model.njnt or len(sensors) != nv:
@@ -107,7 +107,7 @@ class WristFT:
         force_sensor: int,
         torque_sensor: int,
         cutoff: float,
-        output_cutoff: float = 35.0,
+        output_cutoff: float = 18.0,
     ) -> None:
         f_adr = int(model.sensor_adr[force_sensor])
         if int(model.sensor_adr[torque_sensor]) != f_adr + 3:
