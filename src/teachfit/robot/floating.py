@@ -26,8 +26,6 @@ from teachfit.robot.sensor_filter import LowPass2
 from teachfit.tasks.base import Task
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
 
-_NOISE_BLOCK = 1000  # gauge noise drawn this many ticks at a time
-
 
 @dataclass(frozen=True)
 class FloatingToolParams:
@@ -161,8 +159,8 @@ class FloatingToolRobot:
         self._ft_raw = self.data.sensordata[self._f_adr : self._f_adr + 6]
         self._ft_lp = LowPass2(6, self.params.ft_cutoff, float(m.opt.timestep))
         self._ft_filt = self._ft_lp.out
-        self._ft_noise = np.zeros((_NOISE_BLOCK, 6))
-        self._noise_i = _NOISE_BLOCK
+        self._ft_sd = np.repeat(np.asarray(self.params.ft_noise, dtype=float), 3)
+        self._gauges = np.zeros((10, 6))  # one step(n)'s gauge samples
         a, b = self._qpos_adr, self._qvel_adr
         self._pos = self.data.qpos[a : a + 3]
         self._quat = self.data.qpos[a + 3 : a + 7]
@@ -196,7 +194,6 @@ class FloatingToolRobot:
         self._quat[:] = pose.quat
         mujoco.mj_forward(self.model, self.data)
         self._ft_lp.reset(self._ft_raw)
-        self._noise_i = _NOISE_BLOCK
         self._law.reset()
         self.command(ImpedanceCommand.hold(pose))
         self._tare[:] = self._raw_wrench()  # tared at rest in free space, like a real sensor
@@ -233,9 +230,12 @@ class FloatingToolRobot:
         body = self._body
         pos, quat, linvel = self._pos, self._quat, self._linvel
         angvel, angvel_local = self._angvel, self._angvel_local
-        raw, lowpass, noise = self._ft_raw, self._ft_lp, self._ft_noise
+        raw = self._ft_raw
+        if self._gauges.shape[0] < n:
+            self._gauges = np.zeros((n, 6))
+        gauges = self._gauges
         point = d.xpos[body]  # the tool frame origin is the TCP
-        for _ in range(n):
+        for k in range(n):
             mujoco.mju_rotVecQuat(angvel, angvel_local, quat)
             w = ctrl.compute(d.time, pos, quat, linvel, angvel)
             if not math.isfinite(float(w.sum())):
@@ -243,10 +243,9 @@ class FloatingToolRobot:
             qfrc[:] = 0.0
             mujoco.mj_applyFT(m, d, w[:3], w[3:], point, body, qfrc)
             mujoco.mj_step(m, d)
-            if self._noise_i >= _NOISE_BLOCK:
-                self._draw_noise()
-            lowpass.update(raw + noise[self._noise_i])  # gauges sampled, then filtered
-            self._noise_i += 1
+            gauges[k] = raw  # the gauges sampled every tick ...
+        # ... with their noise, through the device's low-pass (one call for the n ticks)
+        self._ft_lp.filter(gauges[:n] + self._noise(n))
         self._check_divergence()
         return self.state()
 
@@ -280,11 +279,9 @@ class FloatingToolRobot:
         t_env_tcp = t_env_site + np.cross(lever, f_env)
         return np.concatenate([f_env, t_env_tcp])
 
-    def _draw_noise(self) -> None:
-        """The next block of gauge noise, per tick, before the filter (N, N·m)."""
-        sd = np.repeat(np.asarray(self.params.ft_noise, dtype=float), 3)
-        self._ft_noise[:] = self.rng.normal(0.0, 1.0, self._ft_noise.shape) * sd
-        self._noise_i = 0
+    def _noise(self, n: int) -> np.ndarray:
+        """(n, 6) gauge noise of ``n`` ticks, before the filter (N, N·m)."""
+        return self.rng.normal(0.0, 1.0, (n, 6)) * self._ft_sd
 
     def measured_wrench(self) -> np.ndarray:
         """What the wrist F/T sensor reports: its filtered output, tared and biased (N, N·m,

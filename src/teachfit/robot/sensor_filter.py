@@ -12,10 +12,10 @@ Butterworth falls off 40 dB/decade: at 35 Hz the same impacts leave 0.06 N at 10
 content. 18 Hz keeps the slow press (0-2 Hz) untouched and delays a force step by about
 12 ms, about what a 10 ms averaging window (the other way to decimate) would.
 
-The coefficients come from :func:`scipy.signal.butter` (bilinear transform); the recurrence
-itself (transposed direct form II) is written here because it runs inside the simulator's
-1 kHz tick, per sample, where calling ``scipy.signal.lfilter`` once per tick would cost more
-than the physics step.
+The coefficients come from :func:`scipy.signal.butter` (bilinear transform). The floating
+tool filters each ``step(n)``'s block of gauge samples with ``scipy.signal.lfilter``
+(:class:`LowPass2`); the FR3's compiled tick runs the same recurrence per sample in numba
+(:mod:`teachfit.robot.fr3.kernel`), where no library call can enter.
 """
 
 from __future__ import annotations
@@ -38,30 +38,30 @@ def butterworth2(cutoff: float, dt: float) -> np.ndarray:
 
 
 class LowPass2:
-    """A second-order Butterworth low-pass over a vector signal, one sample per :meth:`update`.
+    """A second-order Butterworth low-pass over a vector signal, filtered a block at a time.
 
-    ``out`` holds the filtered value (read it, do not replace it); :meth:`reset` starts the
-    filter at rest at a value (its steady state there, so no transient follows).
+    :meth:`filter` takes the samples of one block (``(k, size)``, one row a tick), carries
+    the filter's state from block to block (``scipy.signal.lfilter`` with ``zi``) and leaves
+    the last filtered sample in ``out`` (read it, do not replace it): the same result as a
+    per-tick recursion, at one call per block. :meth:`reset` starts the filter at rest at a
+    value (its steady state there, so no transient follows).
     """
 
     def __init__(self, size: int, cutoff: float, dt: float) -> None:
         self.coef = butterworth2(cutoff, dt)
+        self._b = self.coef[:3].copy()
+        self._a = np.array([1.0, self.coef[3], self.coef[4]])
+        self._zi_unit = signal.lfilter_zi(self._b, self._a)[:, None]  # (2, 1)
+        self.zi = np.zeros((2, size))
         self.out = np.zeros(size)
-        self.z1 = np.zeros(size)
-        self.z2 = np.zeros(size)
 
     def reset(self, x: np.ndarray) -> None:
         """The filter at rest at ``x`` (its output and states as after a long constant input)."""
-        b0, b1, b2, a1, a2 = self.coef
         self.out[:] = x
-        self.z2[:] = (b2 - a2) * x
-        self.z1[:] = (b1 - a1) * x + self.z2
+        self.zi[:] = self._zi_unit * np.asarray(x, dtype=float)
 
-    def update(self, x: np.ndarray) -> None:
-        """Filter one new sample ``x`` into :attr:`out` (transposed direct form II)."""
-        b0, b1, b2, a1, a2 = self.coef
-        out, z1, z2 = self.out, self.z1, self.z2
-        np.multiply(x, b0, out=out)
-        out += z1
-        z1[:] = b1 * x - a1 * out + z2
-        z2[:] = b2 * x - a2 * out
+    def filter(self, block: np.ndarray) -> np.ndarray:
+        """The filtered samples of ``block`` (k, size); ``out`` becomes the last of them."""
+        y, self.zi = signal.lfilter(self._b, self._a, block, axis=0, zi=self.zi)
+        self.out[:] = y[-1]
+        return y
