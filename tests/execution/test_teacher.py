@@ -99,3 +99,26 @@ def test_blind_teacher_inserts_the_unchamfered_puzzle_piece():
     demo, why = BlindTeacher(task, seed=0).demonstrate()
     assert demo is not None, why
     assert task.ground_truth_inserted(Pose(demo.pos[-1], demo.quat[-1]))
+
+
+def test_the_press_wanders_slowly_seeded_and_stays_apart_from_the_other_draws():
+    task = get_task("peg2d")
+    still = BlindTeacher(task, TeacherStyle(press_wander=0.0), seed=4)
+    a, b = BlindTeacher(task, seed=4), BlindTeacher(task, seed=4)
+    start = task.contact_pose([0.03, 0.0])
+    plan_a, plan_b, plan_still = a.plan(start), b.plan(start), still.plan(start)
+    assert np.array_equal(plan_a.wrench_ff, plan_b.wrench_ff)
+    assert np.array_equal(plan_a.pos, plan_still.pos)  # its own random stream
+    assert np.all(plan_still.wrench_ff == 0.0)
+    dev = -plan_a.wrench_ff[:, 2]  # the press's deviation from push_force, 100 Hz, 60 s
+    assert 0.2 < dev.std() < 0.4  # press_wander 0.3 N
+    assert np.corrcoef(dev[:-1], dev[1:])[0, 1] > 0.98  # time constant 1 s: slow
+    assert np.all(plan_a.wrench_ff[:, [0, 1, 3, 4, 5]] == 0.0)
+
+
+def test_the_arm_teacher_presses_by_feel_the_floating_one_open_loop():
+    task = get_task("peg2d")
+    assert BlindTeacher(task, seed=0).style.press_feel == 0.0
+    assert BlindTeacher(task, seed=0, robot="fr3").style.press_feel > 0.0
+    with pytest.raises(TeachfitError, match="press_wander"):
+        TeacherStyle(press_wander=7.0)

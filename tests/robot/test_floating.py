@@ -1,11 +1,13 @@
 import numpy as np
 import pytest
+from scipy import signal
 
 from teachfit.core.control import AdaptiveSpec
 from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.floating import FloatingToolParams, FloatingToolRobot
 from teachfit.robot.interface import Robot
+from teachfit.robot.sensor_filter import butterworth2
 from teachfit.tasks import get_task
 
 
@@ -39,9 +41,16 @@ def test_sensor_noise_and_bias_are_applied():
     params = FloatingToolParams(ft_noise=(0.5, 0.0), ft_bias=(1.0, 0, 0, 0, 0, 0))
     robot = FloatingToolRobot(task, params=params, seed=3)
     robot.reset(task.contact_pose([0.02, 0.0]).translated([0, 0, 0.01]))
-    samples = np.array([robot.state().wrench for _ in range(400)])
+    assert np.array_equal(robot.state().wrench, robot.state().wrench)  # noise enters per tick
+    samples = np.array([robot.step(10).wrench for _ in range(400)])  # in free space, 100 Hz
     assert samples[:, 0].mean() == pytest.approx(1.0, abs=0.1)
-    assert samples[:, 1].std() == pytest.approx(0.5, rel=0.15)
+    # the gauges' white noise (0.5 N per 1 kHz sample) leaves the 18 Hz Butterworth scaled by
+    # the root of its impulse response's energy (about 0.19)
+    b0, b1, b2, a1, a2 = butterworth2(params.ft_cutoff, params.timestep)
+    impulse = signal.lfilter([b0, b1, b2], [1.0, a1, a2], np.eye(1, 2000)[0])
+    gain = float(np.sqrt(np.sum(impulse**2)))
+    assert 0.15 < gain < 0.25
+    assert samples[:, 1].std() == pytest.approx(0.5 * gain, rel=0.15)
 
 
 def test_divergence_is_reported_not_crashed():

@@ -60,11 +60,13 @@ def test_sliding_force_is_smooth_at_100_hz(sensor, start_xy, velocity):
     assert lag1(fz) >= 0.9
 
 
-def test_the_tasks_stiff_contact_makes_the_part_hop():
-    """The cause, kept as a check: with the tasks' contact (impedance 0.95 from first
-    touch, 2 ms) the sliding part loses contact every few ticks and the signal is chatter."""
+def test_the_tasks_stiff_contact_hops_but_the_filtered_signal_is_smooth():
+    """With the tasks' contact (impedance 0.95 from first touch, 2 ms) the sliding part loses
+    contact every few ticks: micro-impacts at 200-500 Hz. Point samples of a first-order
+    filter read them as white noise (std > 1 N); through the output Butterworth they are gone
+    from the 100 Hz signal, as from a real sensor's filtered output."""
     task = get_task("peg2d")
     stiff = FR3Params(contact_solref=STIFF_SOLREF, contact_solimp=STIFF_SOLIMP)
     fz, contacts, _ = slide(FR3Robot(task, params=stiff), task, (0.035, -0.012), (0, 0.012, 0))
     assert contacts.min() == 0
-    assert fz.std() > 1.0
+    assert fz.std() <= 0.5

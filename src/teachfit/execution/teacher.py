@@ -13,7 +13,9 @@ belief about where the hole is is off by ``belief_sigma``. Patterns:
 - ``"zigzag"``: straight towards the belief, then a zig-zag raster around it.
  Human-like noise is a slow random
 wander (an Ornstein-Uhlenbeck process) plus a small physiological tremor; for tasks with a
-rotational search DOF the teacher also wiggles the part about z around its belief. What is
+rotational search DOF the teacher also wiggles the part about z around its belief. The press
+is not constant either: it wanders slowly around ``push_force`` (another Ornstein-Uhlenbeck
+process, ``press_wander`` N over ``press_timescale`` s; see :meth:`BlindTeacher.press`). What is
 recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench at
 ``record_rate``. Demonstrations that end at once or never are discarded, as in seed A.
 """
@@ -38,6 +40,10 @@ from teachfit.tasks.base import Task
 
 PATTERNS = ("sweep", "spiral", "zigzag")
 
+#: per-robot style defaults: on the arm, joint friction loads the open-loop press (f_z swings
+#: 4.5-7.5 N with the sweep's direction), which a person pressing by feel corrects
+ROBOT_STYLE: dict[str, dict[str, float]] = {"fr3": {"press_feel": 0.3}}
+
 
 @dataclass(frozen=True)
 class TeacherStyle:
@@ -56,6 +62,9 @@ class TeacherStyle:
     rz_wiggle: float = 0.2
     rz_wiggle_frequency: float = 0.4
     push_force: float = 6.0
+    press_wander: float = 0.3
+    press_timescale: float = 1.0
+    press_feel: float = 0.0
     arm_stiffness: float = 600.0
     max_duration: float = 60.0
     min_duration: float = 0.5
@@ -65,11 +74,21 @@ class TeacherStyle:
         if self.pattern not in PATTERNS:
             raise TeachfitError(f"teacher pattern must be one of {PATTERNS}, got {self.pattern!r}")
         positive = ("speed", "spiral_pitch", "sweep_halfwidth", "max_duration", "record_rate")
-        for name in (*positive, "wander_timescale"):
+        for name in (*positive, "wander_timescale", "press_timescale"):
             if not getattr(self, name) > 0:
                 raise TeachfitError(f"teacher {name} must be > 0")
+        if not 0 <= self.press_wander < self.push_force:
+            raise TeachfitError("teacher press_wander must be within [0, push_force)")
         if self.min_duration >= self.max_duration:
             raise TeachfitError("teacher min_duration must be below max_duration")
+
+
+def robot_style(style: TeacherStyle, robot: str) -> TeacherStyle:
+    """``style`` with :data:`ROBOT_STYLE`'s defaults for ``robot`` on fields left at theirs."""
+    default = TeacherStyle(pattern=style.pattern)
+    hints = ROBOT_STYLE.get(robot, {})
+    keep = {k: v for k, v in hints.items() if getattr(style, k) == getattr(default, k)}
+    return dataclasses.replace(style, **keep) if keep else style
 
 
 def style_for(task: Task, style: TeacherStyle | None = None) -> TeacherStyle:
@@ -124,9 +143,11 @@ class BlindTeacher:
         robot: str = "floating",
     ) -> None:
         self.task = task
-        self.style = style_for(task, style)
+        self.style = robot_style(style_for(task, style), robot)
         self.seed, self.robot_name = int(seed), robot
         self.rng = np.random.default_rng(seed)
+        # the press's own stream: the plans' other draws stay what they were without it
+        self._press_rng = np.random.default_rng([int(seed), 0x70726573])
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
         self._fresh = True  # nothing recorded yet: a recording depends on the seed alone
         self._replayed = False
@@ -183,6 +204,10 @@ class BlindTeacher:
         tremor = st.tremor_amplitude * np.sin(2 * np.pi * st.tremor_frequency * t[:, None] + phase)
         return w + tremor
 
+    def press(self, n: int, dt: float) -> np.ndarray:
+        """(n,) the press's slow deviation from ``push_force`` (N): :func:`press_wander`."""
+        return press_wander(self.style, n, dt, self._press_rng)
+
     def plan(self, start: Pose) -> SetpointTrajectory:
         """The path the teacher's hand intends, world frame, for ``max_duration``."""
         st, task = self.style, self.task
@@ -217,7 +242,9 @@ class BlindTeacher:
         else:
             quat = np.tile(start.quat, (n, 1))
         pos = np.column_stack([xy, np.full(n, task.surface_z)])
-        return SetpointTrajectory.from_path(t, pos, quat, name="teacher-plan")
+        ff = np.zeros((n, 6))
+        ff[:, 2] = -self.press(n, dt)  # added to the follow skill's constant -push_force
+        return SetpointTrajectory.from_path(t, pos, quat, wrench_ff=ff, name="teacher-plan")
 
     # ----------------------------------------------------------------------- recording
     def demonstrate(self, start: Pose | None = None) -> tuple[Demonstration | None, str]:
@@ -231,13 +258,7 @@ class BlindTeacher:
             )
         self._fresh = False
         start = start or self.task.protocol.teacher_start(self.rng)
-        cfg = FollowConfig(
-            stiffness_along=st.arm_stiffness,
-            stiffness_across=st.arm_stiffness,
-            aligned=False,
-            push_force=st.push_force,
-            settle_time=0.0,
-        )
+        cfg = follow_config(st)
         plan = self.plan(start)
         rate = min(st.record_rate, 100.0)
         outcome = run_trajectory(self.robot, self.task, plan, start, cfg, log_rate=rate)
@@ -318,6 +339,38 @@ class BlindTeacher:
                 f"discarded: {discarded}"
             )
         return demos, discarded
+
+
+def follow_config(style: TeacherStyle) -> FollowConfig:
+    """How the teacher's hand drives the compliant robot: its arm's stiffness in x-y, the
+    follow skill's default z stiffness, its press (and ``press_feel`` loop), no settling."""
+    return FollowConfig(
+        stiffness_along=style.arm_stiffness,
+        stiffness_across=style.arm_stiffness,
+        aligned=False,
+        push_force=style.push_force,
+        settle_time=0.0,
+        press_feel=style.press_feel,
+    )
+
+
+def press_wander(style: TeacherStyle, n: int, dt: float, rng: np.random.Generator) -> np.ndarray:
+    """(n,) a teacher's press deviation from ``style.push_force`` every ``dt`` s (N, positive
+    presses harder).
+
+    An assumption, not a measurement we can cite for kinesthetic teaching: a person holding a
+    steady push of a few newtons drifts by a few percent of it, slowly (force-steadiness
+    studies report coefficients of variation of a few percent at low forces, most of the
+    fluctuation's power below 1-2 Hz). Modelled as a stationary Ornstein-Uhlenbeck process of
+    standard deviation ``style.press_wander`` and time constant ``style.press_timescale``.
+    """
+    a = np.exp(-dt / style.press_timescale)
+    kicks = rng.normal(0.0, style.press_wander * np.sqrt(1 - a * a), n)
+    dev = np.empty(n)
+    dev[0] = rng.normal(0.0, style.press_wander)  # started stationary
+    for i in range(1, n):
+        dev[i] = a * dev[i - 1] + kicks[i]
+    return dev
 
 
 def _along_polyline(corners: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.robot.interface import law_fault
+from teachfit.robot.sensor_filter import LowPass2
 from teachfit.tasks.base import Task
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
 
@@ -31,17 +32,20 @@ class FloatingToolParams:
     """Tool dynamics and wrist sensor model.
 
     ``mass`` (kg) and ``inertia`` (kg·m², diagonal) are the apparent inertia the controller
-    moves (a light arm's end-effector). ``ft_noise`` is the standard deviation of the white
-    noise on ``[f; tau]`` (N, N·m), ``ft_bias`` a constant offset; readings are tared at reset.
-    ``ft_cutoff`` (Hz) is the sensor's first-order low-pass filter, as on real F/T sensors
-    (ATI's digital filter): it also removes MuJoCo's tick-to-tick contact chatter in sliding.
+    moves (a light arm's end-effector). The wrist sensor is modelled as an ATI Mini45 on a Net
+    F/T (seed A's): its gauges are sampled every physics tick (1 kHz here; 7 kHz on the real
+    one) with white noise of ``ft_noise`` (N, N·m, standard deviation per unfiltered sample,
+    of the order of the Mini45's documented resolution), then low-pass filtered on the device
+    (``ft_cutoff`` Hz, a second-order Butterworth, one of the Net F/T's selectable cutoffs:
+    :mod:`teachfit.robot.sensor_filter`); what the 100 Hz log and the skills read is that
+    filtered output. ``ft_bias`` is a constant offset; readings are tared at reset.
     """
 
     mass: float = 1.0
     inertia: tuple[float, float, float] = (0.004, 0.004, 0.004)
     ft_noise: tuple[float, float] = (0.05, 0.002)
     ft_bias: tuple[float, float, float, float, float, float] = (0.0,) * 6
-    ft_cutoff: float = 80.0
+    ft_cutoff: float = 18.0
     timestep: float = 0.001
     contact: ContactParams = field(default_factory=ContactParams)
 
@@ -50,8 +54,8 @@ class FloatingToolParams:
             raise ControlError("tool mass and inertia must be positive")
         if min(self.ft_noise) < 0:
             raise ControlError("ft_noise must be >= 0")
-        if not 0 < self.ft_cutoff:
-            raise ControlError("ft_cutoff must be > 0 Hz")
+        if not 0 < self.ft_cutoff < 0.5 / self.timestep:
+            raise ControlError("ft_cutoff must be within (0 Hz, the physics rate's Nyquist)")
         if not 0 < self.timestep <= 0.002:
             raise ControlError("timestep must be within (0, 2 ms]")
 
@@ -153,8 +157,10 @@ class FloatingToolRobot:
         self._t_adr = int(m.sensor_adr[t_id])
         assert self._t_adr == self._f_adr + 3, "force and torque sensors must be adjacent"
         self._ft_raw = self.data.sensordata[self._f_adr : self._f_adr + 6]
-        self._ft_filt = np.zeros(6)
-        self._ft_alpha = 1.0 - float(np.exp(-2 * np.pi * self.params.ft_cutoff * m.opt.timestep))
+        self._ft_lp = LowPass2(6, self.params.ft_cutoff, float(m.opt.timestep))
+        self._ft_filt = self._ft_lp.out
+        self._ft_sd = np.repeat(np.asarray(self.params.ft_noise, dtype=float), 3)
+        self._gauges = np.zeros((10, 6))  # one step(n)'s gauge samples
         a, b = self._qpos_adr, self._qvel_adr
         self._pos = self.data.qpos[a : a + 3]
         self._quat = self.data.qpos[a + 3 : a + 7]
@@ -187,7 +193,7 @@ class FloatingToolRobot:
         self._pos[:] = pose.pos
         self._quat[:] = pose.quat
         mujoco.mj_forward(self.model, self.data)
-        self._ft_filt[:] = self._ft_raw
+        self._ft_lp.reset(self._ft_raw)
         self._law.reset()
         self.command(ImpedanceCommand.hold(pose))
         self._tare[:] = self._raw_wrench()  # tared at rest in free space, like a real sensor
@@ -224,9 +230,12 @@ class FloatingToolRobot:
         body = self._body
         pos, quat, linvel = self._pos, self._quat, self._linvel
         angvel, angvel_local = self._angvel, self._angvel_local
-        raw, filt, alpha = self._ft_raw, self._ft_filt, self._ft_alpha
+        raw = self._ft_raw
+        if self._gauges.shape[0] < n:
+            self._gauges = np.zeros((n, 6))
+        gauges = self._gauges
         point = d.xpos[body]  # the tool frame origin is the TCP
-        for _ in range(n):
+        for k in range(n):
             mujoco.mju_rotVecQuat(angvel, angvel_local, quat)
             w = ctrl.compute(d.time, pos, quat, linvel, angvel)
             if not math.isfinite(float(w.sum())):
@@ -234,7 +243,9 @@ class FloatingToolRobot:
             qfrc[:] = 0.0
             mujoco.mj_applyFT(m, d, w[:3], w[3:], point, body, qfrc)
             mujoco.mj_step(m, d)
-            filt += alpha * (raw - filt)  # the sensor's low-pass filter
+            gauges[k] = raw  # the gauges sampled every tick ...
+        # ... with their noise, through the device's low-pass (one call for the n ticks)
+        self._ft_lp.filter(gauges[:n] + self._noise(n))
         self._check_divergence()
         return self.state()
 
@@ -255,7 +266,7 @@ class FloatingToolRobot:
         return out
 
     def _raw_wrench(self) -> np.ndarray:
-        """Environment wrench on the held part at the TCP, world frame, untared and noiseless."""
+        """Environment wrench on the held part at the TCP, world frame, untared, filtered."""
         d = self.data
         rot = d.site_xmat[self._site_ft].reshape(3, 3)
         f_site = self._ft_filt[:3]
@@ -268,18 +279,18 @@ class FloatingToolRobot:
         t_env_tcp = t_env_site + np.cross(lever, f_env)
         return np.concatenate([f_env, t_env_tcp])
 
+    def _noise(self, n: int) -> np.ndarray:
+        """(n, 6) gauge noise of ``n`` ticks, before the filter (N, N·m)."""
+        return self.rng.normal(0.0, 1.0, (n, 6)) * self._ft_sd
+
     def measured_wrench(self) -> np.ndarray:
-        """What the wrist F/T sensor reports: tared, biased, noisy (N, N·m, world, at TCP)."""
-        noise = np.concatenate(
-            [
-                self.rng.normal(0.0, self.params.ft_noise[0], 3),
-                self.rng.normal(0.0, self.params.ft_noise[1], 3),
-            ]
-        )
-        return self._raw_wrench() - self._tare + np.asarray(self.params.ft_bias) + noise
+        """What the wrist F/T sensor reports: its filtered output, tared and biased (N, N·m,
+        world, at the TCP); the gauge noise is inside the filter."""
+        return self._raw_wrench() - self._tare + np.asarray(self.params.ft_bias)
 
     def true_contact_wrench(self) -> np.ndarray:
-        """Noise-free tared wrench (for tests and diagnostics)."""
+        """Tared wrench without the bias (for tests and diagnostics; the filtered gauge noise
+        is in it unless ``ft_noise`` is zero)."""
         return self._raw_wrench() - self._tare
 
     # -------------------------------------------------------------------- divergence

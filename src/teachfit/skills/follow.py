@@ -44,7 +44,11 @@ class FollowConfig:
     ``push_force`` presses the part onto the surface; ``settle_time`` is how long to wait after
     the trajectory ends; ``max_force`` (N) ends the execution (force limit); ``anchor``:
     ``"frame"`` follows the trajectory as given in the task frame, ``"entry"`` translates it
-    so that it starts where the set-point is when the node is entered.
+    so that it starts where the set-point is when the node is entered. ``press_feel`` (s), when
+    positive, closes a slow loop on the press as a person pressing by feel does: while in
+    contact (measured f_z above half the wanted), the push is corrected by the integral of the
+    wanted minus the measured f_z over ``press_feel`` (clipped to half ``push_force``); 0 (the
+    default) pushes open loop.
     """
 
     stiffness_along: float = 1500.0
@@ -56,6 +60,7 @@ class FollowConfig:
     settle_time: float = 1.0
     max_force: float = 80.0
     anchor: str = "frame"
+    press_feel: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -65,6 +70,7 @@ class FollowConfig:
             "push_force",
             "settle_time",
             "max_force",
+            "press_feel",
         ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
@@ -102,12 +108,14 @@ class _FollowRun(PrimitiveRun):
         self.direction = np.array([1.0, 0.0])
         self.offset = np.zeros(3)
         self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
+        self.press_correction = 0.0  # N, the felt-press loop's integral (press_feel > 0)
 
     def enter(self, pc: Percept) -> None:
         self.direction[:] = (1.0, 0.0)
         self.offset[:] = pc.p_d - self.traj.pos[0] if self.cfg.anchor == "entry" else 0.0
         pc.goal[:] = self.traj.pos[-1] + self.offset
         pc.done = False
+        self.press_correction = 0.0
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
@@ -120,6 +128,13 @@ class _FollowRun(PrimitiveRun):
         out.twist[3:] = 0.0
         out.wrench[:] = ff
         out.wrench[2] -= cfg.push_force
+        if cfg.press_feel > 0.0:
+            wanted = -out.wrench[2]
+            if pc.f[2] > 0.5 * wanted:  # pressing on a surface: not over a hole, not in air
+                step = (wanted - pc.f[2]) * pc.dt / cfg.press_feel
+                lim = 0.5 * cfg.push_force
+                self.press_correction = min(lim, max(-lim, self.press_correction + step))
+            out.wrench[2] -= self.press_correction
         if cfg.aligned:
             out.stiffness_full[:] = aligned_stiffness(
                 self.direction, cfg.stiffness_along, cfg.stiffness_across, cfg.stiffness_z,

@@ -195,26 +195,42 @@ def observe(fns, m, d, dat, obs, sc):  # noqa: ANN001, ANN201
     """After ``mj_step2``: the momentum observer on the joint torque sensors, or the wrist
     F/T filter (see ``sensing``). ``qM``, ``qfrc_bias`` still hold the step's start values.
 
+    Either estimate then passes the output low-pass (second-order Butterworth, ``coef``,
+    :mod:`teachfit.robot.sensor_filter`) into ``out`` (states ``z``, (2, n)).
+
     ``obs``: (dq_prev, ddq, M ddq, sensor addresses, joint axes, armature, noise block,
-    tau_ext, wrist sensor address, wrist filter state).
+    tau_ext, wrist sensor address, wrist filter state, coef, tau out, tau z, ft out, ft z).
     """
     qvel, bias, sdata = dat[1], dat[2], dat[4]
-    dq_prev, ddq, mddq, tj_adr, axes, armature, noise, tau_ext, ft_adr, ft_filt = obs
+    dq_prev, ddq, mddq, tj_adr, axes, armature, noise, tau_ext, ft_adr, ft_filt = obs[:10]
+    coef, tau_out, tau_z, ft_out, ft_z = obs[10:]
     nv = qvel.shape[0]
+    k = int(sc[NOISE_I])
+    sc[NOISE_I] = k + 1
     if sc[USE_FT] != 0.0:
-        for i in range(6):
-            ft_filt[i] += sc[ALPHA] * (sdata[ft_adr + i] - ft_filt[i])
+        for i in range(6):  # the gauges' noise is inside the sensor's filters
+            ft_filt[i] += sc[ALPHA] * (sdata[ft_adr + i] + noise[k, i] - ft_filt[i])
+        _biquad(coef, ft_filt, ft_out, ft_z)
         return
     for j in range(nv):
         ddq[j] = qvel[j] - dq_prev[j]
     fns[4](m, d, _addr(mddq), _addr(ddq))
-    k = int(sc[NOISE_I])
     for j in range(nv):
         a = tj_adr[j]
         tau_j = sdata[a] * axes[j, 0] + sdata[a + 1] * axes[j, 1] + sdata[a + 2] * axes[j, 2]
         raw = (mddq[j] - armature[j] * ddq[j]) * sc[INV_DT] + bias[j] - tau_j - noise[k, j]
         tau_ext[j] += sc[ALPHA] * (raw - tau_ext[j])
-    sc[NOISE_I] = k + 1
+    _biquad(coef, tau_ext, tau_out, tau_z)
+
+
+@numba.njit(cache=True, inline="always")
+def _biquad(coef, x, y, z) -> None:  # noqa: ANN001
+    """One sample of :class:`teachfit.robot.sensor_filter.LowPass2` per channel of ``x``."""
+    b0, b1, b2, a1, a2 = coef[0], coef[1], coef[2], coef[3], coef[4]
+    for i in range(x.shape[0]):
+        y[i] = b0 * x[i] + z[0, i]
+        z[0, i] = b1 * x[i] - a1 * y[i] + z[1, i]
+        z[1, i] = b2 * x[i] - a2 * y[i]
 
 
 @numba.njit(cache=True, inline="always")
@@ -290,7 +306,7 @@ def run_fixed(n, t, fns, m, d, site, dat, ctl, law, obs, lim, sc, times, log):  
     timed = times.shape[0] >= n
     ts = np.zeros(2, np.int64)
     for k in range(n):
-        if sc[USE_FT] == 0.0 and sc[NOISE_I] >= noise.shape[0]:
+        if sc[NOISE_I] >= noise.shape[0]:
             return k, NOISE_EMPTY
         fns[0](m, d)
         start = _now(fns, ts) if timed else 0

@@ -68,12 +68,15 @@ class FR3Params:
     flange axis (the bottom face of the Franka Hand housing; the fingers are removed and the
     part is rigidly attached). ``sensor`` chooses how the external wrench is measured:
     ``"joint-torques"`` (Franka's ``O_F_ext_hat_K``) or ``"wrist-ft"`` (an F/T sensor at the
-    flange). ``wrench_cutoff`` (Hz) is the first-order low-pass of either estimate;
-    ``torque_noise`` (N·m) and ``ft_noise`` (N, N·m) the white noise of the joint torque
-    sensors and of the wrist sensor. ``null_stiffness`` (N·m/rad) and ``null_damping``
-    (N·m·s/rad) pull the redundant joint motion to the IK posture through the dynamically
-    consistent null-space projector. ``visual`` loads the visual meshes (rendering; costs
-    about a second of start-up).
+    flange). ``wrench_cutoff`` (Hz) is the first-order low-pass of either estimate (the
+    momentum observer's gain, the wrist sensor's analogue stage), ``output_cutoff`` (Hz) the
+    second-order Butterworth both then pass before anyone reads them (the 100 Hz log's
+    anti-alias filter; 18 Hz is one of the ATI Net F/T's options, see
+    :mod:`teachfit.robot.sensor_filter`); ``torque_noise`` (N·m) and ``ft_noise`` (N, N·m)
+    the white noise per tick of the joint torque sensors and of the wrist sensor's gauges.
+    ``null_stiffness`` (N·m/rad) and ``null_damping`` (N·m·s/rad) pull the redundant joint
+    motion to the IK posture through the dynamically consistent null-space projector.
+    ``visual`` loads the visual meshes (rendering; costs about a second of start-up).
 
     Contact model (see :mod:`teachfit.robot.fr3.model` for why): ``contact_solref`` and
     ``contact_solimp`` replace the task's ``solref``/``solimp`` (its friction is kept):
@@ -86,6 +89,7 @@ class FR3Params:
     mount_offset: float = 0.066
     sensor: str = "joint-torques"
     wrench_cutoff: float = 30.0
+    output_cutoff: float = 18.0
     torque_noise: float = 0.02
     ft_noise: tuple[float, float] = (0.05, 0.002)
     null_stiffness: float = 10.0
@@ -102,6 +106,8 @@ class FR3Params:
             raise ControlError(f"fr3 sensor must be one of {SENSORS}, got {self.sensor!r}")
         if not self.wrench_cutoff > 0:
             raise ControlError("wrench_cutoff must be > 0 Hz")
+        if not 0 < self.output_cutoff < 0.5 / self.timestep:
+            raise ControlError("output_cutoff must be within (0 Hz, the physics rate's Nyquist)")
         if self.torque_noise < 0 or min(self.ft_noise) < 0:
             raise ControlError("sensor noise must be >= 0")
         if self.null_stiffness < 0 or self.null_damping < 0:

@@ -92,15 +92,23 @@ class FR3Robot:
             self.params.wrench_cutoff,
             self.params.torque_noise,
             self.rng,
+            self.params.output_cutoff,
         )
         force = mujoco.mj_name2id(m, obj.mjOBJ_SENSOR, fr3_model.FT_FORCE)
         torque = mujoco.mj_name2id(m, obj.mjOBJ_SENSOR, fr3_model.FT_TORQUE)
-        self.ft = WristFT(m, d, flange, force, torque, self.params.wrench_cutoff)
+        self.ft = WristFT(
+            m, d, flange, force, torque, self.params.wrench_cutoff, self.params.output_cutoff
+        )
         self._use_ft = self.wrench_source == "wrist-ft"
+        if self._use_ft:  # the noise block then feeds the wrist sensor's gauges
+            f_sd, t_sd = self.params.ft_noise
+            self.observer.noise_std[:] = (f_sd, f_sd, f_sd, t_sd, t_sd, t_sd, 0.0)
+            self.observer.draw_noise()
         sc = self.ctl.sc
         sc[kernel.ALPHA], sc[kernel.INV_DT] = self.observer.alpha, 1.0 / self.control_period
         sc[kernel.USE_FT] = float(self._use_ft)
-        self._obs_bufs = (*self.observer.bufs, self.ft.adr, self.ft.filt)
+        self._obs_bufs = (*self.observer.bufs, self.ft.adr, self.ft.filt, self.observer.coef)
+        self._obs_bufs += (self.observer.tau_out, self.observer.tau_z, self.ft.out, self.ft.z)
         self._limits = (self.q_min, self.q_max, self.dq_max)
         self._warning_numbers = d.warning.number
         self._warnings = 0
@@ -267,13 +275,7 @@ class FR3Robot:
     def measured_wrench(self) -> np.ndarray:
         """External wrench on the tool at the TCP (N, N·m, world) from ``wrench_source``."""
         if self._use_ft:
-            noise = np.concatenate(
-                [
-                    self.rng.normal(0.0, self.params.ft_noise[0], 3),
-                    self.rng.normal(0.0, self.params.ft_noise[1], 3),
-                ]
-            )
-            return self.ft.wrench(self.data.site_xpos[self._tcp]) + noise
+            return self.ft.wrench(self.data.site_xpos[self._tcp])
         return self.observer.wrench(self.ctl.jac)
 
     @property

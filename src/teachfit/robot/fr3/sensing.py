@@ -18,18 +18,25 @@ full joint-space inertia less the rotors' armature, whose torque the sensors do 
 arithmetic runs compiled every tick, :func:`teachfit.robot.fr3.kernel.observe`). The TCP
 wrench is the least-squares solution of ``J^T F = r``: ``F = pinv(J^T) r`` (N, N·m, world
 frame at the TCP), the wrench the environment exerts on the tool. The sensors carry white
-noise of ``torque_noise`` N·m.
+noise of ``torque_noise`` N·m per tick.
 
 **Wrist F/T sensor**: MuJoCo's force and torque sensors on a site at the flange (the interface
 between link 7 and the hand), filtered by the same first-order low-pass, tared at reset (the
 hand and part's weight), turned into the environment's wrench at the TCP as on the floating
-tool. Noise ``ft_noise`` (N, N·m) is added at read-out.
+tool. Its gauges carry white noise of ``ft_noise`` (N, N·m) per tick, inside the filters.
+
+**Output filter.** Either estimate then passes a second-order Butterworth low-pass
+(``FR3Params.output_cutoff``, :mod:`teachfit.robot.sensor_filter`), as Franka filters
+``O_F_ext_hat_K`` and ATI's Net F/T filters on the device before anything reads it at 100 Hz:
+the 100 Hz log and the skills read a signal without aliased kHz content.
 """
 
 from __future__ import annotations
 
 import mujoco
 import numpy as np
+
+from teachfit.robot.sensor_filter import butterworth2
 
 _NOISE_BLOCK = 1000  # sensor noise drawn this many ticks at a time
 
@@ -53,13 +60,18 @@ class JointTorqueObserver:
         cutoff: float,
         noise: float,
         rng: np.random.Generator,
+        output_cutoff: float = 18.0,
     ) -> None:
         nv = model.nv
         if nv != model.njnt or len(sensors) != nv:
             raise ValueError("the observer expects one dof per joint and a sensor per joint")
         self.alpha = lowpass_alpha(cutoff, float(model.opt.timestep))
-        self.noise_std, self.rng = float(noise), rng
+        self.coef = butterworth2(output_cutoff, float(model.opt.timestep))
+        #: per-channel noise std of the block (N·m; the robot sets the wrist sensor's instead)
+        self.noise_std, self.rng = np.full(nv, float(noise)), rng
         self.tau_ext = np.zeros(nv)
+        self.tau_out = np.zeros(nv)  # after the output filter: what the robot reports
+        self.tau_z = np.zeros((2, nv))
         self.noise = np.zeros((_NOISE_BLOCK, nv))
         ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, s) for s in sensors]
         adr = np.array([model.sensor_adr[i] for i in ids], dtype=np.int64)
@@ -71,15 +83,17 @@ class JointTorqueObserver:
 
     def reset(self) -> None:
         self.tau_ext[:] = 0.0
+        self.tau_out[:] = 0.0
+        self.tau_z[:] = 0.0
         self.draw_noise()
 
     def draw_noise(self) -> None:
         """The next block of sensor noise (the kernel walks through it, ``NOISE_I``)."""
-        self.noise[:] = self.rng.normal(0.0, self.noise_std, self.noise.shape)
+        self.noise[:] = self.rng.normal(0.0, 1.0, self.noise.shape) * self.noise_std
 
     def wrench(self, jac: np.ndarray) -> np.ndarray:
         """``F = pinv(J^T) tau_ext`` (6,) for the TCP Jacobian ``jac`` (6, nv)."""
-        return np.linalg.lstsq(jac.T, self.tau_ext, rcond=None)[0]
+        return np.linalg.lstsq(jac.T, self.tau_out, rcond=None)[0]
 
 
 class WristFT:
@@ -93,6 +107,7 @@ class WristFT:
         force_sensor: int,
         torque_sensor: int,
         cutoff: float,
+        output_cutoff: float = 18.0,
     ) -> None:
         f_adr = int(model.sensor_adr[force_sensor])
         if int(model.sensor_adr[torque_sensor]) != f_adr + 3:
@@ -101,11 +116,18 @@ class WristFT:
         self.raw = data.sensordata[f_adr : f_adr + 6]
         self.filt = np.zeros(6)
         self.alpha = lowpass_alpha(cutoff, float(model.opt.timestep))
+        self.coef = butterworth2(output_cutoff, float(model.opt.timestep))
+        self.out = np.zeros(6)  # after the output filter: what the robot reports
+        self.z = np.zeros((2, 6))
         self.tare = np.zeros(6)
 
     def reset(self, tcp: np.ndarray) -> None:
         """Start the filter at the current reading and tare it (``wrench(tcp)`` reads zero)."""
         self.filt[:] = self.raw
+        b0, b1, b2, a1, a2 = self.coef
+        self.out[:] = self.raw  # the output filter at rest there
+        self.z[1] = (b2 - a2) * self.raw
+        self.z[0] = (b1 - a1) * self.raw + self.z[1]
         self.tare[:] = 0.0
         self.tare[:] = self.wrench(tcp)
 
@@ -115,6 +137,6 @@ class WristFT:
         rot = d.site_xmat[self.site].reshape(3, 3)
         # MuJoCo reports what the hand exerts on link 7; the environment's wrench on the tool
         # balances it quasi-statically: flip the sign, then move the torque to the TCP
-        f_env = -(rot @ self.filt[:3])
-        t_env = -(rot @ self.filt[3:]) + np.cross(d.site_xpos[self.site] - tcp, f_env)
+        f_env = -(rot @ self.out[:3])
+        t_env = -(rot @ self.out[3:]) + np.cross(d.site_xpos[self.site] - tcp, f_env)
         return np.concatenate([f_env, t_env]) - self.tare

@@ -1,0 +1,39 @@
+"""The follow primitive's felt-press loop (``press_feel``)."""
+
+import numpy as np
+import pytest
+
+from teachfit.core.geometry import Pose
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.skills.follow import FollowConfig, FollowSetpoints
+from teachfit.skills.percept import MPCommand, Percept
+
+
+def _pushes(press_feel, measured, ticks=50):
+    t = np.array([0.0, 10.0])
+    traj = SetpointTrajectory.from_path(t, np.zeros((2, 3)), np.tile([1.0, 0, 0, 0], (2, 1)))
+    run = FollowSetpoints(traj, FollowConfig(push_force=6.0, press_feel=press_feel)).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    out = []
+    for _ in range(ticks):
+        pc.f[2] = measured
+        cmd = MPCommand()
+        run.command(pc, cmd)
+        out.append(-cmd.wrench[2])
+    return np.array(out)
+
+
+def test_open_loop_by_default():
+    assert np.all(_pushes(0.0, 4.0) == 6.0)
+
+
+def test_a_light_felt_press_is_pushed_harder_slowly_and_bounded():
+    push = _pushes(0.3, 4.5, ticks=200)  # 1.5 N short of the wanted 6 N
+    assert push[0] < 6.2 and np.all(np.diff(push) >= 0)
+    assert push[30] == pytest.approx(6.0 + 1.5 * 0.01 / 0.3 * 31)
+    assert push[-1] == 9.0  # clipped at half the push force more
+
+
+def test_no_correction_out_of_contact():
+    assert np.all(_pushes(0.3, 0.5) == 6.0)  # over a hole or in the air: the plain push
