@@ -4,6 +4,7 @@ import pytest
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.execution.teacher import BlindTeacher, TeacherStyle, style_for
+from teachfit.robot.fr3 import FR3Robot
 from teachfit.tasks import get_task
 from teachfit.tasks.registry import load_task
 
@@ -67,6 +68,16 @@ def test_other_patterns_go_straight_towards_the_belief():
 def test_builtin_tasks_keep_the_default_style():
     assert style_for(get_task("peg2d")) == TeacherStyle()
     assert style_for(get_task("peg2d"), TeacherStyle(pattern="spiral")).pattern == "spiral"
+
+
+def test_an_arm_slows_the_teacher_only_on_tasks_that_search_in_rz():
+    arm = FR3Robot  # the hints are a class attribute: no model needs building
+    socket = style_for(get_task("socket3d"), robot=arm)
+    assert socket.speed < TeacherStyle().speed
+    assert socket.rz_wiggle_frequency < TeacherStyle().rz_wiggle_frequency
+    assert style_for(get_task("peg2d"), robot=arm) == TeacherStyle()  # Table I's stays
+    explicit = style_for(get_task("socket3d"), TeacherStyle(speed=0.02), robot=arm)
+    assert explicit.speed == 0.02  # an explicit choice wins over the robot's hints
 
 
 def test_mesh_task_scales_the_teacher_to_its_fit(mesh_examples):

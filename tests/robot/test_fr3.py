@@ -10,7 +10,7 @@ from teachfit.core.errors import LimitViolation, SimulationDiverged, TeachfitErr
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot import make_robot
 from teachfit.robot.fr3 import FR3Params, FR3Robot
-from teachfit.robot.fr3.model import JOINTS, PART_PREFIX
+from teachfit.robot.fr3.model import HAND_CLEARANCE, JOINTS, PART_PREFIX, fixture_top, grasp_drop
 from teachfit.robot.fr3.params import DTAU_MAX, GAZ_PHI1, Q_MAX, Q_MIN, TAU_MAX
 from teachfit.robot.interface import Robot
 from teachfit.tasks import get_task
@@ -199,6 +199,17 @@ def test_aligned_peg_inserts_and_one_millimetre_off_is_blocked():
     assert not task.ground_truth_inserted(off.pose)
     assert abs(task.insertion_depth(off.pose)) < 2e-4
     assert off.wrench[2] > 5.0
+
+
+def test_the_hand_clears_the_socket_wall_with_the_plug_past_its_success_depth():
+    socket = get_task("socket3d")
+    wall_top = socket.surface_z + socket.params.recess_depth
+    assert fixture_top(socket) == pytest.approx(wall_top, abs=1e-6)
+    drop = grasp_drop(socket)  # held this much lower in the fingers than flush under the hand
+    inserted = socket.hole2world.pos[2] - socket.success_depth - 0.002
+    hand_bottom = inserted + socket.scene.held_part_length + drop
+    assert drop > 0.004 and hand_bottom >= wall_top + HAND_CLEARANCE - 1e-6
+    assert grasp_drop(get_task("peg2d")) == 0.0  # the parts that clear keep their grasp
 
 
 def test_limit_violation_and_divergence_are_latched_until_reset(task, robot):

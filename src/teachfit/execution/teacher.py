@@ -91,14 +91,20 @@ def robot_style(style: TeacherStyle, robot: str) -> TeacherStyle:
     return dataclasses.replace(style, **keep) if keep else style
 
 
-def style_for(task: Task, style: TeacherStyle | None = None) -> TeacherStyle:
+def style_for(
+    task: Task, style: TeacherStyle | None = None, robot: object | None = None
+) -> TeacherStyle:
     """``style`` (default :class:`TeacherStyle`) with the task's ``teacher_hints()`` (a dict of
     field overrides scaled to its cell, e.g. a mesh task's) -- or, for a built-in task without
     them, :func:`unchamfered_hints` -- on the fields left at their defaults (``pattern``
-    only over the default sweep)."""
+    only over the default sweep). For a task that searches in rz, the ``robot``'s
+    ``teacher_rz_hints`` (a dict, e.g. the FR3's) come after the task's: an arm whose yaw lags
+    the wiggle needs a slower hand."""
     base = style or TeacherStyle()
     hints = getattr(task, "teacher_hints", None)
-    given = hints() if hints is not None else unchamfered_hints(task)
+    given = dict(hints() if hints is not None else unchamfered_hints(task))
+    if "rz" in task.search_dims:
+        given.update(getattr(robot, "teacher_rz_hints", None) or {})
     default = TeacherStyle(pattern=base.pattern)
     keep = {k: v for k, v in given.items() if getattr(base, k) == getattr(default, k)}
     if base.pattern != TeacherStyle.pattern:
@@ -143,12 +149,12 @@ class BlindTeacher:
         robot: str = "floating",
     ) -> None:
         self.task = task
-        self.style = robot_style(style_for(task, style), robot)
         self.seed, self.robot_name = int(seed), robot
         self.rng = np.random.default_rng(seed)
         # the press's own stream: the plans' other draws stay what they were without it
         self._press_rng = np.random.default_rng([int(seed), 0x70726573])
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
+        self.style = robot_style(style_for(task, style, self.robot), robot)
         self._fresh = True  # nothing recorded yet: a recording depends on the seed alone
         self._replayed = False
         self.has_rz = "rz" in task.search_dims

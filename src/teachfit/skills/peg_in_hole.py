@@ -9,8 +9,11 @@ surface); the lateral move runs along its +x. Five primitives:
 2. ``contact``   down at ``v_contact`` until the surface pushes back ``f_contact``.
 3. ``lateral``   along +x at ``v_lateral`` pressing ``f_push``, compliant across the motion,
    until constrained: the lowest rim has dropped over the hole edge (``drop_depth`` below
-   the entry) or the part is wedged (the environment resists the motion with ``f_lateral``,
-   or the part stopped moving).
+   the entry) or the part is wedged (the environment resists the motion with ``f_lateral``
+   once ``t_settle`` has passed, or the part stopped moving). The settle time keeps the
+   landing's impact out of that check: on an arm (several kg of apparent mass, the FR3) the
+   part lands with 15 N, whose friction alone resists with more than ``f_lateral`` in the
+   first tick, and the skill skipped the lateral move; the floating tool lands with 4 N.
 4. ``align``     rotate upright into the estimated hole orientation (the nearest yaw modulo
    the part's symmetry ``rz_period``) keeping contact with ``f_push``.
 5. ``insert``    push with the learned ``force`` while the set-point sinks to ``depth``,
@@ -72,6 +75,9 @@ CONTEXT: dict[str, ContextParam] = {
     "f_contact": ContextParam(3.0, "N", "force that marks contact with the surface"),
     "f_push": ContextParam(4.0, "N", "pressing force while moving laterally and aligning"),
     "f_lateral": ContextParam(4.0, "N", "resistance that marks a constrained lateral move"),
+    "t_settle": ContextParam(
+        0.05, "s", "lateral move: time after landing before a resistance counts as a constraint"
+    ),
     "drop_depth": ContextParam(0.001, "m", "depth below the entry that marks a caught part"),
     "v_still": ContextParam(0.002, "m/s", "lateral speed below which the part is stuck"),
     "f_max": ContextParam(50.0, "N", "safety limit of the contact force"),
@@ -176,7 +182,7 @@ def build(controller: str = "adaptive") -> Skill:
     )
     constrained = Any_(
         (
-            ForceAbove("f_lateral", axis="-x"),
+            TimeAbove("t_settle") & ForceAbove("f_lateral", axis="-x"),
             DepthAbove("drop_depth"),
             TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
         )

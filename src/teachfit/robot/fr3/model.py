@@ -143,6 +143,46 @@ def _arm_spec(params: FR3Params) -> mujoco.MjSpec:
     return arm
 
 
+#: the hand's lowest point stays this far (m) above the fixture when the part is inserted
+HAND_CLEARANCE = 0.002
+#: how deep (m) past the task's success depth the hand must be able to go
+_EXTRA_DEPTH = 0.002
+
+
+def fixture_top(task: Task) -> float:
+    """Highest point (m, world z) of the task's colliding fixture geometry (planes excluded)."""
+    model = mujoco.MjModel.from_xml_string(_cell_xml(task, ContactParams(), 0.001))
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    part = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, _PART_SRC)
+    top = float(task.surface_z)
+    for g in range(model.ngeom):
+        body = model.geom_bodyid[g]
+        if model.body_rootid[body] == part or model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE:
+            continue
+        if model.geom_contype[g] == 0 and model.geom_conaffinity[g] == 0:
+            continue
+        centre, half = model.geom_aabb[g, :3], model.geom_aabb[g, 3:]
+        rz = data.geom_xmat[g].reshape(3, 3)[2]
+        top = max(top, float(data.geom_xpos[g, 2] + rz @ centre + np.abs(rz) @ half))
+    return top
+
+
+def grasp_drop(task: Task) -> float:
+    """How much lower (m) than flush under the hand the part is held: enough that the Franka
+    Hand clears the fixture by :data:`HAND_CLEARANCE` with the part ``_EXTRA_DEPTH`` past its
+    success depth (0 for every built-in task but ``socket3d``, whose recess wall stands 22 mm
+    above its floor and would stop the hand 0.4 mm short of success: the part is then held
+    lower in the fingers, as a person would grasp it)."""
+    hand_z = (
+        float(task.hole2world.pos[2])
+        - float(task.success_depth)
+        - _EXTRA_DEPTH
+        + float(task.scene.held_part_length)
+    )
+    return max(0.0, fixture_top(task) + HAND_CLEARANCE - hand_z)
+
+
 def build_fr3_spec(task: Task, params: FR3Params | None = None) -> mujoco.MjSpec:
     """The whole cell: the task's fixture, the FR3 on its base, the held part on the hand,
     torque motors, the wrist F/T sensors and the joint torque sensors."""
@@ -157,7 +197,8 @@ def build_fr3_spec(task: Task, params: FR3Params | None = None) -> mujoco.MjSpec
     base.attach_body(_arm_spec(params).body("base"), ARM_PREFIX, "")
     # part frame = TCP, +z back towards the flange: rotated by pi about the hand's x axis
     mount = spec.body(HAND).add_frame(
-        pos=[0.0, 0.0, params.mount_offset + task.scene.held_part_length], quat=[0.0, 1.0, 0.0, 0.0]
+        pos=[0.0, 0.0, params.mount_offset + task.scene.held_part_length + grasp_drop(task)],
+        quat=[0.0, 1.0, 0.0, 0.0],
     )
     spec.copy_during_attach = True
     part = mount.attach_body(spec.body(_PART_SRC), PART_PREFIX, "")
