@@ -60,6 +60,8 @@ class TeacherStyle:
     max_duration: float = 60.0
     min_duration: float = 0.5
     record_rate: float = 100.0
+    #: sinking (m) after which the hand stops moving the part sideways (None: never)
+    hold_depth: float | None = None
 
     def __post_init__(self) -> None:
         if self.pattern not in PATTERNS:
@@ -75,7 +77,8 @@ class TeacherStyle:
 def style_for(task: Task, style: TeacherStyle | None = None) -> TeacherStyle:
     """``style`` (default :class:`TeacherStyle`) with the task's ``teacher_hints()`` (a dict of
     field overrides scaled to its cell, e.g. a mesh task's) on the fields left at their
-    defaults; built-in tasks have no hints and keep the style as it is."""
+    defaults (``peg2d`` scales its sweep to its clearance, chamfers and friction; tasks
+    without hints keep the style as it is)."""
     base = style or TeacherStyle()
     hints = getattr(task, "teacher_hints", None)
     if hints is None:
@@ -209,6 +212,7 @@ class BlindTeacher:
             aligned=False,
             push_force=st.push_force,
             settle_time=0.0,
+            hold_depth=st.hold_depth,
         )
         plan = self.plan(start)
         rate = min(st.record_rate, 100.0)

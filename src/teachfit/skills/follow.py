@@ -44,7 +44,11 @@ class FollowConfig:
     ``push_force`` presses the part onto the surface; ``settle_time`` is how long to wait after
     the trajectory ends; ``max_force`` (N) ends the execution (force limit); ``anchor``:
     ``"frame"`` follows the trajectory as given in the task frame, ``"entry"`` translates it
-    so that it starts where the set-point is when the node is entered.
+    so that it starts where the set-point is when the node is entered. ``hold_depth`` (m,
+    None: off): once the TCP has sunk that far below its height on entering the node (the part
+    dropped into the hole), the x-y set-point stays where the part is and only the push goes
+    on, as a person who feels the part drop stops moving it sideways (dragged on, a part caught
+    in a hole with high friction wedges instead of sliding in).
     """
 
     stiffness_along: float = 1500.0
@@ -56,6 +60,7 @@ class FollowConfig:
     settle_time: float = 1.0
     max_force: float = 80.0
     anchor: str = "frame"
+    hold_depth: float | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -69,6 +74,10 @@ class FollowConfig:
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise SkillError(f"follow: {name} must be >= 0, got {value}")
+        if self.hold_depth is not None and not (
+            math.isfinite(self.hold_depth) and self.hold_depth > 0
+        ):
+            raise SkillError(f"follow: hold_depth must be > 0, got {self.hold_depth}")
         if self.anchor not in ("frame", "entry"):
             raise SkillError(f"follow: anchor must be 'frame' or 'entry', got {self.anchor!r}")
 
@@ -101,6 +110,8 @@ class _FollowRun(PrimitiveRun):
         self.rot_k = np.asarray(cfg.stiffness_rot, dtype=float)
         self.direction = np.array([1.0, 0.0])
         self.offset = np.zeros(3)
+        self.z0 = 0.0
+        self.hold: np.ndarray | None = None  # x-y where the part dropped (hold_depth)
         self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
 
     def enter(self, pc: Percept) -> None:
@@ -108,6 +119,7 @@ class _FollowRun(PrimitiveRun):
         self.offset[:] = pc.p_d - self.traj.pos[0] if self.cfg.anchor == "entry" else 0.0
         pc.goal[:] = self.traj.pos[-1] + self.offset
         pc.done = False
+        self.z0, self.hold = float(pc.p[2]), None
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
@@ -120,6 +132,13 @@ class _FollowRun(PrimitiveRun):
         out.twist[3:] = 0.0
         out.wrench[:] = ff
         out.wrench[2] -= cfg.push_force
+        if cfg.hold_depth is not None:
+            if self.hold is None and self.z0 - pc.p[2] >= cfg.hold_depth:
+                self.hold = pc.p[:2].copy()
+            if self.hold is not None:
+                pc.p_d[:2] = self.hold
+                out.twist[:2] = 0.0
+                out.wrench[:2] = 0.0
         if cfg.aligned:
             out.stiffness_full[:] = aligned_stiffness(
                 self.direction, cfg.stiffness_along, cfg.stiffness_across, cfg.stiffness_z,
