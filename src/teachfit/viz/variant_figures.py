@@ -41,7 +41,7 @@ def success_by_parameter(
     for ax, name in zip(axs[0], axes_names, strict=True):
         xs = np.array([r["values"][name] for r in records], dtype=float)  # type: ignore[index]
         levels = np.unique(xs)
-        step = float(np.min(np.diff(levels))) if levels.size > 1 else 1.0
+        step = float(np.min(np.diff(levels))) if levels.size > 1 else abs(levels[0]) or 1.0
         for k, method in enumerate(methods):
             pts = [
                 (x, r["rates"][method])  # type: ignore[index]
@@ -60,6 +60,7 @@ def success_by_parameter(
         if goal is not None:
             ax.axhline(100 * goal, ls="--", color="0.4", lw=1, label=f"goal {100 * goal:.0f} %")
         ax.set_xticks(levels)
+        ax.set_xlim(levels[0] - 0.5 * step, levels[-1] + 0.5 * step)
         ax.set_xlabel(_LABELS.get(name, name))
         ax.set_ylim(-5, 105)
         ax.grid(alpha=0.3)
