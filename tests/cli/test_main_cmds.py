@@ -216,3 +216,11 @@ def test_learn_plan_run_search(tmp_path):
 def test_bench_search_names_missing_tables():
     res = invoke("bench", "search", "--table", "7")
     assert res.exit_code == 2 and "available" in res.output
+
+
+def test_bench_search_variants_refuses_what_it_cannot_run(tmp_path):
+    res = invoke("bench", "search", "--variants", "--table", "2")
+    assert res.exit_code == 2 and "--table 1, 3 or all" in res.output
+    bad = tmp_path / "fig.xyz"
+    res = invoke("bench", "search", "--variants", "--figure", bad)
+    assert res.exit_code == 2 and "fig.xyz" in _flat(res.output) and not bad.exists()

@@ -91,3 +91,23 @@ def test_a_robot_fault_is_its_own_outcome():
     )
     assert outcome.outcome is Outcome.FAULT and "stopped answering" in outcome.reason
     assert outcome.log.n_samples >= 10
+
+
+def test_hold_depth_presses_a_dropped_peg_in_instead_of_dragging_it():
+    # sharp edges, 0.2 mm clearance, friction 0.8: dragged on, a peg that dropped in wedges
+    import pytest
+
+    from teachfit.core.errors import SkillError
+    from teachfit.robot.registry import make_robot
+
+    task = get_task("peg2d", peg_chamfer=0.0, hole_chamfer=0.0, clearance=0.0002, friction=0.8)
+    robot = make_robot("floating", task, seed=0)
+    n = 250  # 2.5 s, 30 mm at 12 mm/s across the hole's centre
+    pos = np.column_stack([np.linspace(-0.008, 0.022, n), np.zeros(n), np.full(n, task.surface_z)])
+    plan = SetpointTrajectory.from_path(np.arange(n) / 100, pos, np.tile([1.0, 0, 0, 0], (n, 1)))
+    cfg = FollowConfig(stiffness_along=600, stiffness_across=600, aligned=False, settle_time=0.0,
+                       hold_depth=task.hold_depth)  # fmt: skip
+    out = run_trajectory(robot, task, plan, task.contact_pose(pos[0, :2]), cfg)
+    assert out.success, out.reason
+    with pytest.raises(SkillError, match="hold_depth"):
+        FollowConfig(hold_depth=0.0)

@@ -66,7 +66,9 @@ def test_other_patterns_go_straight_towards_the_belief():
 
 
 def test_builtin_tasks_keep_the_default_style():
-    assert style_for(get_task("peg2d")) == TeacherStyle()
+    # the default peg2d keeps the default sweep; its hand only stops once the peg is in the bore
+    assert style_for(get_task("peg2d")) == TeacherStyle(hold_depth=0.002)
+    assert style_for(get_task("socket3d")) == TeacherStyle()
     assert style_for(get_task("peg2d"), TeacherStyle(pattern="spiral")).pattern == "spiral"
 
 

@@ -193,7 +193,20 @@ def table2(
 
 
 def _socket_demos(task: object, seed: int) -> list[Demonstration]:
-    """Two worst-case teacher demonstrations started at opposite ends of the socket's upper half.
+    """Two worst-case teacher demonstrations started at opposite ends of the socket's upper half
+    (:func:`record_socket_demos`); raises if one end failed six times."""
+    demos, discarded = record_socket_demos(task, seed)
+    if len(demos) < 2:
+        raise TeachfitError(
+            f"the teacher failed six times from one end of the socket ({discarded[-1]})"
+        )
+    return demos
+
+
+def record_socket_demos(task: object, seed: int) -> tuple[list[Demonstration], list[str]]:
+    """Two worst-case teacher demonstrations started at opposite ends of the socket's upper
+    half, and the reasons of the discarded attempts (up to six per end; fewer than two
+    demonstrations when an end failed six times).
 
     Opposite ends in position (left and right of the upper half, against the wall) and in yaw
     (turned by 60-100 % of ``start_rz`` one way, then the other), so that together they span
@@ -203,27 +216,29 @@ def _socket_demos(task: object, seed: int) -> list[Demonstration]:
     key = cache_key(
         task=task, style=TeacherStyle(), seed=seed, robot=ROBOT[0], n=2, limit=6, kind="socket"
     )
-    return cached(key, lambda: (_record_socket_demos(task, seed), []))[0]
+    return cached(key, lambda: _record_socket_demos(task, seed))
 
 
-def _record_socket_demos(task: object, seed: int) -> list[Demonstration]:
+def _record_socket_demos(task: object, seed: int) -> tuple[list[Demonstration], list[str]]:
     rng = np.random.default_rng(seed)
     dist = task.play - task.params.start_wall_gap  # type: ignore[attr-defined]
     teacher = BlindTeacher(task, seed=seed, robot=ROBOT[0])  # type: ignore[arg-type]
     demos: list[Demonstration] = []
+    discarded: list[str] = []
     rz_max = task.params.start_rz  # type: ignore[attr-defined]
     for (lo, hi), sign in (((0.05, 0.25), 1.0), ((0.75, 0.95), -1.0)):
         for _attempt in range(6):
             ang = np.pi * rng.uniform(lo, hi)
             rz = sign * rng.uniform(0.6 * rz_max, rz_max)  # worst case: far from aligned
             start = task.contact_pose(dist * np.array([np.cos(ang), np.sin(ang)]), rz)  # type: ignore[attr-defined]
-            demo, _why = teacher.demonstrate(start)
+            demo, why = teacher.demonstrate(start)
             if demo is not None:
                 demos.append(demo)
                 break
+            discarded.append(why)
         else:
-            raise TeachfitError("the teacher failed six times from one end of the socket")
-    return demos
+            return demos, discarded
+    return demos, discarded
 
 
 def table3(

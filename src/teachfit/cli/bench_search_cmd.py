@@ -79,6 +79,19 @@ def bench_search(
         str | None,
         typer.Option(help="demonstrations of --task, FILE.h5 (default: the teacher records one)"),
     ] = None,
+    variants: Annotated[
+        bool,
+        typer.Option(
+            help="run Table I (peg2d; --table 1) / III (socket3d; --table 3) on a seeded "
+            "sample of task variants (--table all: both)"
+        ),
+    ] = False,
+    n_variants: Annotated[
+        int, typer.Option("--n-variants", min=1, help="--variants: variants per task")
+    ] = 12,
+    figure: Annotated[
+        Path, typer.Option(help="--variants: figure of success against each parameter")
+    ] = Path("search_variants.png"),
 ) -> None:
     """The search paper's experiments (Ehlers et al. 2019) in simulation, beside its numbers.
 
@@ -93,6 +106,13 @@ def bench_search(
         raise TeachfitError(f"--demo {demo} is for --task TASK (the paper's tables record theirs)")
     todo = TABLES[:-1] if table == "all" else (table,)
     bs.use_robot(robot)
+    if variants:
+        names = {"1": ["peg2d"], "3": ["socket3d"], "all": ["peg2d", "socket3d"]}.get(table)
+        if names is None or task is not None:
+            raise TeachfitError("--variants runs --table 1, 3 or all, and takes no --task")
+        for name in names:
+            _variants(name, n_variants, seed, starts or 20, points, workers, markdown, figure)
+        return
     if task is not None:
         _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
         return
@@ -164,3 +184,61 @@ def _task_table(
         rows = task_table(task, demos, seed, starts, points, workers, lambda: bar.advance(job))
     title = f"Table I protocol ({task}, {len(demos)} demo(s), {starts} starts, seed {seed})"
     _emit(title, rows, markdown)
+
+
+def _variants(
+    task: str,
+    n: int,
+    seed: int,
+    starts: int,
+    points: int | None,
+    workers: int | None,
+    markdown: Path | None,
+    figure: Path,
+) -> None:
+    from matplotlib.figure import Figure
+
+    from teachfit.bench import search_variants as sv
+    from teachfit.viz.output import save_figure
+    from teachfit.viz.variant_figures import success_by_parameter
+
+    if figure.suffix.lower().lstrip(".") not in Figure().canvas.get_supported_filetypes():
+        raise TeachfitError(f"cannot write figure {figure}: unknown image format; use .png")
+    with progress_bar() as bar:
+        job = bar.add_task(f"{task} variants: TSHIX and ergodic", total=2 * n * starts)
+        results = sv.run_variants(
+            task, n, seed, starts, points, workers, progress=lambda: bar.advance(job)
+        )
+    protocol, default_points, demos = sv.PROTOCOLS[task]
+    title = (
+        f"{task} variants ({protocol} protocol, {demos} teacher demo(s), {starts} starts, "
+        f"{points or default_points} points, seed {seed})"
+    )
+    cols = (*(k for k, _ in results[0].variant.values), "demos kept/tried", "TSHIX", "ergodic")
+    lines = []
+    for r in results:
+        cells = [f"{v:g}" for _, v in r.variant.values] + [f"{r.kept}/{r.tried}"]
+        by = {row.method: row.ours for row in r.rows}
+        for m in ("tshix", "ergodic"):
+            s = by.get(m)
+            cells.append(r.why[:60] if s is None else _rate(s.successes, s.trials, s.low, s.high))
+        lines.append(cells)
+    table = Table(title=title)
+    for col in cols:
+        table.add_column(col, justify="right")
+    for cells in lines:
+        table.add_row(*cells)
+    print_table(table)
+    misses = sv.goal_misses(results)
+    goal = sv.GOALS[task]
+    console.print(
+        f"goal TSHIX >= {100 * goal:.0f} % on every variant: "
+        + ("met" if not misses else f"missed on {', '.join(r.variant.label for r in misses)}")
+    )
+    out = figure.with_name(f"{figure.stem}_{task}{figure.suffix}")
+    fig = success_by_parameter(sv.figure_data(results), title, goal)
+    console.print(f"figure -> {save_figure(fig, out)}")
+    if markdown is not None:
+        md = [f"\n**{title}**\n", "| " + " | ".join(cols) + " |", "|" + " --- |" * len(cols)]
+        md += ["| " + " | ".join(c) + " |" for c in lines]
+        append_markdown(markdown, "\n".join(md))

@@ -170,6 +170,9 @@ def run_search(
 ) -> SearchRun:
     """Execute one search trajectory from ``start`` through the engine."""
     setpoints = search_setpoints(traj, task, start, model if feedforward else None)
+    if config is None and getattr(task, "hold_depth", None) is not None:
+        # a part that sank into the bore is pressed in, not dragged on (it would wedge)
+        config = FollowConfig(hold_depth=task.hold_depth)  # type: ignore[attr-defined]
     return SearchRun(run_trajectory(robot, task, setpoints, start, config), traj, setpoints)
 
 

@@ -69,6 +69,8 @@ class TeacherStyle:
     max_duration: float = 60.0
     min_duration: float = 0.5
     record_rate: float = 100.0
+    #: sinking (m) after which the hand stops moving the part sideways (None: never)
+    hold_depth: float | None = None
 
     def __post_init__(self) -> None:
         if self.pattern not in PATTERNS:
@@ -95,8 +97,9 @@ def style_for(
     task: Task, style: TeacherStyle | None = None, robot: object | None = None
 ) -> TeacherStyle:
     """``style`` (default :class:`TeacherStyle`) with the task's ``teacher_hints()`` (a dict of
-    field overrides scaled to its cell, e.g. a mesh task's) -- or, for a built-in task without
-    them, :func:`unchamfered_hints` -- on the fields left at their defaults (``pattern``
+    field overrides scaled to its cell, e.g. a mesh task's, or ``peg2d``'s sweep scaled to its
+    clearance, chamfers and friction) -- or, for a built-in task without them,
+    :func:`unchamfered_hints` -- on the fields left at their defaults (``pattern``
     only over the default sweep). For a task that searches in rz, the ``robot``'s
     ``teacher_rz_hints`` (a dict, e.g. the FR3's) come after the task's: an arm whose yaw lags
     the wiggle needs a slower hand."""
@@ -349,7 +352,8 @@ class BlindTeacher:
 
 def follow_config(style: TeacherStyle) -> FollowConfig:
     """How the teacher's hand drives the compliant robot: its arm's stiffness in x-y, the
-    follow skill's default z stiffness, its press (and ``press_feel`` loop), no settling."""
+    follow skill's default z stiffness, its press (and ``press_feel`` loop), no settling, and
+    the sideways hold once the part has dropped ``hold_depth``."""
     return FollowConfig(
         stiffness_along=style.arm_stiffness,
         stiffness_across=style.arm_stiffness,
@@ -357,6 +361,7 @@ def follow_config(style: TeacherStyle) -> FollowConfig:
         push_force=style.push_force,
         settle_time=0.0,
         press_feel=style.press_feel,
+        hold_depth=style.hold_depth,
     )
 
 

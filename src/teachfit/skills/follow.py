@@ -48,7 +48,11 @@ class FollowConfig:
     positive, closes a slow loop on the press as a person pressing by feel does: while in
     contact (measured f_z above half the wanted), the push is corrected by the integral of the
     wanted minus the measured f_z over ``press_feel`` (clipped to half ``push_force``); 0 (the
-    default) pushes open loop.
+    default) pushes open loop. ``hold_depth`` (m, None: off): once the TCP has sunk that far
+    below its height on entering the node (the part dropped into the hole), the x-y set-point
+    stays where the part is and only the push goes on, as a person who feels the part drop
+    stops moving it sideways (dragged on, a part caught in a hole with high friction wedges
+    instead of sliding in).
     """
 
     stiffness_along: float = 1500.0
@@ -61,6 +65,7 @@ class FollowConfig:
     max_force: float = 80.0
     anchor: str = "frame"
     press_feel: float = 0.0
+    hold_depth: float | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -75,6 +80,10 @@ class FollowConfig:
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0):
                 raise SkillError(f"follow: {name} must be >= 0, got {value}")
+        if self.hold_depth is not None and not (
+            math.isfinite(self.hold_depth) and self.hold_depth > 0
+        ):
+            raise SkillError(f"follow: hold_depth must be > 0, got {self.hold_depth}")
         if self.anchor not in ("frame", "entry"):
             raise SkillError(f"follow: anchor must be 'frame' or 'entry', got {self.anchor!r}")
 
@@ -107,6 +116,8 @@ class _FollowRun(PrimitiveRun):
         self.rot_k = np.asarray(cfg.stiffness_rot, dtype=float)
         self.direction = np.array([1.0, 0.0])
         self.offset = np.zeros(3)
+        self.z0 = 0.0
+        self.hold: np.ndarray | None = None  # x-y where the part dropped (hold_depth)
         self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
         self.press_correction = 0.0  # N, the felt-press loop's integral (press_feel > 0)
 
@@ -116,6 +127,7 @@ class _FollowRun(PrimitiveRun):
         pc.goal[:] = self.traj.pos[-1] + self.offset
         pc.done = False
         self.press_correction = 0.0
+        self.z0, self.hold = float(pc.p[2]), None
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
@@ -135,6 +147,13 @@ class _FollowRun(PrimitiveRun):
                 lim = 0.5 * cfg.push_force
                 self.press_correction = min(lim, max(-lim, self.press_correction + step))
             out.wrench[2] -= self.press_correction
+        if cfg.hold_depth is not None:
+            if self.hold is None and self.z0 - pc.p[2] >= cfg.hold_depth:
+                self.hold = pc.p[:2].copy()
+            if self.hold is not None:
+                pc.p_d[:2] = self.hold
+                out.twist[:2] = 0.0
+                out.wrench[:2] = 0.0
         if cfg.aligned:
             out.stiffness_full[:] = aligned_stiffness(
                 self.direction, cfg.stiffness_along, cfg.stiffness_across, cfg.stiffness_z,

@@ -19,6 +19,11 @@ from teachfit.tasks.params import doc_field
 from teachfit.tasks.protocols.seed_a import Peg2DProtocol
 from teachfit.tasks.scene.round_hole import Peg2DScene
 
+#: the blind teacher's defaults (m, N/m, m/s) and the load it slides (push + peg weight, N)
+#: at the default friction, which its default sweep suits (see Peg2D.teacher_hints)
+DEFAULT_PITCH, DEFAULT_HALFWIDTH, DEFAULT_FRICTION = 0.0025, 0.015, 0.3
+TEACHER_STIFFNESS, TEACHER_SPEED, TEACHER_LOAD = 600.0, 0.012, 7.0
+
 
 @dataclass(frozen=True)
 class Peg2DParams(RoundPegParams):
@@ -89,3 +94,39 @@ class Peg2D(Task):
     def detection_radius(self) -> float:
         """The peg's footprint stays on the cylinder top within its radius minus the peg's."""
         return (self.params.block_diameter - self.params.peg_diameter) / 2
+
+    @property
+    def capture_halfwidth(self) -> float:
+        """Lateral TCP offset (m) within which a pressed peg drops in: the radial clearance
+        plus both chamfers' widths (straight passes drop in up to 1.5 mm off with the default
+        1 mm and 0.5 mm chamfers, up to ~0.1 mm off with sharp edges and 0.2 mm clearance)."""
+        p = self.params
+        return p.clearance / 2 + p.peg_chamfer + p.hole_chamfer
+
+    @property
+    def hold_depth(self) -> float:
+        """Sinking (m) that means the peg is in the bore: both chamfers' depth plus 0.5 mm."""
+        return self.params.peg_chamfer + self.params.hole_chamfer + 0.0005
+
+    def teacher_hints(self) -> dict[str, float]:
+        """The blind teacher's sweep scaled to this cell (m, s; TeacherStyle fields).
+
+        The defaults (rows 2.5 mm apart, 15 mm half-width, 60 s) suit the default cell. Rows
+        are at most 1.6 capture half-widths apart, so that a pass always crosses the hole
+        where the peg drops in; the half-width grows by the extra friction lag of the
+        sliding peg over the default friction's (``friction * (push + weight) / stiffness``:
+        within it of a turn the peg sticks instead of sliding); the time budget grows with
+        the raster's length (up to 10 minutes); the teacher stops moving the peg sideways
+        once it sank :attr:`hold_depth` (a hand that feels the drop).
+        """
+        pitch = min(DEFAULT_PITCH, 1.6 * self.capture_halfwidth)
+        lag = (self.params.friction - DEFAULT_FRICTION) * TEACHER_LOAD / TEACHER_STIFFNESS
+        half = DEFAULT_HALFWIDTH + max(0.0, lag)
+        rows = (self.params.demo_offset + half) / pitch + 1  # start to past the hole
+        duration = rows * (2 * half + pitch) / TEACHER_SPEED
+        return {
+            "spiral_pitch": pitch,
+            "sweep_halfwidth": half,
+            "max_duration": float(min(600.0, max(60.0, duration))),
+            "hold_depth": self.hold_depth,
+        }

@@ -1,0 +1,21 @@
+from teachfit.bench.search_variants import figure_data, goal_misses, run_variant
+from teachfit.tasks.variants import Variant
+from teachfit.viz.variant_figures import success_by_parameter
+
+
+def test_one_variant_runs_tshix_and_ergodic_on_the_same_starts(tmp_path):
+    # the default cell as a variant: its teacher demonstration is the session-cached one
+    v = Variant("peg2d", (("peg_diameter_mm", 20.0), ("friction", 0.3)), ())
+    ticks = []
+    res = run_variant(
+        v, seed=0, n_starts=1, n_points=40, workers=0, progress=lambda: ticks.append(1)
+    )
+    assert res.kept == 1 and res.tried >= 1 and not res.why
+    assert [r.method for r in res.rows] == ["tshix", "ergodic"]
+    assert all(r.ours.trials == 1 for r in res.rows) and len(ticks) == 2
+    missed = goal_misses([res])
+    assert (res.rate("tshix") < 0.9) == bool(missed)
+    data = figure_data([res])
+    assert data[0]["values"] == {"peg_diameter_mm": 20.0, "friction": 0.3}
+    fig = success_by_parameter(data, "test", goal=0.9)
+    assert len(fig.axes) == 2 and fig.axes[0].get_legend() is not None
