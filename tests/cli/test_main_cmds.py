@@ -219,8 +219,8 @@ def test_bench_search_names_missing_tables():
 
 
 def test_bench_search_variants_refuses_what_it_cannot_run(tmp_path):
-    res = invoke("bench", "search", "--variants", "--table", "2")
+    res = invoke("bench", "search", "--variants", "2", "--table", "2")
     assert res.exit_code == 2 and "--table 1, 3 or all" in res.output
     bad = tmp_path / "fig.xyz"
-    res = invoke("bench", "search", "--variants", "--figure", bad)
+    res = invoke("bench", "search", "--variants", "2", "--plot", bad)
     assert res.exit_code == 2 and "fig.xyz" in _flat(res.output) and not bad.exists()

@@ -80,17 +80,16 @@ def bench_search(
         typer.Option(help="demonstrations of --task, FILE.h5 (default: the teacher records one)"),
     ] = None,
     variants: Annotated[
-        bool,
+        int,
         typer.Option(
-            help="run Table I (peg2d; --table 1) / III (socket3d; --table 3) on a seeded "
-            "sample of task variants (--table all: both)"
+            min=0,
+            help="also run this many seeded task variants per task: Table I's protocol on "
+            "peg2d variants (--table 1), Table III's on socket3d ones (--table 3), both (all); "
+            "0: none",
         ),
-    ] = False,
-    n_variants: Annotated[
-        int, typer.Option("--n-variants", min=1, help="--variants: variants per task")
-    ] = 12,
-    figure: Annotated[
-        Path, typer.Option(help="--variants: figure of success against each parameter")
+    ] = 0,
+    plot: Annotated[
+        Path, o.plot("with --variants, success against each variant parameter (one per task)")
     ] = Path("search_variants.png"),
 ) -> None:
     """The search paper's experiments (Ehlers et al. 2019) in simulation, beside its numbers.
@@ -111,7 +110,7 @@ def bench_search(
         if names is None or task is not None:
             raise TeachfitError("--variants runs --table 1, 3 or all, and takes no --task")
         for name in names:
-            _variants(name, n_variants, seed, starts or 20, points, workers, markdown, figure)
+            _variants(name, variants, seed, starts or 20, points, workers, markdown, plot)
         return
     if task is not None:
         _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)

@@ -51,6 +51,7 @@ CANONICAL: dict[str, tuple[str, str]] = {
     "--method": ("text", ""),
     "--params": ("path", "skill parameters"),
     "--methods": ("text", "methods, comma-separated"),
+    "--variants": ("int", "also run this many seeded task variants"),
     "--runs": ("int", "planning runs"),
     "--view": ("flag", "watch the run in MuJoCo's viewer"),
     "--skill": ("text", "skill: built-in name or skill .toml"),

@@ -222,8 +222,8 @@ def bench_planning_cmd(
         int,
         typer.Option(
             min=0,
-            help="also run this many seeded parameter variants per task (clearance 0.5 mm to "
-            "the default, sizes x0.9-1.1), --runs seeds each; 0: none",
+            help="also run this many seeded task variants per task (clearance 0.5 mm to the "
+            "default, sizes x0.9-1.1), --runs seeds each; 0: none",
         ),
     ] = 0,
 ) -> None:
