@@ -77,7 +77,8 @@ def test_an_arm_slows_the_teacher_only_on_tasks_that_search_in_rz():
     socket = style_for(get_task("socket3d"), robot=arm)
     assert socket.speed < TeacherStyle().speed
     assert socket.rz_wiggle_frequency < TeacherStyle().rz_wiggle_frequency
-    assert style_for(get_task("peg2d"), robot=arm) == TeacherStyle()  # Table I's stays
+    peg2d = get_task("peg2d")
+    assert style_for(peg2d, robot=arm) == style_for(peg2d)  # Table I's stays as on the tool
     explicit = style_for(get_task("socket3d"), TeacherStyle(speed=0.02), robot=arm)
     assert explicit.speed == 0.02  # an explicit choice wins over the robot's hints
 
@@ -103,8 +104,10 @@ def test_unchamfered_yaw_task_gets_a_fine_spiral_inside_its_yaw_tolerance():
     zigzag = style_for(puzzle, TeacherStyle(pattern="zigzag", rz_wiggle=0.3))
     assert zigzag.pattern == "zigzag" and zigzag.rz_wiggle == 0.3
     assert zigzag.spiral_pitch == pytest.approx(puzzle.params.clearance)
-    for name in ("key", "peg", "peg2d", "socket3d"):
+    for name in ("key", "peg", "socket3d"):
         assert style_for(get_task(name)) == TeacherStyle()
+    peg2d = get_task("peg2d")  # its default cell keeps the default sweep, and holds after a drop
+    assert style_for(peg2d) == TeacherStyle(hold_depth=peg2d.hold_depth)
 
 
 def test_blind_teacher_inserts_the_unchamfered_puzzle_piece():

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Self
 import numpy as np
 
 from teachfit.core.errors import TaskError
-from teachfit.core.geometry import Pose
+from teachfit.core.geometry import Pose, quat_conj_into, quat_rotate_into
 
 if TYPE_CHECKING:
     from teachfit.tasks.protocols.base import Protocol
@@ -125,9 +125,12 @@ class Task(ABC):
         """The success detector, from what a robot measures (its TCP pose, world) and what the
         cell's drawing says: the TCP is at least :attr:`success_depth` below the nominal entry
         height and within :attr:`detection_radius` of the nominal hole axis."""
-        rel = self.nominal_hole2world.inverse().compose(tool2world)
-        deep = self.entry_height - float(tool2world.pos[2]) >= self.success_depth
-        return deep and float(np.hypot(rel.pos[0], rel.pos[1])) <= float(self.detection_radius)
+        if self.entry_height - float(tool2world.pos[2]) < self.success_depth:
+            return False  # most ticks: checked first, without the frame change
+        hole = self.nominal_hole2world
+        rel = np.empty(3)  # the TCP in the hole frame: R^T (p - p_hole), R^T by the conjugate
+        quat_rotate_into(rel, quat_conj_into(np.empty(4), hole.quat), tool2world.pos - hole.pos)
+        return float(np.hypot(rel[0], rel[1])) <= float(self.detection_radius)
 
     # ------------------------------------------------------------------------------- I/O
     @classmethod
