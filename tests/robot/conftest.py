@@ -59,3 +59,19 @@ def expected_tcp(franka_sim: object) -> Callable[[object], object]:
         return (b2w @ o_t_ee @ e2t)[:3]
 
     return tcp
+
+
+@pytest.fixture
+def ctrl_c() -> Iterator[None]:
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test, as at a terminal.
+
+    A process started in the background of a shell without job control (a CI runner's, or
+    ``cmd &`` in a script) inherits SIGINT *ignored*, and Python then leaves it ignored: a
+    test that sends itself SIGINT would wait for an interrupt that never comes."""
+    import signal
+
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)

@@ -179,7 +179,7 @@ def test_killed_server_is_a_lost_connection_with_the_data_kept(franka_sim: objec
     assert not os.path.exists(f"/proc/{old_pid}")  # the killed server is gone, reaped
 
 
-def test_ctrl_c_holds_then_finishes_the_loop(robot: FrankaRobot) -> None:
+def test_ctrl_c_holds_then_finishes_the_loop(robot: FrankaRobot, ctrl_c: None) -> None:
     import os
     import signal
     import threading

@@ -82,7 +82,7 @@ def test_pushed_arm_is_recorded_with_the_pushing_wrench(franka: object, push_fil
     np.testing.assert_allclose(np.diff(rec.t[1:]), 0.01, atol=1e-6)  # 100 Hz, none lost
 
 
-def test_ctrl_c_ends_the_recording_and_keeps_every_sample(franka: object) -> None:
+def test_ctrl_c_ends_the_recording_and_keeps_every_sample(franka: object, ctrl_c: None) -> None:
     timer = _at_robot_time(franka, 0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
     rec = record_kinesthetic(franka, duration=None, rate_hz=200.0)  # type: ignore[arg-type]
     timer.join()
