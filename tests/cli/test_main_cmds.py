@@ -9,7 +9,12 @@ from typer.testing import CliRunner
 
 from teachfit.cli import app
 from teachfit.demonstrations.csv_import import ColumnMap, import_csv
-from teachfit.demonstrations.dataset import dataset_summary, read_dataset
+from teachfit.demonstrations.dataset import (
+    Demonstration,
+    dataset_summary,
+    read_dataset,
+    write_dataset,
+)
 
 runner = CliRunner()
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -21,6 +26,13 @@ def invoke(*args):
 
 def _flat(text: str) -> str:
     return " ".join(text.split())
+
+
+def _still_demo(task: str, n: int = 50) -> Demonstration:
+    """A short demonstration of ``task`` holding still at 100 Hz (a file of another task)."""
+    quat = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    pos, wrench = np.zeros((n, 3)), np.zeros((n, 6))
+    return Demonstration(np.arange(n) / 100.0, pos, quat, wrench, task=task, source="synthetic")
 
 
 @pytest.fixture(scope="module")
@@ -189,7 +201,7 @@ def test_learn_plan_run_search(tmp_path):
         "--model",
         model,
         "-n",
-        "50",
+        "30",
         "--starts",
         "1",
         "--demo",
@@ -199,8 +211,7 @@ def test_learn_plan_run_search(tmp_path):
     assert "starts" in res.output
     res = invoke("search", "run", "--task", "socket3d", "--model", model, "--starts", "1")
     assert res.exit_code == 2  # a peg2d model for the socket task
-    other = tmp_path / "socket.h5"
-    assert invoke("demo", "record", "--task", "socket3d", "-n", "1", "--out", other).exit_code == 0
+    other = write_dataset(tmp_path / "socket.h5", [_still_demo("socket3d")])  # another task's
     res = invoke("search", "run", "--model", model, "--starts", "1", "--demo", f"{other}:0")
     assert res.exit_code == 2 and "socket3d" in res.output
     res = invoke("search", "run", "--model", model, "--method", "ergodic", "--passes", "2")
@@ -216,6 +227,13 @@ def test_learn_plan_run_search(tmp_path):
 def test_bench_search_names_missing_tables():
     res = invoke("bench", "search", "--table", "7")
     assert res.exit_code == 2 and "available" in res.output
+
+
+def test_bench_search_methods_are_rows_of_one_table():
+    res = invoke("bench", "search", "--table", "3", "--methods", "tshix,spiral")
+    assert res.exit_code == 2 and "Table III has no method 'tshix'" in _flat(res.output)
+    res = invoke("bench", "search", "--table", "2", "--methods", "tshix")
+    assert res.exit_code == 2 and "--table 1 or --table 3" in _flat(res.output)
 
 
 def test_bench_search_variants_refuses_what_it_cannot_run(tmp_path):

@@ -22,7 +22,14 @@ from functools import cache
 
 import numpy as np
 
-from teachfit.bench.search_jobs import JobResult, SearchJob, model_json, pose_tuple, run_jobs
+from teachfit.bench.search_jobs import (
+    JobResult,
+    SearchJob,
+    model_json,
+    planned_lengths,
+    pose_tuple,
+    run_jobs,
+)
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.demonstrations.dataset import Demonstration
@@ -125,6 +132,54 @@ def _peg_demo(seed: int, clearance: float, robot: str) -> tuple[Demonstration, S
     return demos[0], SearchModel.fit(demos, task.name)
 
 
+#: Table I's rows, in table order
+TABLE1_METHODS = ("tshix", "tshix-iid", "ergodic")
+#: Table III's rows, in table order
+TABLE3_METHODS = (
+    "random-walk",
+    "spiral",
+    "tshix-1demo",
+    "tshix-2demo",
+    "tshix-2demo-diag",
+    "ergodic-3d-2demo",
+)
+
+
+def chosen_methods(
+    methods: Sequence[str] | None, available: Sequence[str], table: str
+) -> tuple[str, ...]:
+    """The rows of ``table`` to run: ``methods`` in table order (None: all ``available``)."""
+    if methods is None:
+        return tuple(available)
+    unknown = [m for m in methods if m not in available]
+    if unknown or not methods:
+        raise TeachfitError(
+            f"Table {table} has no method {unknown[0] if unknown else '(none given)'!r}; "
+            f"available: {', '.join(available)}"
+        )
+    return tuple(m for m in available if m in methods)
+
+
+def _planned_tshix(model: SearchModel, n_points: int, seeds: Sequence[int]) -> tuple[float, float]:
+    """Mean weighted (rz at the planner's scale) and x-y lengths (m) of the TSHIX paths that
+    jobs with ``seeds`` plan: what the ergodic and random-walk rows are sized by (planning only,
+    the same paths the TSHIX jobs execute)."""
+    lengths = [planned_lengths(model, "tshix", n_points, s) for s in seeds]
+    return float(np.mean([w for _, w in lengths])), float(np.mean([xy for xy, _ in lengths]))
+
+
+def _run_rows(
+    jobs: dict[str, list[SearchJob]],
+    paper: dict[str, tuple[int, int] | None],
+    workers: int | None,
+    progress: Progress,
+) -> list[Row]:
+    """Run every row's jobs in one parallel batch; the rows in ``jobs``' order."""
+    flat = [j for js in jobs.values() for j in js]
+    res = iter(run_jobs(flat, workers, progress))
+    return [_row(name, [next(res) for _ in js], paper[name]) for name, js in jobs.items()]
+
+
 def table1(
     seed: int = 0,
     n_starts: int = 30,
@@ -132,25 +187,35 @@ def table1(
     clearance: float = 0.0005,
     workers: int | None = None,
     progress: Progress = None,
+    methods: Sequence[str] | None = None,
 ) -> list[Row]:
-    """Table I's protocol; rows ``tshix``, ``tshix-iid`` and ``ergodic`` on the same starts."""
+    """Table I's protocol; rows ``tshix``, ``tshix-iid`` and ``ergodic`` (or ``methods`` of
+    :data:`TABLE1_METHODS`) on the same starts."""
+    chosen = chosen_methods(methods, TABLE1_METHODS, "I")
     overrides, demo, model = _peg_setup(seed, clearance)
     task = get_task("peg2d", **overrides)
     rng = np.random.default_rng(seed + 1)
     starts = task.protocol.protocol_starts("table1", n_starts, rng, demo.start_pose)
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
-    tshix = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds)
-    iid = _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds, sampling="random")
-    res = run_jobs(tshix + iid, workers, progress)
-    res_q, res_r = res[:n_starts], res[n_starts:]
-    length = float(np.mean([r.weighted_length for r in res_q]))
-    erg = _jobs("peg2d", overrides, model, starts, "ergodic", n_points, seeds, length=length)
-    res_e = run_jobs(erg, workers, progress)
-    return [
-        _row("tshix", res_q, PAPER_TABLE1["tshix"]),
-        _row("tshix-iid", res_r, PAPER_TABLE1["tshix"]),
-        _row("ergodic", res_e, PAPER_TABLE1["ergodic"]),
-    ]
+    job = {
+        "tshix": lambda: _jobs("peg2d", overrides, model, starts, "tshix", n_points, seeds),
+        "tshix-iid": lambda: _jobs(
+            "peg2d", overrides, model, starts, "tshix", n_points, seeds, sampling="random"
+        ),
+        "ergodic": lambda: _jobs(
+            "peg2d",
+            overrides,
+            model,
+            starts,
+            "ergodic",
+            n_points,
+            seeds,
+            length=_planned_tshix(model, n_points, seeds)[0],
+        ),
+    }
+    paper = {"tshix": PAPER_TABLE1["tshix"], "tshix-iid": PAPER_TABLE1["tshix"]}
+    paper["ergodic"] = PAPER_TABLE1["ergodic"]
+    return _run_rows({m: job[m]() for m in chosen}, paper, workers, progress)
 
 
 def table2(
@@ -247,8 +312,11 @@ def table3(
     n_points: int = 600,
     workers: int | None = None,
     progress: Progress = None,
+    methods: Sequence[str] | None = None,
 ) -> list[Row]:
-    """Table III's protocol on ``socket3d``; one row per method, same starts for all."""
+    """Table III's protocol on ``socket3d``; one row per method of :data:`TABLE3_METHODS` (or
+    ``methods`` of them), same starts for all."""
+    chosen = chosen_methods(methods, TABLE3_METHODS, "III")
     task = get_task("socket3d")
     demos = _socket_demos(task, seed)
     # seed A's rows keep its full covariance; `learn search` (covariance "auto") chooses by
@@ -258,26 +326,25 @@ def table3(
     two_diag = SearchModel.fit(demos, task.name, covariance="diag")
     starts = task.protocol.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
-    t1 = _jobs("socket3d", {}, one, starts, "tshix", n_points, seeds)
-    t2 = _jobs("socket3d", {}, two, starts, "tshix", n_points, seeds)
-    t2d = _jobs("socket3d", {}, two_diag, starts, "tshix", n_points, seeds)
-    res = run_jobs(t1 + t2 + t2d, workers, progress)
-    r1, r2, r2d = res[:n_starts], res[n_starts : 2 * n_starts], res[2 * n_starts :]
-    length = float(np.mean([r.weighted_length for r in r2]))
-    xy = float(np.mean([r.path_length for r in r2]))
-    steps = max(1, int(xy / 0.003))  # random-walk moves average 3 mm: equal x-y path length
-    more = (
-        _jobs("socket3d", {}, two, starts, "random-walk", steps, seeds)
-        + _jobs("socket3d", {}, two, starts, "spiral", n_points, seeds)
-        + _jobs("socket3d", {}, two, starts, "ergodic", n_points, seeds, length=length)
-    )
-    res = run_jobs(more, workers, progress)
-    rw, sp, er = res[:n_starts], res[n_starts : 2 * n_starts], res[2 * n_starts :]
-    return [
-        _row("random-walk", rw, PAPER_TABLE3["random-walk"]),
-        _row("spiral", sp, None),
-        _row("tshix-1demo", r1, PAPER_TABLE3["tshix-1demo"]),
-        _row("tshix-2demo", r2, PAPER_TABLE3["tshix-2demo"]),
-        _row("tshix-2demo-diag", r2d, None),
-        _row("ergodic-3d-2demo", er, None),
-    ]
+
+    def sized(method: str) -> list[SearchJob]:
+        """The random walk of the mean TSHIX (2 demos) x-y length, or the ergodic trajectory
+        of its weighted length."""
+        length, xy = _planned_tshix(two, n_points, seeds)
+        if method == "random-walk":
+            steps = max(1, int(xy / 0.003))  # random-walk moves average 3 mm: equal x-y length
+            return _jobs("socket3d", {}, two, starts, "random-walk", steps, seeds)
+        return _jobs("socket3d", {}, two, starts, "ergodic", n_points, seeds, length=length)
+
+    job = {
+        "random-walk": lambda: sized("random-walk"),
+        "spiral": lambda: _jobs("socket3d", {}, two, starts, "spiral", n_points, seeds),
+        "tshix-1demo": lambda: _jobs("socket3d", {}, one, starts, "tshix", n_points, seeds),
+        "tshix-2demo": lambda: _jobs("socket3d", {}, two, starts, "tshix", n_points, seeds),
+        "tshix-2demo-diag": lambda: _jobs(
+            "socket3d", {}, two_diag, starts, "tshix", n_points, seeds
+        ),
+        "ergodic-3d-2demo": lambda: sized("ergodic"),
+    }
+    paper = {m: PAPER_TABLE3.get(m) for m in TABLE3_METHODS}
+    return _run_rows({m: job[m]() for m in chosen}, paper, workers, progress)

@@ -24,6 +24,7 @@ from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task
+from teachfit.trajectories import SearchTrajectory
 from teachfit.trajectories.ergodic import ergodic_metric
 
 
@@ -108,17 +109,25 @@ def run_job(job: SearchJob) -> JobResult:
     if not np.isfinite(metric):
         metric = ergodic_metric(traj.states, model.exploration, t=traj.t)
     o = run.result
-    xy = np.linalg.norm(np.diff(traj.states[:, :2], axis=0), axis=1).sum()
-    scale = float(traj.meta.get("length_scale", 1.0))
+    xy, weighted = _lengths(traj)
     return JobResult(
-        o.success,
-        f"{o.outcome.value}: {o.reason}",
-        o.time_to_success,
-        plan_s,
-        float(xy),
-        metric,
-        traj.path_length(scale),
+        o.success, f"{o.outcome.value}: {o.reason}", o.time_to_success, plan_s, xy, metric, weighted
     )
+
+
+def _lengths(traj: SearchTrajectory) -> tuple[float, float]:
+    """A planned path's x-y length and its length weighted with rz at the planner's scale (m)."""
+    xy = np.linalg.norm(np.diff(traj.states[:, :2], axis=0), axis=1).sum()
+    return float(xy), traj.path_length(float(traj.meta.get("length_scale", 1.0)))
+
+
+def planned_lengths(
+    model: SearchModel, method: str, n_points: int, seed: int
+) -> tuple[float, float]:
+    """The x-y and weighted lengths (m) of the path a job with this model, method, size and
+    ``traj_seed`` plans (planning only; the model through its JSON document, as a job gets it)."""
+    traj = plan_search(_model(model_json(model)), method, n_points, np.random.default_rng(seed))
+    return _lengths(traj)
 
 
 def pose_tuple(pose: Pose) -> tuple[float, ...]:

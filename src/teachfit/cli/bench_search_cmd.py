@@ -91,6 +91,14 @@ def bench_search(
     plot: Annotated[
         Path, o.plot("with --variants, success against each variant parameter (one per task)")
     ] = Path("search_variants.png"),
+    methods: Annotated[
+        str | None,
+        typer.Option(
+            help="methods, comma-separated: the rows of --table 1 or 3 to run (default: all; "
+            "Table I: tshix, tshix-iid, ergodic; Table III: random-walk, spiral, tshix-1demo, "
+            "tshix-2demo, tshix-2demo-diag, ergodic-3d-2demo)"
+        ),
+    ] = None,
 ) -> None:
     """The search paper's experiments (Ehlers et al. 2019) in simulation, beside its numbers.
 
@@ -104,6 +112,13 @@ def bench_search(
     if demo is not None and task is None:
         raise TeachfitError(f"--demo {demo} is for --task TASK (the paper's tables record theirs)")
     todo = TABLES[:-1] if table == "all" else (table,)
+    rows_of = None if methods is None else [m.strip() for m in methods.split(",") if m.strip()]
+    if rows_of is not None and (table not in ("1", "3") or variants or task is not None):
+        raise TeachfitError("--methods chooses rows of --table 1 or --table 3 (one table)")
+    if rows_of is not None:  # a bad name fails before any demonstration is recorded
+        bs.chosen_methods(
+            rows_of, *((bs.TABLE1_METHODS, "I") if table == "1" else (bs.TABLE3_METHODS, "III"))
+        )
     bs.use_robot(robot)
     if variants:
         names = {"1": ["peg2d"], "3": ["socket3d"], "all": ["peg2d", "socket3d"]}.get(table)
@@ -118,9 +133,15 @@ def bench_search(
     with progress_bar() as bar:
         if "1" in todo:
             n = starts or 30
-            job = bar.add_task("Table I: TSHIX (QMC, i.i.d.) and ergodic", total=3 * n)
+            k = len(bs.chosen_methods(rows_of, bs.TABLE1_METHODS, "I"))
+            job = bar.add_task("Table I: TSHIX (QMC, i.i.d.) and ergodic", total=k * n)
             rows = bs.table1(
-                seed, n, points or 300, workers=workers, progress=lambda: bar.advance(job)
+                seed,
+                n,
+                points or 300,
+                workers=workers,
+                progress=lambda: bar.advance(job),
+                methods=rows_of,
             )
             _emit(
                 f"Table I (peg2d, 0.5 mm clearance, 1 demo, {n} starts, seed {seed})",
@@ -148,9 +169,15 @@ def bench_search(
                 )
         if "3" in todo:
             n = starts or 15
-            job = bar.add_task("Table III: socket3d", total=6 * n)
+            k = len(bs.chosen_methods(rows_of, bs.TABLE3_METHODS, "III"))
+            job = bar.add_task("Table III: socket3d", total=k * n)
             rows = bs.table3(
-                seed, n, points or 600, workers=workers, progress=lambda: bar.advance(job)
+                seed,
+                n,
+                points or 600,
+                workers=workers,
+                progress=lambda: bar.advance(job),
+                methods=rows_of,
             )
             _emit(
                 f"Table III (socket3d x-y-rz, {n} starts, {points or 600} points, seed {seed})",
