@@ -1,9 +1,12 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.execution.teacher import BlindTeacher, TeacherStyle, style_for
+from teachfit.robot.floating import FloatingToolRobot
 from teachfit.robot.fr3 import FR3Robot
 from teachfit.tasks import get_task
 from teachfit.tasks.registry import load_task
@@ -73,14 +76,21 @@ def test_builtin_tasks_keep_the_default_style():
 
 
 def test_an_arm_slows_the_teacher_only_on_tasks_that_search_in_rz():
-    arm = FR3Robot  # the hints are a class attribute: no model needs building
+    arm = FR3Robot  # the hints are the class's table: no model needs building
     socket = style_for(get_task("socket3d"), robot=arm)
-    assert socket.speed < TeacherStyle().speed
-    assert socket.rz_wiggle_frequency < TeacherStyle().rz_wiggle_frequency
+    # the one per-robot table gives what the former two did (press by feel everywhere, the
+    # slower hand in rz only), field for field
+    assert socket == TeacherStyle(speed=0.006, rz_wiggle_frequency=0.15, press_feel=0.3)
     peg2d = get_task("peg2d")
-    assert style_for(peg2d, robot=arm) == style_for(peg2d)  # Table I's stays as on the tool
+    # Table I's stays as on the tool, but for the press by feel
+    assert style_for(peg2d, robot=arm) == dataclasses.replace(style_for(peg2d), press_feel=0.3)
     explicit = style_for(get_task("socket3d"), TeacherStyle(speed=0.02), robot=arm)
     assert explicit.speed == 0.02  # an explicit choice wins over the robot's hints
+    assert explicit.rz_wiggle_frequency == 0.15
+    for name in ("peg2d", "socket3d", "puzzle"):  # the floating tool has no hints
+        task = get_task(name)
+        assert FloatingToolRobot.teacher_hints(task) == {}
+        assert style_for(task, robot=FloatingToolRobot) == style_for(task)
 
 
 def test_mesh_task_scales_the_teacher_to_its_fit(mesh_examples):

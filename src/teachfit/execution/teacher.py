@@ -23,6 +23,7 @@ recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,15 +35,12 @@ from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.execution.follow import run_trajectory
 from teachfit.execution.teacher_cache import cache_key, cached
+from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills.follow import FollowConfig
 from teachfit.tasks.base import Task
 
 PATTERNS = ("sweep", "spiral", "zigzag")
-
-#: per-robot style defaults: on the arm, joint friction loads the open-loop press (f_z swings
-#: 4.5-7.5 N with the sweep's direction), which a person pressing by feel corrects
-ROBOT_STYLE: dict[str, dict[str, float]] = {"fr3": {"press_feel": 0.3}}
 
 
 @dataclass(frozen=True)
@@ -85,34 +83,30 @@ class TeacherStyle:
             raise TeachfitError("teacher min_duration must be below max_duration")
 
 
-def robot_style(style: TeacherStyle, robot: str) -> TeacherStyle:
-    """``style`` with :data:`ROBOT_STYLE`'s defaults for ``robot`` on fields left at theirs."""
+def with_hints(style: TeacherStyle, hints: Mapping[str, object]) -> TeacherStyle:
+    """``style`` with ``hints`` (field overrides) on the fields left at their defaults
+    (``pattern`` only over the default sweep)."""
     default = TeacherStyle(pattern=style.pattern)
-    hints = ROBOT_STYLE.get(robot, {})
     keep = {k: v for k, v in hints.items() if getattr(style, k) == getattr(default, k)}
+    if style.pattern != TeacherStyle.pattern:
+        keep.pop("pattern", None)
     return dataclasses.replace(style, **keep) if keep else style
 
 
 def style_for(
-    task: Task, style: TeacherStyle | None = None, robot: object | None = None
+    task: Task, style: TeacherStyle | None = None, robot: Robot | None = None
 ) -> TeacherStyle:
     """``style`` (default :class:`TeacherStyle`) with the task's ``teacher_hints()`` (a dict of
     field overrides scaled to its cell, e.g. a mesh task's, or ``peg2d``'s sweep scaled to its
     clearance, chamfers and friction) -- or, for a built-in task without them,
-    :func:`unchamfered_hints` -- on the fields left at their defaults (``pattern``
-    only over the default sweep). For a task that searches in rz, the ``robot``'s
-    ``teacher_rz_hints`` (a dict, e.g. the FR3's) come after the task's: an arm whose yaw lags
-    the wiggle needs a slower hand."""
-    base = style or TeacherStyle()
+    :func:`unchamfered_hints` -- then the ``robot``'s ``teacher_hints(task)`` (the one
+    per-robot table, e.g. the FR3's press by feel and its slower hand on tasks searching in
+    rz), on the fields left at their defaults (:func:`with_hints`)."""
     hints = getattr(task, "teacher_hints", None)
     given = dict(hints() if hints is not None else unchamfered_hints(task))
-    if "rz" in task.search_dims:
-        given.update(getattr(robot, "teacher_rz_hints", None) or {})
-    default = TeacherStyle(pattern=base.pattern)
-    keep = {k: v for k, v in given.items() if getattr(base, k) == getattr(default, k)}
-    if base.pattern != TeacherStyle.pattern:
-        keep.pop("pattern", None)
-    return dataclasses.replace(base, **keep) if keep else base
+    if robot is not None:
+        given.update(robot.teacher_hints(task))
+    return with_hints(style or TeacherStyle(), given)
 
 
 def unchamfered_hints(task: Task) -> dict[str, object]:
@@ -157,7 +151,7 @@ class BlindTeacher:
         # the press's own stream: the plans' other draws stay what they were without it
         self._press_rng = np.random.default_rng([int(seed), 0x70726573])
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
-        self.style = robot_style(style_for(task, style, self.robot), robot)
+        self.style = style_for(task, style, self.robot)
         self._fresh = True  # nothing recorded yet: a recording depends on the seed alone
         self._replayed = False
         self.has_rz = "rz" in task.search_dims
