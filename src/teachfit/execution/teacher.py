@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from rich.progress import Progress
+from scipy.signal import lfilter
 
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose, quat_from_rz
@@ -54,6 +55,9 @@ class TeacherStyle:
     sweep_halfwidth: float = 0.015
     wander_amplitude: float = 0.0005
     wander_timescale: float = 0.5
+    #: time constant (s) of a first-order low-pass on the hand's wander and tremor, 0: none
+    #: (the wander is then an Ornstein-Uhlenbeck path whose velocity is white at 100 Hz)
+    hand_smoothing: float = 0.0
     tremor_amplitude: float = 0.00005
     tremor_frequency: float = 9.0
     rz_belief_sigma: float = 0.1
@@ -77,6 +81,8 @@ class TeacherStyle:
         for name in (*positive, "wander_timescale", "press_timescale"):
             if not getattr(self, name) > 0:
                 raise TeachfitError(f"teacher {name} must be > 0")
+        if not self.hand_smoothing >= 0:
+            raise TeachfitError("teacher hand_smoothing must be >= 0")
         if not 0 <= self.press_wander < self.push_force:
             raise TeachfitError("teacher press_wander must be within [0, push_force)")
         if self.min_duration >= self.max_duration:
@@ -194,7 +200,8 @@ class BlindTeacher:
         return p0 + local[:, :1] * u + local[:, 1:] * v
 
     def _noise(self, n: int, dt: float) -> np.ndarray:
-        """(n, 2) slow wander (Ornstein-Uhlenbeck) plus tremor, m."""
+        """(n, 2) slow wander (Ornstein-Uhlenbeck) plus tremor, low-passed over
+        ``hand_smoothing`` s when positive, m."""
         st = self.style
         a = np.exp(-dt / st.wander_timescale)
         sd = st.wander_amplitude * np.sqrt(1 - a * a)
@@ -205,6 +212,9 @@ class BlindTeacher:
         phase = self.rng.uniform(0, 2 * np.pi, 2)
         t = dt * np.arange(n)
         tremor = st.tremor_amplitude * np.sin(2 * np.pi * st.tremor_frequency * t[:, None] + phase)
+        if st.hand_smoothing > 0:  # the same draws through a hand of lower bandwidth
+            c = np.exp(-dt / st.hand_smoothing)
+            return lfilter([1.0 - c], [1.0, -c], w + tremor, axis=0)
         return w + tremor
 
     def press(self, n: int, dt: float) -> np.ndarray:
