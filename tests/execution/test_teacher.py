@@ -1,9 +1,12 @@
+import dataclasses
+
 import numpy as np
 import pytest
 
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.execution.teacher import BlindTeacher, TeacherStyle, style_for
+from teachfit.robot.floating import FloatingToolRobot
 from teachfit.robot.fr3 import FR3Robot
 from teachfit.tasks import get_task
 from teachfit.tasks.registry import load_task
@@ -73,14 +76,22 @@ def test_builtin_tasks_keep_the_default_style():
 
 
 def test_an_arm_slows_the_teacher_only_on_tasks_that_search_in_rz():
-    arm = FR3Robot  # the hints are a class attribute: no model needs building
+    arm = FR3Robot  # the hints are the class's table: no model needs building
     socket = style_for(get_task("socket3d"), robot=arm)
-    assert socket.speed < TeacherStyle().speed
-    assert socket.rz_wiggle_frequency < TeacherStyle().rz_wiggle_frequency
+    # the one per-robot table gives what the former two did (press by feel everywhere, the
+    # slower hand in rz only), field for field
+    arm_hand = {"press_feel": 0.15, "hand_smoothing": 0.1}
+    assert socket == TeacherStyle(speed=0.006, rz_wiggle_frequency=0.15, **arm_hand)
     peg2d = get_task("peg2d")
-    assert style_for(peg2d, robot=arm) == style_for(peg2d)  # Table I's stays as on the tool
+    # Table I's stays as on the tool, but for the press by feel and the smoother hand
+    assert style_for(peg2d, robot=arm) == dataclasses.replace(style_for(peg2d), **arm_hand)
     explicit = style_for(get_task("socket3d"), TeacherStyle(speed=0.02), robot=arm)
     assert explicit.speed == 0.02  # an explicit choice wins over the robot's hints
+    assert explicit.rz_wiggle_frequency == 0.15
+    for name in ("peg2d", "socket3d", "puzzle"):  # the floating tool has no hints
+        task = get_task(name)
+        assert FloatingToolRobot.teacher_hints(task) == {}
+        assert style_for(task, robot=FloatingToolRobot) == style_for(task)
 
 
 def test_mesh_task_scales_the_teacher_to_its_fit(mesh_examples):
@@ -130,6 +141,22 @@ def test_the_press_wanders_slowly_seeded_and_stays_apart_from_the_other_draws():
     assert 0.2 < dev.std() < 0.4  # press_wander 0.3 N
     assert np.corrcoef(dev[:-1], dev[1:])[0, 1] > 0.98  # time constant 1 s: slow
     assert np.all(plan_a.wrench_ff[:, [0, 1, 3, 4, 5]] == 0.0)
+
+
+def test_a_smoothed_hand_keeps_its_draws_and_loses_its_jerk():
+    task = get_task("peg2d")
+    start = task.contact_pose([0.03, 0.0])
+    raw, smooth = (
+        BlindTeacher(task, TeacherStyle(hand_smoothing=tau), seed=4).plan(start) for tau in (0, 0.1)
+    )
+    # the same path within the wander's reach (0.5 mm std), its 100 Hz velocity steps gone
+    dev = np.linalg.norm(smooth.pos - raw.pos, axis=1)
+    assert dev.max() < 2e-3 and dev.mean() < 5e-4
+    jerk = [np.diff(p.pos[:, :2], 2, axis=0).std() for p in (raw, smooth)]
+    assert jerk[1] < 0.2 * jerk[0]
+    assert BlindTeacher(task, seed=4).plan(start).pos == pytest.approx(raw.pos)  # default: none
+    with pytest.raises(TeachfitError, match="hand_smoothing"):
+        TeacherStyle(hand_smoothing=-0.1)
 
 
 def test_the_arm_teacher_presses_by_feel_the_floating_one_open_loop():

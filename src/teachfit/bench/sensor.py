@@ -24,7 +24,7 @@ from teachfit.execution.teacher import (
     TeacherStyle,
     follow_config,
     press_wander,
-    robot_style,
+    with_hints,
 )
 from teachfit.robot.registry import make_robot
 from teachfit.tasks.registry import get_task
@@ -120,7 +120,9 @@ def slide_smoothness(
     slow wander seeded by ``seed``), through the execution engine; samples after the first
     0.5 s (``options`` go to the robot, e.g. ``sensor="wrist-ft"`` on the FR3)."""
     the_task = get_task(task)
-    st = robot_style(style or TeacherStyle(), robot)
+    bot = make_robot(robot, the_task, seed=seed, **options)
+    # the robot's teacher hints (e.g. its press by feel), not the task's search pattern
+    st = with_hints(style or TeacherStyle(), bot.teacher_hints(the_task))
     dt = 0.01
     n = int(round((duration + 0.5) / dt)) + 1
     start = the_task.contact_pose(np.asarray(start_xy, dtype=float))
@@ -131,7 +133,6 @@ def slide_smoothness(
     plan = SetpointTrajectory.from_path(
         t, pos, np.tile(start.quat, (n, 1)), wrench_ff=ff, name="slide"
     )
-    bot = make_robot(robot, the_task, seed=seed, **options)
     try:
         log = run_trajectory(bot, the_task, plan, start, follow_config(st)).log
     finally:

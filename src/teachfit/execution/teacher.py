@@ -23,10 +23,12 @@ recorded is what a kinesthetic demonstration records: TCP pose and wrist wrench 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from rich.progress import Progress
+from scipy.signal import lfilter
 
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose, quat_from_rz
@@ -34,15 +36,12 @@ from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.execution.follow import run_trajectory
 from teachfit.execution.teacher_cache import cache_key, cached
+from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills.follow import FollowConfig
 from teachfit.tasks.base import Task
 
 PATTERNS = ("sweep", "spiral", "zigzag")
-
-#: per-robot style defaults: on the arm, joint friction loads the open-loop press (f_z swings
-#: 4.5-7.5 N with the sweep's direction), which a person pressing by feel corrects
-ROBOT_STYLE: dict[str, dict[str, float]] = {"fr3": {"press_feel": 0.3}}
 
 
 @dataclass(frozen=True)
@@ -56,6 +55,9 @@ class TeacherStyle:
     sweep_halfwidth: float = 0.015
     wander_amplitude: float = 0.0005
     wander_timescale: float = 0.5
+    #: time constant (s) of a first-order low-pass on the hand's wander and tremor, 0: none
+    #: (the wander is then an Ornstein-Uhlenbeck path whose velocity is white at 100 Hz)
+    hand_smoothing: float = 0.0
     tremor_amplitude: float = 0.00005
     tremor_frequency: float = 9.0
     rz_belief_sigma: float = 0.1
@@ -79,40 +81,38 @@ class TeacherStyle:
         for name in (*positive, "wander_timescale", "press_timescale"):
             if not getattr(self, name) > 0:
                 raise TeachfitError(f"teacher {name} must be > 0")
+        if not self.hand_smoothing >= 0:
+            raise TeachfitError("teacher hand_smoothing must be >= 0")
         if not 0 <= self.press_wander < self.push_force:
             raise TeachfitError("teacher press_wander must be within [0, push_force)")
         if self.min_duration >= self.max_duration:
             raise TeachfitError("teacher min_duration must be below max_duration")
 
 
-def robot_style(style: TeacherStyle, robot: str) -> TeacherStyle:
-    """``style`` with :data:`ROBOT_STYLE`'s defaults for ``robot`` on fields left at theirs."""
+def with_hints(style: TeacherStyle, hints: Mapping[str, object]) -> TeacherStyle:
+    """``style`` with ``hints`` (field overrides) on the fields left at their defaults
+    (``pattern`` only over the default sweep)."""
     default = TeacherStyle(pattern=style.pattern)
-    hints = ROBOT_STYLE.get(robot, {})
     keep = {k: v for k, v in hints.items() if getattr(style, k) == getattr(default, k)}
+    if style.pattern != TeacherStyle.pattern:
+        keep.pop("pattern", None)
     return dataclasses.replace(style, **keep) if keep else style
 
 
 def style_for(
-    task: Task, style: TeacherStyle | None = None, robot: object | None = None
+    task: Task, style: TeacherStyle | None = None, robot: Robot | None = None
 ) -> TeacherStyle:
     """``style`` (default :class:`TeacherStyle`) with the task's ``teacher_hints()`` (a dict of
     field overrides scaled to its cell, e.g. a mesh task's, or ``peg2d``'s sweep scaled to its
     clearance, chamfers and friction) -- or, for a built-in task without them,
-    :func:`unchamfered_hints` -- on the fields left at their defaults (``pattern``
-    only over the default sweep). For a task that searches in rz, the ``robot``'s
-    ``teacher_rz_hints`` (a dict, e.g. the FR3's) come after the task's: an arm whose yaw lags
-    the wiggle needs a slower hand."""
-    base = style or TeacherStyle()
+    :func:`unchamfered_hints` -- then the ``robot``'s ``teacher_hints(task)`` (the one
+    per-robot table, e.g. the FR3's press by feel and its slower hand on tasks searching in
+    rz), on the fields left at their defaults (:func:`with_hints`)."""
     hints = getattr(task, "teacher_hints", None)
     given = dict(hints() if hints is not None else unchamfered_hints(task))
-    if "rz" in task.search_dims:
-        given.update(getattr(robot, "teacher_rz_hints", None) or {})
-    default = TeacherStyle(pattern=base.pattern)
-    keep = {k: v for k, v in given.items() if getattr(base, k) == getattr(default, k)}
-    if base.pattern != TeacherStyle.pattern:
-        keep.pop("pattern", None)
-    return dataclasses.replace(base, **keep) if keep else base
+    if robot is not None:
+        given.update(robot.teacher_hints(task))
+    return with_hints(style or TeacherStyle(), given)
 
 
 def unchamfered_hints(task: Task) -> dict[str, object]:
@@ -157,7 +157,7 @@ class BlindTeacher:
         # the press's own stream: the plans' other draws stay what they were without it
         self._press_rng = np.random.default_rng([int(seed), 0x70726573])
         self.robot = make_robot(robot, task, seed=int(self.rng.integers(2**31)))
-        self.style = robot_style(style_for(task, style, self.robot), robot)
+        self.style = style_for(task, style, self.robot)
         self._fresh = True  # nothing recorded yet: a recording depends on the seed alone
         self._replayed = False
         self.has_rz = "rz" in task.search_dims
@@ -200,7 +200,8 @@ class BlindTeacher:
         return p0 + local[:, :1] * u + local[:, 1:] * v
 
     def _noise(self, n: int, dt: float) -> np.ndarray:
-        """(n, 2) slow wander (Ornstein-Uhlenbeck) plus tremor, m."""
+        """(n, 2) slow wander (Ornstein-Uhlenbeck) plus tremor, low-passed over
+        ``hand_smoothing`` s when positive, m."""
         st = self.style
         a = np.exp(-dt / st.wander_timescale)
         sd = st.wander_amplitude * np.sqrt(1 - a * a)
@@ -211,6 +212,9 @@ class BlindTeacher:
         phase = self.rng.uniform(0, 2 * np.pi, 2)
         t = dt * np.arange(n)
         tremor = st.tremor_amplitude * np.sin(2 * np.pi * st.tremor_frequency * t[:, None] + phase)
+        if st.hand_smoothing > 0:  # the same draws through a hand of lower bandwidth
+            c = np.exp(-dt / st.hand_smoothing)
+            return lfilter([1.0 - c], [1.0, -c], w + tremor, axis=0)
         return w + tremor
 
     def press(self, n: int, dt: float) -> np.ndarray:

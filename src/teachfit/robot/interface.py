@@ -24,7 +24,9 @@ The measured wrench is the one the *environment exerts on the tool*.
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -32,6 +34,9 @@ from teachfit.core.control import ControllerSpec
 from teachfit.core.errors import ControlError
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+
+if TYPE_CHECKING:
+    from teachfit.tasks.base import Task
 
 
 @runtime_checkable
@@ -76,6 +81,17 @@ class Robot(Protocol):
     def close(self) -> None:
         """Release the robot (stop the control loop, free the connection or the simulator)."""
         ...
+
+    def teacher_hints(self, task: Task) -> Mapping[str, object]:
+        """How a person guiding this robot demonstrates ``task``: overrides of the blind
+        teacher's style fields (:class:`~teachfit.execution.teacher.TeacherStyle`), applied by
+        ``execution.teacher.style_for`` on fields left at their defaults. The one per-robot
+        table; :data:`NO_TEACHER_HINTS` for a robot that needs none (the floating tool)."""
+        ...
+
+
+#: the teacher hints of a robot a person guides as the paper's teacher did (read-only, empty)
+NO_TEACHER_HINTS: Mapping[str, object] = MappingProxyType({})
 
 
 def law_fault(law: object, t: float) -> ControlError | None:

@@ -51,12 +51,21 @@ class FR3Robot:
     """
 
     name = "fr3"
-    #: the blind teacher's style on tasks that search in rz (``execution.teacher.style_for``):
-    #: the arm's yaw follows the teacher's 0.4 Hz wiggle about 2 degrees late (the floating
-    #: tool's 0.3) and its joint friction stops the valleys from turning the part into line,
-    #: so at the default pace the pins never meet both holes (socket3d: 0 of 6 starts in 60 s);
-    #: a person guiding this heavier, stickier arm moves and turns slower
-    teacher_rz_hints: Mapping[str, float] = MappingProxyType(
+    #: the blind teacher's style on every task (:meth:`teacher_hints`): joint friction loads
+    #: the open-loop press (f_z swings 4.5-7.5 N with the sweep's direction), which a person
+    #: pressing by feel corrects within 0.15 s; and a hand guiding the arm's few kilograms of
+    #: apparent mass moves with less bandwidth than the free tool's (its wander and tremor
+    #: low-passed over 0.1 s: unfiltered, their 100 Hz velocity steps shake the arm at
+    #: 10-25 Hz and f_z with them; BENCHMARKS.md, session 6)
+    TEACHER_HINTS: Mapping[str, float] = MappingProxyType(
+        {"press_feel": 0.15, "hand_smoothing": 0.1}
+    )
+    #: and on tasks that search in rz: the arm's yaw follows the teacher's 0.4 Hz wiggle about
+    #: 2 degrees late (the floating tool's 0.3) and its joint friction stops the valleys from
+    #: turning the part into line, so at the default pace the pins never meet both holes
+    #: (socket3d: 0 of 6 starts in 60 s); a person guiding this heavier, stickier arm moves
+    #: and turns slower
+    TEACHER_RZ_HINTS: Mapping[str, float] = MappingProxyType(
         {"speed": 0.006, "rz_wiggle_frequency": 0.15}
     )
 
@@ -269,6 +278,13 @@ class FR3Robot:
             ang_vel=self.ctl.twist[3:].copy(),
             wrench=self.measured_wrench(),
         )
+
+    @classmethod
+    def teacher_hints(cls, task: Task) -> Mapping[str, object]:
+        """The blind teacher's style on this arm for ``task`` (``execution.teacher.style_for``):
+        :data:`TEACHER_HINTS`, with :data:`TEACHER_RZ_HINTS` where ``task`` searches in rz."""
+        rz = cls.TEACHER_RZ_HINTS if "rz" in task.search_dims else {}
+        return MappingProxyType({**cls.TEACHER_HINTS, **rz})
 
     def close(self) -> None:
         """Nothing to release but the simulator's memory (kept until garbage collection)."""

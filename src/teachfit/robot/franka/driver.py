@@ -25,7 +25,9 @@ Cartesian impedance approach with our own law.
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -39,6 +41,10 @@ from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
 from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
+from teachfit.robot.interface import NO_TEACHER_HINTS
+
+if TYPE_CHECKING:
+    from teachfit.tasks.base import Task
 
 #: GIL switch interval (s) while a driver runs
 SWITCH_INTERVAL = 2e-4
@@ -187,6 +193,11 @@ class FrankaRobot:
         self._loop.t0 = self._loop.t_abs
         self.resets += 1
         return self.step(1)
+
+    @staticmethod
+    def teacher_hints(task: Task) -> Mapping[str, object]:
+        """None: the simulated teacher drives no real arm (a person guides it)."""
+        return NO_TEACHER_HINTS
 
     def close(self) -> None:
         """Finish the control loop (the arm holds where it is) and release the connection."""
