@@ -21,6 +21,7 @@ from teachfit.core.control import ControllerSpec, FixedGainSpec
 from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.floating_kernel import FloatingKernel
 from teachfit.robot.interface import law_fault
 from teachfit.robot.sensor_filter import LowPass2
 from teachfit.tasks.base import Task
@@ -172,6 +173,7 @@ class FloatingToolRobot:
         self._warning_numbers = self.data.warning.number
         self._cmd: ImpedanceCommand | None = None
         self._fault: SimulationDiverged | ControlError | None = None
+        self._kernel = self._bind_kernel()
 
     # ------------------------------------------------------------------ Robot protocol
     @property
@@ -188,6 +190,7 @@ class FloatingToolRobot:
         if controller is not None:
             self.controller_spec = controller
             self._law = make_law(controller, self.params.apparent_mass, self.control_period)
+            self._kernel = self._bind_kernel()
         self._fault = None
         mujoco.mj_resetData(self.model, self.data)
         self._pos[:] = pose.pos
@@ -221,9 +224,31 @@ class FloatingToolRobot:
         """The control law object running in the loop (inspection and tests only)."""
         return self._law
 
+    def _bind_kernel(self) -> FloatingKernel | None:
+        """The compiled tick for the current law (None: a law only Python runs)."""
+        if not FloatingKernel.supports(self._law):
+            return None
+        st = (self._pos, self._quat, self._linvel, self._angvel_local, self._angvel)
+        st += (self.data.xpos[self._body], self.data.qfrc_applied, self.data.sensordata)
+        st += (np.zeros(6),)
+        return FloatingKernel(self.model, self.data, self._body, self._law, st)
+
     def step(self, n: int = 1) -> RobotState:
         if self._fault is not None:
             raise self._fault
+        if self._gauges.shape[0] < n:
+            self._gauges = np.zeros((n, 6))
+        if self._kernel is None:
+            self._step_python(n)
+        elif self._kernel.step(n, self._f_adr, self._gauges) < n:
+            self._law_output_fault(self._pos, self._quat, self._linvel, self._angvel)
+        # the gauges' samples with their noise, through the device's low-pass (one call)
+        self._ft_lp.filter(self._gauges[:n] + self._noise(n))
+        self._check_divergence()
+        return self.state()
+
+    def _step_python(self, n: int) -> None:
+        """``n`` ticks with the law in Python (a law the compiled tick does not know)."""
         m, d = self.model, self.data
         ctrl = self._law
         qfrc = d.qfrc_applied
@@ -231,8 +256,6 @@ class FloatingToolRobot:
         pos, quat, linvel = self._pos, self._quat, self._linvel
         angvel, angvel_local = self._angvel, self._angvel_local
         raw = self._ft_raw
-        if self._gauges.shape[0] < n:
-            self._gauges = np.zeros((n, 6))
         gauges = self._gauges
         point = d.xpos[body]  # the tool frame origin is the TCP
         for k in range(n):
@@ -243,11 +266,7 @@ class FloatingToolRobot:
             qfrc[:] = 0.0
             mujoco.mj_applyFT(m, d, w[:3], w[3:], point, body, qfrc)
             mujoco.mj_step(m, d)
-            gauges[k] = raw  # the gauges sampled every tick ...
-        # ... with their noise, through the device's low-pass (one call for the n ticks)
-        self._ft_lp.filter(gauges[:n] + self._noise(n))
-        self._check_divergence()
-        return self.state()
+            gauges[k] = raw  # the gauges sampled every tick
 
     def state(self) -> RobotState:
         return RobotState(
