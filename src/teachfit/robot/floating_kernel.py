@@ -61,11 +61,7 @@ def _adapt(ad, err, derr, w, sc) -> None:  # noqa: ANN001
         ka[i] = max(min(ka[i] + dk, k_room[i]), 0.0)
         damp = (math.sqrt(k0[i] + ka[i]) - sqrt_k0[i]) * sqrt_m2[i] * xi
         w[i] += ka[i] * err[i] + damp * derr[i] + ff[i]
-    for lo, cap in ((0, sc[CLIP_F]), (3, sc[CLIP_T])):
-        norm = math.sqrt(w[lo] * w[lo] + w[lo + 1] * w[lo + 1] + w[lo + 2] * w[lo + 2])
-        if norm > cap:
-            for i in range(lo, lo + 3):
-                w[i] *= cap / norm
+    k.clip_wrench(w, sc[CLIP_F], sc[CLIP_T])
 
 
 @numba.njit(cache=True)
