@@ -240,10 +240,13 @@ class FloatingToolRobot:
             self._gauges = np.zeros((n, 6))
         if self._kernel is None:
             self._step_python(n)
-        elif self._kernel.step(n, self._f_adr, self._gauges) < n:
-            self._law_output_fault(self._pos, self._quat, self._linvel, self._angvel)
-        # the gauges' samples with their noise, through the device's low-pass (one call)
-        self._ft_lp.filter(self._gauges[:n] + self._noise(n))
+            # the gauges' samples with their noise, through the device's low-pass (one call)
+            self._ft_lp.filter(self._gauges[:n] + self._noise(n))
+        else:  # the same, per tick inside the compiled loop
+            lp = self._ft_lp
+            ft = (self._noise(n), lp.coef, lp.out, lp.zi, self._gauges[0])
+            if self._kernel.step(n, self._f_adr, ft) < n:
+                self._law_output_fault(self._pos, self._quat, self._linvel, self._angvel)
         self._check_divergence()
         return self.state()
 

@@ -65,15 +65,19 @@ def _adapt(ad, err, derr, w, sc) -> None:  # noqa: ANN001
 
 
 @numba.njit(cache=True)
-def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, gauges, f_adr):  # noqa: ANN001, ANN201
+def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, ft, f_adr):  # noqa: ANN001, ANN201
     """``n`` ticks from time ``t`` (s); returns the ticks done (fewer: a non-finite wrench
     before the tick of that index, nothing applied).
 
     ``st``: (TCP pos, quat, linear velocity, local angular velocity, world angular velocity,
     TCP point, qfrc_applied, sensordata, twist scratch); ``law``: (K, D, f, x_d, q_d, v_d,
-    e, de, q scratch, r scratch, wrench). ``gauges[k]`` gets tick ``k``'s raw F/T sensor.
+    e, de, q scratch, r scratch, wrench). ``ft``: (gauge noise (n, 6), filter coefficients,
+    filter output (6,), filter state (2, 6), gauge scratch (6,)): every tick the raw F/T
+    sensor at ``f_adr`` plus that tick's noise passes the device's low-pass
+    (:class:`teachfit.robot.sensor_filter.LowPass2`, the recurrence of ``lfilter``).
     """
     pos, quat, linvel, angvel_local, angvel, point, qfrc, sdata, twist = st
+    noise, coef, ft_out, ft_z, gauge = ft
     kmat, dmat, ff, xd, qd, vd, err, derr, qtmp, rtmp, w = law
     for tick in range(n):
         fns[7](k._addr(angvel), k._addr(angvel_local), k._addr(quat))
@@ -94,7 +98,8 @@ def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, gauges, f_adr):  # noq
         fns[APPLY_FT](m, d, k._addr(w), k._addr(w) + 24, k._addr(point), body, k._addr(qfrc))
         fns[12](m, d)  # mj_step
         for i in range(6):
-            gauges[tick, i] = sdata[f_adr + i]
+            gauge[i] = sdata[f_adr + i] + noise[tick, i]
+        k._biquad(coef, gauge, ft_out, ft_z)
         t += sc[k.DT]  # as mj_step advances d->time
     return n
 
@@ -129,8 +134,9 @@ class FloatingKernel:
         """Whether ``law`` runs compiled (the two laws of :mod:`teachfit.control`)."""
         return type(law) in (AdaptiveImpedance, CartesianImpedance)
 
-    def step(self, n: int, f_adr: int, gauges: np.ndarray) -> int:
-        """``n`` ticks; the law's scalar state in and out around the compiled loop."""
+    def step(self, n: int, f_adr: int, ft: tuple) -> int:
+        """``n`` ticks (``ft`` as for :func:`run`); the law's scalar state in and out around
+        the compiled loop."""
         law, sc = self.law, self.sc
         e = law._error
         sc[k.T0], sc[k.EXPIRY] = e._t0, e._expiry
@@ -143,7 +149,7 @@ class FloatingKernel:
             sc[k.MAX_F], sc[k.MAX_T] = lim.max_force, lim.max_torque
         done = run(
             n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
-            self.adaptive, self.state, self.law_bufs, self.ad, sc, gauges, f_adr,
+            self.adaptive, self.state, self.law_bufs, self.ad, sc, ft, f_adr,
         )  # fmt: skip
         e._t0, e._expiry = float(sc[k.T0]), float(sc[k.EXPIRY])
         e._spinning, e.lapsed = bool(sc[k.SPINNING]), bool(sc[k.LAPSED])
