@@ -295,11 +295,16 @@ class FloatingToolRobot:
         t_site = self._ft_filt[3:]
         # MuJoCo reports what the child exerts on the parent; the environment's wrench on the
         # part balances it (quasi-statically), so flip the sign, then move the torque to the TCP.
-        f_env = -(rot @ f_site)
-        t_env_site = -(rot @ t_site)
-        lever = d.site_xpos[self._site_ft] - self._pos
-        t_env_tcp = t_env_site + np.cross(lever, f_env)
-        return np.concatenate([f_env, t_env_tcp])
+        out = np.empty(6)
+        out[:3] = -(rot @ f_site)
+        out[3:] = -(rot @ t_site)
+        # + lever x f_env, written out: np.cross costs ~10 small numpy calls (per command)
+        lx, ly, lz = (d.site_xpos[self._site_ft] - self._pos).tolist()
+        fx, fy, fz = out[:3].tolist()
+        out[3] += ly * fz - lz * fy
+        out[4] += lz * fx - lx * fz
+        out[5] += lx * fy - ly * fx
+        return out
 
     def _noise(self, n: int) -> np.ndarray:
         """(n, 6) gauge noise of ``n`` ticks, before the filter (N, N·m)."""
@@ -341,6 +346,6 @@ class FloatingToolRobot:
                 f"MuJoCo warning(s) {kinds} at t={self.data.time:.3f} s: simulation invalid"
             )
             raise self._fault
-        if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+        if not math.isfinite(float(self.data.qpos.sum()) + float(self.data.qvel.sum())):
             self._fault = SimulationDiverged(f"NaN/inf in the state at t={self.data.time:.3f} s")
             raise self._fault
