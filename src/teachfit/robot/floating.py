@@ -4,7 +4,8 @@ This is the simulated robot behind :class:`~teachfit.robot.interface.Robot`. The
 (free joint, gravity compensated like a torque-controlled arm's payload) carries the task's
 held part on a child body; MuJoCo force/torque sensors between the two play the wrist F/T
 sensor. Each control tick (one 1 ms physics step) the controller's wrench at the TCP is applied
-with ``mj_applyFT``.
+with ``mj_applyFT``. For the two laws of :mod:`teachfit.control` the ticks of a ``step(n)`` run
+compiled (:mod:`teachfit.robot.floating_kernel`); any other law runs them in Python.
 """
 
 from __future__ import annotations

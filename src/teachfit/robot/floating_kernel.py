@@ -23,6 +23,7 @@ import ctypes
 import math
 from functools import cache
 
+import mujoco
 import numba
 import numpy as np
 
@@ -110,7 +111,14 @@ class FloatingKernel:
     ``state`` is the :func:`run` ``st`` tuple (views into the robot's MjData and buffers).
     """
 
-    def __init__(self, model: object, data: object, body: int, law: object, state: tuple) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        body: int,
+        law: AdaptiveImpedance | CartesianImpedance,
+        state: tuple,
+    ) -> None:
         self.fns = routines()
         self.m_ptr, self.d_ptr = model._address, data._address
         self.data, self.body, self.state = data, body, state
