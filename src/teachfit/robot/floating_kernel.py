@@ -15,6 +15,11 @@ clipping gives ``K e + D de + F_d`` and the errors, then the adaptation and the 
 are added and the sum is clipped. The kernel works on the law objects' own buffers, so their
 state (adapted ``F_ff``, ``K_a``, set-point clock) is what the Python law would hold; a test
 checks that both paths give the same trajectory.
+
+numba caches the machine code on disk (``cache=True``): the first process after a change to
+this file compiles it (about a minute on the busy 2-core machine), later ones load it. The
+cache is keyed on this file only: after an edit of the FR3 kernel's functions used here, touch
+this file (or clear its ``__pycache__``) so that they are compiled in again.
 """
 
 from __future__ import annotations
