@@ -62,20 +62,25 @@ def test_divergence_is_reported_not_crashed():
         robot.step(5)
 
 
-def test_a_nan_wrench_of_the_law_is_a_control_error_not_divergence():
+@pytest.mark.parametrize("compiled", [True, False], ids=["compiled", "python"])
+def test_a_nan_wrench_of_the_law_is_a_control_error_not_divergence(compiled):
     """The state goes NaN because the (adaptive) law commanded NaN: the law is reported."""
     task = get_task("peg2d")
     robot = FloatingToolRobot(task, controller=AdaptiveSpec())
     robot.reset(task.contact_pose([0.02, 0.0]))
     law = robot.law
-    real = law.compute  # type: ignore[attr-defined]
+    if compiled:
+        law._ff_adapt[0] = np.nan  # type: ignore[attr-defined]  # adapted state blown up
+    else:
+        robot._kernel = None  # the Python tick
+        real = law.compute  # type: ignore[attr-defined]
 
-    def blown_up(*args: object) -> np.ndarray:
-        w = real(*args) * np.nan
-        law.last_wrench = w  # type: ignore[attr-defined]
-        return w
+        def blown_up(*args: object) -> np.ndarray:
+            w = real(*args) * np.nan
+            law.last_wrench = w  # type: ignore[attr-defined]
+            return w
 
-    law.compute = blown_up  # type: ignore[attr-defined]
+        law.compute = blown_up  # type: ignore[attr-defined]
     with pytest.raises(ControlError, match="AdaptiveImpedance control law produced a non-fin"):
         robot.step(5)
     with pytest.raises(ControlError):  # the robot stays faulted until reset

@@ -35,7 +35,7 @@ SITUATIONS = [
     ("key", (), (0.0025, 0.0, 0.0), False),
     ("key", (), (0.0, 0.0, np.deg2rad(25.0)), False),
     ("peg", (), (0.0, 0.0, 0.0), True),
-    ("peg", (), (0.001, 0.0, 0.0), True),  # the chamfer guides it in
+    ("peg", (), (0.0005, 0.0, 0.0), True),  # the chamfer guides it in
     ("peg", (), (0.002, 0.0, 0.0), False),  # blocked on the rim
     ("peg", (), (0.022, 0.0, 0.0), False),  # beside the boss: down to the plate
 ]

@@ -13,6 +13,7 @@ on the real robot), and wall time and trials/s on this machine.
 from __future__ import annotations
 
 import math
+import os
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -175,7 +176,7 @@ def run_experiment(
     or the address of a running cluster), ``workers`` of them at once."""
     if method not in METHODS:
         raise LearningError(f"unknown method {method!r}; known: {list(METHODS)}")
-    with tempfile.TemporaryDirectory(prefix="teachfit-bench-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="teachfit-bench-", dir=_ram_dir()) as tmp:
         db = storage or Path(tmp) / "study.db"
         study = Study(
             db,
@@ -215,6 +216,17 @@ def run_experiment(
         wall = time.perf_counter() - t0
         study.close()
         return Experiment.from_records(objective.task, method, objective.seed, study.trials(), wall)
+
+
+def _ram_dir() -> str | None:
+    """A RAM-backed folder for the throw-away study database, if the system has one.
+
+    The study commits to SQLite several times per trial; on a disk each commit waits for an
+    fsync (~10 ms here, 0.1-0.3 s per 4-execution trial with the storage's own queries), on
+    ``/dev/shm`` it does not. ``None``: the system's temporary folder.
+    """
+    shm = Path("/dev/shm")
+    return str(shm) if shm.is_dir() and os.access(shm, os.W_OK) else None
 
 
 def run_learning_bench(

@@ -43,6 +43,16 @@ def _gain(value: object, name: str) -> np.ndarray:
             raise ControlError(f"{name} must be positive semi-definite")
         arr.setflags(write=False)
         return arr
+    b = arr[0, 1]
+    if b == arr[1, 0] and np.count_nonzero(arr) == np.count_nonzero(diag) + 2 and b != 0:
+        # a symmetric x-y block on a diagonal (aligned_stiffness, sent every command period):
+        # its eigenvalues in closed form instead of eigvalsh, the same test
+        a, d = arr[0, 0], arr[1, 1]
+        low = min(diag.min(), 0.5 * (a + d) - float(np.hypot(0.5 * (a - d), b)))
+        if low < -1e-9 * max(1.0, np.abs(arr).max()):
+            raise ControlError(f"{name} must be positive semi-definite")
+        arr.setflags(write=False)
+        return arr
     if not np.allclose(arr, arr.T, atol=1e-9 * max(1.0, np.abs(arr).max())):
         raise ControlError(f"{name} must be symmetric")
     if np.linalg.eigvalsh(arr).min() < -1e-9 * max(1.0, np.abs(arr).max()):

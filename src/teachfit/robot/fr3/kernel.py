@@ -139,7 +139,13 @@ def fixed_law(fns, t, pos, quat, twist, kmat, dmat, ff, xd, qd, vd, sc, err, der
         for j in range(6):
             r += dmat[i, j] * derr[j]
         w[i] = s + r + ff[i]
-    for lo, cap in ((0, sc[MAX_F]), (3, sc[MAX_T])):
+    clip_wrench(w, sc[MAX_F], sc[MAX_T])
+
+
+@numba.njit(cache=True, inline="always")
+def clip_wrench(w, max_f, max_t) -> None:  # noqa: ANN001
+    """Scale force and torque of ``w`` (6,) in place to norms of at most ``max_f``, ``max_t``."""
+    for lo, cap in ((0, max_f), (3, max_t)):
         norm = np.sqrt(w[lo] * w[lo] + w[lo + 1] * w[lo + 1] + w[lo + 2] * w[lo + 2])
         if norm > cap:
             for i in range(lo, lo + 3):

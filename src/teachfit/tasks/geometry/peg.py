@@ -2,16 +2,21 @@
 
 Seed B's hardest task: an aluminium peg with a chamfer, into a hole that "has no walls", so the
 peg can slide off, tilt and get stuck. The paper's numbers are lost in the extracted text, so
-the defaults are plausible ones: a 16 mm peg with a 1 mm chamfer, 0.3 mm diametral clearance,
-a 25 mm deep hole.
+the defaults are plausible ones: a 16 mm peg with a 0.5 mm chamfer, 0.3 mm diametral
+clearance, a 25 mm deep hole.
 
 How hard (issue 16, part 4), from the paper's words (Sec. V): a chamfer on the peg only
-(``hole_chamfer = 0``: "there is a [1] mm chamfer on the peg"); a free-standing boss whose
+(``hole_chamfer = 0``: "there is a [x] mm chamfer on the peg"); a free-standing boss whose
 rim a 4 mm overhang slides off ("the hole has no walls"); the taught hole error of all three
 tasks (0.5 mm per axis: "teaching accuracy below [1] mm"); and ``start_deviation`` 2 mm, the
 "deliberate initial pose deviation" of the four starts (as on the puzzle; see
-:meth:`~teachfit.tasks.protocols.skill.SkillProtocol.start_frames`). ``teachfit bench
-learning --random-rate N`` measures how often random parameters then succeed.
+:meth:`~teachfit.tasks.protocols.skill.SkillProtocol.start_frames`). The chamfer's size is
+lost; 0.5 mm (session 6; 1 mm before) puts the peg's capture range, chamfer plus half the
+clearance = 0.65 mm, below the stated teaching accuracy, so that the taught error matters on
+the paper's hardest task (P(radial error < 0.65 mm) = 57 % at 0.5 mm per axis; with the 1 mm
+chamfer 93 %, and the taught error changed nothing measurable). ``teachfit bench learning
+--random-rate N`` measures how often random parameters then succeed (BENCHMARKS.md: 30 %
+with 0.5 mm, 51 % with 1 mm).
 
 Geometry. The hole is bored into the top of a thin-walled boss (a tube, outer diameter
 ``boss_diameter``) standing ``boss_height`` tall on a base plate (top at ``base_height``),
@@ -48,7 +53,7 @@ class AluminiumPegParams(SkillProtocolParams, RoundPegParams):
     clearance: float = doc_field(
         "diametral clearance: hole diameter minus peg diameter (m)", 3e-4, above=0
     )
-    peg_chamfer: float = doc_field("45-degree chamfer on the peg tip edge (m)", 0.001, at_least=0)
+    peg_chamfer: float = doc_field("45-degree chamfer on the peg tip edge (m)", 0.0005, at_least=0)
     peg_length: float = doc_field("length of the peg below the wrist sensor (m)", 0.060, above=0)
     hole_depth: float = doc_field("depth of the hole below the boss top (m)", 0.025, above=0)
     hole_chamfer: float = doc_field("45-degree chamfer on the hole entry edge (m)", 0.0, at_least=0)

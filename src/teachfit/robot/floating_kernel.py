@@ -1,0 +1,170 @@
+"""The floating tool's 1 kHz tick compiled with numba: law, ``mj_applyFT`` and ``mj_step``.
+
+Why: a tick of :class:`~teachfit.robot.floating.FloatingToolRobot` is one ``mj_step`` (6-60
+µs, most of it narrow-phase collision in contact) plus the control law, ~30 small numpy
+operations that cost 35-45 µs from Python (BENCHMARKS.md, seed B throughput). Compiled, the
+law costs well under a microsecond; the whole ``step(n)`` of ``n`` ticks becomes one call.
+
+This reuses the FR3 kernel's pattern and parts (:mod:`teachfit.robot.fr3.kernel`): MuJoCo's C
+routines through ``ctypes`` on the bindings' own ``libmujoco`` with the model and data
+pointers, and its compiled fixed-gain law :func:`~teachfit.robot.fr3.kernel.fixed_law` (the
+set-point extrapolation and expiry of :class:`teachfit.control.impedance.SetpointError`).
+The adaptive law of :class:`teachfit.control.AdaptiveImpedance` (its module docstring has the
+equations) runs on top: the fixed-gain law with the command's ``K``, ``D`` and ``F_d`` and no
+clipping gives ``K e + D de + F_d`` and the errors, then the adaptation and the adaptive terms
+are added and the sum is clipped. The kernel works on the law objects' own buffers, so their
+state (adapted ``F_ff``, ``K_a``, set-point clock) is what the Python law would hold; a test
+checks that both paths give the same trajectory.
+
+numba caches the machine code on disk (``cache=True``): the first process after a change to
+this file compiles it (about a minute on the busy 2-core machine), later ones load it. The
+cache is keyed on this file only: after an edit of the FR3 kernel's functions used here, touch
+this file (or clear its ``__pycache__``) so that they are compiled in again.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import math
+from functools import cache
+
+import mujoco
+import numba
+import numpy as np
+
+from teachfit.control import AdaptiveImpedance, CartesianImpedance
+from teachfit.robot.fr3 import kernel as k
+
+_P = ctypes.c_size_t
+APPLY_FT = 13  # index of mj_applyFT in :func:`routines`
+# scalar slots after the FR3 kernel's: adaptive damping ratio and the real wrench limits
+XI, CLIP_F, CLIP_T = k.N_SCALARS, k.N_SCALARS + 1, k.N_SCALARS + 2
+N_SCALARS = k.N_SCALARS + 3
+
+
+@cache
+def routines() -> tuple:
+    """The FR3 kernel's routines plus ``mj_applyFT`` (index :data:`APPLY_FT`)."""
+    apply_ft = k._fn("mj_applyFT", _P, _P, _P, _P, _P, ctypes.c_int, _P)
+    return (*k.routines(), apply_ft)
+
+
+@numba.njit(cache=True)
+def _adapt(ad, err, derr, w, sc) -> None:  # noqa: ANN001
+    """Adaptation of ``F_ff`` and ``K_a`` (one period) and the adaptive terms added to ``w``.
+
+    ``ad``: (alpha, beta, gamma_a, gamma_b, kappa, dF step, dK step, F_max, F_ff, K_a,
+    K room, K_cmd diagonal, its square root, 2 sqrt m), all (6,).
+    """
+    alpha, beta, gamma_a, gamma_b, kappa, df_step, dk_step, f_max = ad[:8]
+    ff, ka, k_room, k0, sqrt_k0, sqrt_m2 = ad[8:]
+    xi = sc[XI]
+    for i in range(6):
+        eps = kappa[i] * err[i] + derr[i]
+        step = min(max(alpha[i] * (eps - gamma_a[i] * ff[i]), -df_step[i]), df_step[i])
+        ff[i] = min(max(ff[i] + step, -f_max[i]), f_max[i])
+        dk = min(max(beta[i] * (eps * err[i] - gamma_b[i] * ka[i]), -dk_step[i]), dk_step[i])
+        ka[i] = max(min(ka[i] + dk, k_room[i]), 0.0)
+        damp = (math.sqrt(k0[i] + ka[i]) - sqrt_k0[i]) * sqrt_m2[i] * xi
+        w[i] += ka[i] * err[i] + damp * derr[i] + ff[i]
+    k.clip_wrench(w, sc[CLIP_F], sc[CLIP_T])
+
+
+@numba.njit(cache=True)
+def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, ft, f_adr):  # noqa: ANN001, ANN201
+    """``n`` ticks from time ``t`` (s); returns the ticks done (fewer: a non-finite wrench
+    before the tick of that index, nothing applied).
+
+    ``st``: (TCP pos, quat, linear velocity, local angular velocity, world angular velocity,
+    TCP point, qfrc_applied, sensordata, twist scratch); ``law``: (K, D, f, x_d, q_d, v_d,
+    e, de, q scratch, r scratch, wrench). ``ft``: (gauge noise (n, 6), filter coefficients,
+    filter output (6,), filter state (2, 6), gauge scratch (6,)): every tick the raw F/T
+    sensor at ``f_adr`` plus that tick's noise passes the device's low-pass
+    (:class:`teachfit.robot.sensor_filter.LowPass2`, the recurrence of ``lfilter``).
+    """
+    pos, quat, linvel, angvel_local, angvel, point, qfrc, sdata, twist = st
+    noise, coef, ft_out, ft_z, gauge = ft
+    kmat, dmat, ff, xd, qd, vd, err, derr, qtmp, rtmp, w = law
+    for tick in range(n):
+        fns[7](k._addr(angvel), k._addr(angvel_local), k._addr(quat))
+        for i in range(3):
+            twist[i] = linvel[i]
+            twist[i + 3] = angvel[i]
+        k.fixed_law(
+            fns, t, pos, quat, twist, kmat, dmat, ff, xd, qd, vd, sc, err, derr, qtmp, rtmp, w
+        )  # noqa: E501
+        if adaptive:
+            _adapt(ad, err, derr, w, sc)
+        total = 0.0
+        for i in range(6):
+            total += w[i]
+        if not math.isfinite(total):
+            return tick
+        qfrc[:] = 0.0
+        fns[APPLY_FT](m, d, k._addr(w), k._addr(w) + 24, k._addr(point), body, k._addr(qfrc))
+        fns[12](m, d)  # mj_step
+        for i in range(6):
+            gauge[i] = sdata[f_adr + i] + noise[tick, i]
+        k._biquad(coef, gauge, ft_out, ft_z)
+        t += sc[k.DT]  # as mj_step advances d->time
+    return n
+
+
+class FloatingKernel:
+    """Binds a fixed-gain or adaptive law of a floating tool to :func:`run`.
+
+    ``state`` is the :func:`run` ``st`` tuple (views into the robot's MjData and buffers).
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        body: int,
+        law: AdaptiveImpedance | CartesianImpedance,
+        state: tuple,
+    ) -> None:
+        self.fns = routines()
+        self.m_ptr, self.d_ptr = model._address, data._address
+        self.data, self.body, self.state = data, body, state
+        self.law = law
+        self.sc = np.zeros(N_SCALARS)
+        self.sc[k.DT] = float(model.opt.timestep)
+        self.adaptive = type(law) is AdaptiveImpedance
+        e = law._error  # the law's own buffers: the kernel updates them in place
+        bufs = (e._xd, e._qd, e._vd, e.err, e.derr, e._qtmp, e._rtmp, np.zeros(6))
+        if self.adaptive:
+            self.law_bufs = (law._k0, law._d0, law._fd, *bufs)
+            self.ad = (law._alpha, law._beta, law._gamma_a, law._gamma_b, law._kappa)
+            self.ad += (law._df_step, law._dk_step, law._f_max, law._ff_adapt, law._k_adapt)
+            self.ad += (law._k_room, law._k0_diag, law._sqrt_k0, law._sqrt_m2)
+        else:
+            self.law_bufs = (law._k, law._d, law._ff, *bufs)
+            self.ad = (np.zeros(6),) * 14
+
+    @staticmethod
+    def supports(law: object) -> bool:
+        """Whether ``law`` runs compiled (the two laws of :mod:`teachfit.control`)."""
+        return type(law) in (AdaptiveImpedance, CartesianImpedance)
+
+    def step(self, n: int, f_adr: int, ft: tuple) -> int:
+        """``n`` ticks (``ft`` as for :func:`run`); the law's scalar state in and out around
+        the compiled loop."""
+        law, sc = self.law, self.sc
+        e = law._error
+        sc[k.T0], sc[k.EXPIRY] = e._t0, e._expiry
+        sc[k.SPINNING], sc[k.LAPSED] = float(e._spinning), float(e.lapsed)
+        lim = law.impedance_limits if self.adaptive else law.limits
+        if self.adaptive:
+            sc[k.MAX_F] = sc[k.MAX_T] = np.inf
+            sc[CLIP_F], sc[CLIP_T], sc[XI] = lim.max_force, lim.max_torque, law._xi
+        else:
+            sc[k.MAX_F], sc[k.MAX_T] = lim.max_force, lim.max_torque
+        done = run(
+            n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
+            self.adaptive, self.state, self.law_bufs, self.ad, sc, ft, f_adr,
+        )  # fmt: skip
+        e._t0, e._expiry = float(sc[k.T0]), float(sc[k.EXPIRY])
+        e._spinning, e.lapsed = bool(sc[k.SPINNING]), bool(sc[k.LAPSED])
+        law.last_wrench = self.law_bufs[-1].copy()
+        return int(done)
