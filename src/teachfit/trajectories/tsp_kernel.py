@@ -1,10 +1,13 @@
-"""Compiled local search of the open-tour solver (numba): 2-opt, Or-opt and local kicks.
+"""Compiled local search of the open-tour solver (numba): 2-opt, Or-opt, Lin-Kernighan chains
+and segment-swap kicks.
 
 Why written here: the maintained packages miss one of the three things TSHIX needs. LKH-3
 (``elkai``) is 20-40x over the time budget (0.7 s for 300 points); ``fast-tsp`` stops on a
 wall-clock budget, so its tours change with the machine's load (the same seed must give the
-same tour); OR-Tools' guided local search is also time-bounded. This kernel runs a fixed,
-seeded number of moves: the same input gives the same tour on every machine.
+same tour) and it has no iteration-count mode; OR-Tools' guided local search with a solution
+limit is deterministic but was 1.05-1.24 x LKH in 25-500 ms (measured on the 300-point sets of
+``benchmarks/search_speed.py``). This kernel runs a fixed, seeded number of moves: the same
+input gives the same tour on every machine.
 
 The tour is a path ``tour[0] = start, ..., tour[M-1] = dummy`` over ``M = N + 2`` nodes (node 0
 the start, nodes ``1..N`` the points, node ``M-1`` a dummy at distance 0 from every node), both
@@ -15,10 +18,16 @@ points costs exactly the open tour. Moves (all in O(segment) time on arrays):
   ``(t_lo, t_hi), (t_lo+1, t_hi+1)``;
 - **Or-opt**: move a segment of 1-3 nodes between two neighbours elsewhere, either way round
   (done by two or three reversals);
+- **Lin-Kernighan chain** (when neither improves): a sequence of up to ``depth`` 2-opt flips
+  that keep ``t1`` fixed, each adding an edge from the last free end to a candidate
+  neighbour, the partial gain kept positive; the chain is cut at its best closed gain. At the
+  dummy (the free end of the open tour) the chain may break the longest edge of the tour.
 
-both restricted to K nearest neighbours with don't-look bits. Then **iterated local search**:
-a local double bridge (two adjacent segments of at most ``window`` nodes swapped), local
-search from its six end nodes, kept only if the tour got shorter.
+all restricted to candidate lists (nearest and Delaunay neighbours) with don't-look bits
+(a queue of nodes to look at). Then **iterated local search**: a double bridge (two adjacent
+segments of any length swapped, ``A B C D -> A C B D``; whole clusters of points move), local
+search from its six end nodes, kept when at most ``threshold`` longer (threshold accepting);
+the shortest tour seen is returned.
 """
 
 from __future__ import annotations
@@ -36,6 +45,74 @@ def _d(x: np.ndarray, a: int, b: int, dummy: int) -> float:
         t = x[a, k] - x[b, k]
         s += t * t
     return np.sqrt(s)
+
+
+@njit(cache=True)
+def nearest_neighbour_path(x: np.ndarray, neigh: np.ndarray) -> np.ndarray:
+    """Greedy path from node 0 always to the nearest unvisited node (candidates first, a full
+    scan only when all of them are visited); returns the node order, shape (n,)."""
+    n = x.shape[0]
+    left = np.ones(n, dtype=np.bool_)
+    order = np.empty(n, dtype=np.int64)
+    cur = 0
+    left[0] = False
+    order[0] = 0
+    for k in range(1, n):
+        nxt = -1
+        for c in neigh[cur]:  # nearest first
+            if left[c]:
+                nxt = c
+                break
+        if nxt < 0:
+            best = np.inf
+            for c in range(n):
+                if left[c]:
+                    dc = _d(x, cur, c, -1)
+                    if dc < best:
+                        best, nxt = dc, c
+        left[nxt] = False
+        order[k] = nxt
+        cur = nxt
+    return order
+
+
+@njit(cache=True)
+def merge_candidates(
+    x: np.ndarray, near: np.ndarray, indptr: np.ndarray, indices: np.ndarray, width: int
+) -> np.ndarray:
+    """Candidate lists, shape (n, width): each node's nearest nodes ``near`` (rows may hold
+    the node itself) merged with its Delaunay neighbours ``indices[indptr[v]:indptr[v+1]]``,
+    nearest first, at most ``width``, padded by repeating the last."""
+    n = x.shape[0]
+    out = np.empty((n, width), dtype=np.int64)
+    buf = np.empty(near.shape[1] + n, dtype=np.int64)
+    dist = np.empty(near.shape[1] + n, dtype=np.float64)
+    seen = np.zeros(n, dtype=np.bool_)
+    for v in range(n):
+        c = 0
+        seen[v] = True
+        for u in near[v]:
+            if not seen[u]:
+                seen[u] = True
+                buf[c] = u
+                c += 1
+        for k in range(indptr[v], indptr[v + 1]):
+            u = indices[k]
+            if not seen[u]:
+                seen[u] = True
+                buf[c] = u
+                c += 1
+        for k in range(c):
+            dist[k] = _d(x, v, buf[k], -1)
+            seen[buf[k]] = False
+        seen[v] = False
+        idx = np.argsort(dist[:c], kind="mergesort")
+        w = min(width, c)
+        for k in range(w):
+            out[v, k] = buf[idx[k]]
+        for k in range(w, width):
+            out[v, k] = out[v, w - 1]
+    return out
 
 
 @njit(cache=True)
@@ -160,6 +237,141 @@ def _improve_node(
 
 
 @njit(cache=True)
+def _flip(tour: np.ndarray, pos: np.ndarray, t1: int, t2: int, t3: int, flips: np.ndarray, k: int):
+    """The 2-opt flip of a Lin-Kernighan step: remove ``(t1, t2)`` and ``(t3, t4)``, add
+    ``(t2, t3)`` and ``(t4, t1)``, ``t4`` the neighbour of ``t3`` on ``t2``'s side; records the
+    reversed range in ``flips[k]``. Returns ``t4``, or -1 when the flip would move an end."""
+    i, j = pos[t1], pos[t2]
+    direction = j - i  # +1: t2 follows t1
+    c = pos[t3]
+    p4 = c - direction
+    if p4 < 0 or p4 >= tour.shape[0]:
+        return -1
+    t4 = tour[p4]
+    if t4 == t2 or t3 == t1:
+        return -1
+    if direction == 1:
+        lo, hi = (j, p4) if c > i else (c, i)
+    else:
+        lo, hi = (p4, j) if c < i else (i, c)
+    if lo < 1 or hi > tour.shape[0] - 2 or lo > hi:
+        return -1
+    _reverse(tour, pos, lo, hi)
+    flips[k, 0], flips[k, 1] = lo, hi
+    return t4
+
+
+@njit(cache=True)
+def _best_step(
+    x: np.ndarray,
+    neigh: np.ndarray,
+    tour: np.ndarray,
+    pos: np.ndarray,
+    t1: int,
+    t2: int,
+    g: float,
+    eps: float,
+) -> tuple[float, int]:
+    """The candidate ``t3`` of ``t2`` with positive partial gain ``g - d(t2, t3)`` and the
+    largest ``d(t3, t4) - d(t2, t3)``; returns (that value, t3), t3 = -1 when none."""
+    m = tour.shape[0]
+    dummy = m - 1
+    best_val, best_t3 = -1e300, -1
+    direction = pos[t2] - pos[t1]
+    for t3 in neigh[t2]:
+        if g - _d(x, t2, t3, dummy) <= eps:
+            break
+        if t3 == t1:
+            continue
+        p4 = pos[t3] - direction
+        if p4 < 0 or p4 >= m:
+            continue
+        t4 = tour[p4]
+        if t4 == t2:
+            continue
+        val = _d(x, t3, t4, dummy) - _d(x, t2, t3, dummy)
+        if val > best_val:
+            best_val, best_t3 = val, t3
+    return best_val, best_t3
+
+
+@njit(cache=True)
+def _lk_node(
+    x: np.ndarray,
+    neigh: np.ndarray,
+    tour: np.ndarray,
+    pos: np.ndarray,
+    t1: int,
+    eps: float,
+    flips: np.ndarray,
+    breadth: int,
+) -> tuple[float, int]:
+    """A Lin-Kernighan chain of up to ``flips.shape[0]`` 2-opt flips from ``t1`` (positive
+    partial gains; ``breadth`` alternatives at the first step, then the best
+    ``d(t3, t4) - d(t2, t3)``), cut at its best closed gain.
+
+    Returns (gain, number of flips kept in ``flips``); (0, 0) with the tour unchanged when no
+    chain gains."""
+    m = tour.shape[0]
+    dummy = m - 1
+    depth_max = flips.shape[0]
+    for side in range(2):
+        p2 = pos[t1] + (1 if side == 0 else -1)
+        if p2 < 0 or p2 >= m:
+            continue
+        t2_0 = tour[p2]
+        if t2_0 == dummy:  # no candidate list: every node is at distance 0 from it
+            continue
+        g0 = _d(x, t1, t2_0, dummy)
+        tried = 0
+        for t3_0 in neigh[t2_0]:
+            if tried >= breadth:
+                break
+            if g0 - _d(x, t2_0, t3_0, dummy) <= eps:
+                break
+            t4 = _flip(tour, pos, t1, t2_0, t3_0, flips, 0)
+            if t4 < 0:
+                continue
+            tried += 1
+            g = g0 - _d(x, t2_0, t3_0, dummy) + _d(x, t3_0, t4, dummy)
+            best, best_k = g - _d(x, t4, t1, dummy), 1
+            k = 1
+            t2 = t4
+            while k < depth_max:
+                best_val, best_t3 = -1e300, -1
+                if t2 == dummy:  # the free end: any node is at distance 0, take the longest edge
+                    direction = pos[t2] - pos[t1]
+                    for c in range(1, m - 1):
+                        t3 = tour[c]
+                        t4c = tour[c - direction]
+                        if t3 == t1 or t4c == t2:
+                            continue
+                        val = _d(x, t3, t4c, dummy)
+                        if val > best_val:
+                            best_val, best_t3 = val, t3
+                else:
+                    best_val, best_t3 = _best_step(x, neigh, tour, pos, t1, t2, g, eps)
+                if best_t3 < 0:
+                    break
+                t4 = _flip(tour, pos, t1, t2, best_t3, flips, k)
+                if t4 < 0:
+                    break
+                g += best_val
+                k += 1
+                t2 = t4
+                closed = g - _d(x, t4, t1, dummy)
+                if closed > best:
+                    best, best_k = closed, k
+            for r in range(k - 1, best_k - 1, -1):  # undo the flips past the best
+                _reverse(tour, pos, flips[r, 0], flips[r, 1])
+            if best > eps:
+                return best, best_k
+            for r in range(best_k - 1, -1, -1):
+                _reverse(tour, pos, flips[r, 0], flips[r, 1])
+    return 0.0, 0
+
+
+@njit(cache=True)
 def _local_search(
     x: np.ndarray,
     neigh: np.ndarray,
@@ -169,6 +381,8 @@ def _local_search(
     eps: float,
     queue: np.ndarray,
     inq: np.ndarray,
+    flips: np.ndarray,
+    breadth: int,
 ) -> float:
     """Local search from the nodes ``seeds`` until no move improves; returns the total gain."""
     head_tail = np.zeros(2, dtype=np.int64)
@@ -190,6 +404,18 @@ def _local_search(
                 if 0 <= k < tour.shape[0]:
                     _push(queue, inq, head_tail, tour[k])
             _push(queue, inq, head_tail, a)
+            continue
+        if flips.shape[0] == 0:
+            continue
+        delta, n_flips = _lk_node(x, neigh, tour, pos, a, eps, flips, breadth)
+        if delta > 0.0:
+            gain += delta
+            for r in range(n_flips):
+                lo, hi = flips[r, 0], flips[r, 1]
+                for k in (lo - 1, lo, hi, hi + 1):
+                    if 0 <= k < tour.shape[0]:
+                        _push(queue, inq, head_tail, tour[k])
+            _push(queue, inq, head_tail, a)
     return gain
 
 
@@ -202,6 +428,8 @@ def improve_tour(
     window: int,
     eps: float,
     threshold: float = 0.0,
+    depth: int = 6,
+    breadth: int = 3,
 ) -> np.ndarray:
     """Local search, then one kick per row of ``draws`` (three non-negative ints each).
 
@@ -224,8 +452,9 @@ def improve_tour(
         pos[tour[k]] = k
     queue = np.empty(m, dtype=np.int64)
     inq = np.zeros(m, dtype=np.bool_)
+    flips = np.zeros((depth, 2), dtype=np.int64)
     all_nodes = np.arange(m - 1)
-    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq)
+    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq, flips, breadth)
     inner = m - 2  # movable positions 1..m-2
     if inner < 4:
         return tour
@@ -258,7 +487,7 @@ def improve_tour(
         _move_segment(tour, pos, a, b_end, c_end, True)  # A B C D -> A C rev(B) D
         _reverse(tour, pos, c_end - lb + 1, c_end)  # -> A C B D
         ends[0], ends[1], ends[2], ends[3], ends[4], ends[5] = pa, na, b0, b1, c0, c1
-        gain = delta + _local_search(x, neigh, tour, pos, ends, eps, queue, inq)
+        gain = delta + _local_search(x, neigh, tour, pos, ends, eps, queue, inq, flips, breadth)
         if gain <= eps - threshold:  # longer than accepted: undo
             tour[:] = saved_tour
             pos[:] = saved_pos
