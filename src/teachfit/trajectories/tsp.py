@@ -64,7 +64,8 @@ def _quadrant_neighbours(x: np.ndarray, k: int, per_quadrant: int = 2) -> np.nda
     keep[np.arange(n), first_own] = ~own[np.arange(n), first_own]
     keep[np.arange(n), -1] &= own.any(axis=1)  # rows without self: drop the farthest instead
     idx = idx[keep].reshape(n, q)
-    d = x[idx, :2] - x[:, None, :2]
+    xy = x[:, :2] if x.shape[1] >= 2 else np.column_stack([x, np.zeros(n)])
+    d = xy[idx] - xy[:, None]
     quad = (d[..., 0] >= 0).astype(int) + 2 * (d[..., 1] >= 0).astype(int)
     mask = np.zeros_like(idx, dtype=bool)
     mask[:, :k] = True
@@ -86,7 +87,7 @@ def _candidates(x: np.ndarray, k: int, width: int = 10) -> np.ndarray:
     Delaunay edges hold nearly all edges of an optimal tour, including the long ones between
     clusters that no short nearest-neighbour list reaches; degenerate point sets (qhull
     fails) and other dimensions fall back to :func:`_quadrant_neighbours`."""
-    from teachfit.trajectories.tsp_kernel import merge_candidates
+    from teachfit.trajectories.tsp_moves import merge_candidates
 
     n, dim = x.shape
     if dim not in (2, 3) or n <= dim + 1:
@@ -112,7 +113,8 @@ def _compiled(
     x: np.ndarray, rng: np.random.Generator, n_neighbours: int, n_kicks: int
 ) -> list[int]:
     """Nearest-neighbour path improved by :func:`teachfit.trajectories.tsp_kernel.improve_tour`."""
-    from teachfit.trajectories.tsp_kernel import improve_tour, nearest_neighbour_path
+    from teachfit.trajectories.tsp_kernel import improve_tour
+    from teachfit.trajectories.tsp_moves import nearest_neighbour_path
 
     n = x.shape[0]  # node 0 = start, 1..n-1 = points; dummy = n
     neigh = _candidates(x, n_neighbours)
