@@ -93,3 +93,16 @@ def test_duplicate_points_fall_back_and_stay_valid():
     assert r.length == pytest.approx(open_tour(base).length, rel=0.05)
     line = np.random.default_rng(2).uniform(0, 1, (30, 1))
     assert open_tour(line).length == pytest.approx(line.max())  # sweep out from 0
+
+
+def test_lin_kernighan_chains_keep_a_valid_near_optimal_tour(monkeypatch):
+    # the chains run above tsp._LK_FROM points; lowered here to keep the instance small
+    import teachfit.trajectories.tsp as tsp
+
+    monkeypatch.setattr(tsp, "_LK_FROM", 50)
+    pts = np.random.default_rng(7).uniform(-1, 1, size=(150, 3))
+    a, b = open_tour(pts), open_tour(pts)
+    np.testing.assert_array_equal(a.order, b.order)
+    assert sorted(a.order.tolist()) == list(range(150))
+    assert a.length == pytest.approx(path_length(np.zeros(3), pts, a.order))
+    assert a.length <= 1.02 * open_tour(pts, solver="lkh").length
