@@ -1,6 +1,7 @@
 """Wall time of TSHIX (ours vs LKH via elkai) and of ergodic search, measured in one run.
 
-Usage: ``python benchmarks/search_speed.py [--repeats 5] [--seed 0] [--sizes 100,300,1000]``
+Usage: ``python benchmarks/search_speed.py [--repeats 5] [--seed 0] [--part all|tshix|tsp]
+[--sizes 100,300,1000,2000] [--instances 3] [--lkh-cache FILE]``
 
 For each N = 100..500 TSHIX plans ``repeats`` trajectories from a fixed 2-D exploration
 distribution; the tour length of our open-tour solver is compared with LKH-3 (elkai) on the
@@ -14,6 +15,8 @@ the solver's CPU time (``time.process_time``), which a loaded machine disturbs l
 from __future__ import annotations
 
 import argparse
+import json
+import os
 import time
 
 import numpy as np
@@ -37,10 +40,23 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--sizes", default="100,300,1000", help="point counts of the family table")
+    ap.add_argument("--sizes", default="100,300,1000,2000", help="point counts of the family table")
+    ap.add_argument("--instances", type=int, default=3, help="point sets per family table cell")
+    ap.add_argument("--part", choices=("all", "tshix", "tsp"), default="all")
+    ap.add_argument("--lkh-cache", help="JSON file keeping LKH's results (family table)")
+    ap.add_argument("--only-lkh", action="store_true", help="only fill the LKH cache")
     args = ap.parse_args()
     open_tour(np.random.default_rng(0).uniform(size=(20, 2)))  # compile the kernel first
-    print("TSHIX wall time (median of", args.repeats, "runs), tour length vs LKH (elkai, RUNS=1)")
+    if args.part != "tsp":
+        tshix_speed(args.repeats, args.seed)
+    if args.part != "tshix":
+        sizes = [int(v) for v in args.sizes.split(",")]
+        families(args.seed, sizes, args.instances, args.lkh_cache, args.only_lkh)
+
+
+def tshix_speed(repeats: int, seed: int) -> None:
+    """TSHIX planning time and tour length vs LKH; ergodic trajectories of the same length."""
+    print("TSHIX wall time (median of", repeats, "runs), tour length vs LKH (elkai, RUNS=1)")
     print(
         f"{'dims':>6} {'N':>4} {'TSHIX [ms]':>11} {'TSP ours [ms]':>14} {'LKH [ms]':>9} "
         f"{'ratio med':>9} {'ratio max':>9}"
@@ -52,8 +68,8 @@ def main() -> None:
         w = metric_weights(dims, planner.length_scale)
         for n in (100, 200, 300, 400, 500):
             t_plan, t_ours, t_lkh, ratios = [], [], [], []
-            for r in range(args.repeats):
-                rng = np.random.default_rng(args.seed + r)
+            for r in range(repeats):
+                rng = np.random.default_rng(seed + r)
                 t0 = time.perf_counter()
                 tr = planner.plan(n, rng)
                 t_plan.append(time.perf_counter() - t0)
@@ -76,7 +92,7 @@ def main() -> None:
         expl = _expl(dims)
         length = tr.path_length(ls)
         times = []
-        for _ in range(args.repeats):
+        for _ in range(repeats):
             t0 = time.perf_counter()
             erg = ergodic_trajectory(expl, speed=0.01, length=length, length_scale=ls)
             times.append(time.perf_counter() - t0)
@@ -91,10 +107,9 @@ def main() -> None:
             f"(length {opt.path_length(ls):.3f} m)"
         )
 
-    families(args.seed, [int(v) for v in args.sizes.split(",")])
-
 
 def _points(family: str, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Points in a 40 mm square (m): uniform, Gaussian (10 mm) or 8 clusters (2 mm spread)."""
     if family == "uniform":
         return rng.uniform(-0.02, 0.02, (n, 2))
     if family == "gaussian":
@@ -103,22 +118,71 @@ def _points(family: str, n: int, rng: np.random.Generator) -> np.ndarray:
     return centres[rng.integers(0, 8, n)] + rng.normal(0.0, 0.002, (n, 2))
 
 
-def families(seed: int, sizes: list[int]) -> None:
-    """Open tours on uniform, Gaussian and clustered points: ours vs LKH-3 (elkai, RUNS=1)."""
-    print("\nOpen tour on three point families (CPU ms; length / LKH length)")
-    print(f"{'family':>10} {'N':>5} {'ours [ms]':>10} {'LKH [ms]':>9} {'ratio':>7}")
-    for family in ("uniform", "gaussian", "clustered"):
-        for n in sizes:
-            pts = _points(family, n, np.random.default_rng(seed + n))
-            t0 = time.process_time()
-            ours = open_tour(pts)
-            t_ours = time.process_time() - t0
-            t0 = time.process_time()
-            ref = open_tour(pts, solver="lkh")
-            t_lkh = time.process_time() - t0
+def _lkh_cached(cache_file: str | None, key: str, pts: np.ndarray) -> tuple[float, float]:
+    """LKH-3 length and CPU seconds of one instance, read from / added to ``cache_file``.
+
+    LKH (RUNS=1) is deterministic and takes minutes at 2000 points: its results are kept in a
+    JSON file (merged on write, so two runs may share it)."""
+    cache = {}
+    if cache_file and os.path.exists(cache_file):
+        with open(cache_file) as f:
+            cache = json.load(f)
+    if key in cache:
+        return tuple(cache[key])
+    t0 = time.process_time()
+    length = open_tour(pts, solver="lkh").length
+    cpu = time.process_time() - t0
+    if cache_file:
+        if os.path.exists(cache_file):
+            with open(cache_file) as f:
+                cache = json.load(f)
+        cache[key] = (length, cpu)
+        tmp = cache_file + ".tmp"
+        with open(tmp, "w") as f:
+            json.dump(cache, f, indent=0)
+        os.replace(tmp, cache_file)
+    return length, cpu
+
+
+def families(
+    seed: int,
+    sizes: list[int],
+    instances: int = 3,
+    lkh_cache: str | None = None,
+    only_lkh: bool = False,
+) -> None:
+    """Open tours on uniform, Gaussian and clustered points: ours vs LKH-3 (elkai, RUNS=1).
+
+    Per cell, ``instances`` seeded point sets (seed ``(seed, i, n)``); prints the median and
+    max of our length / LKH's and the medians of both CPU times (ours: the least of three
+    calls on each instance, which a loaded machine disturbs least)."""
+    print(f"\nOpen tour on three point families ({instances} instances; CPU ms; length / LKH)")
+    print(
+        f"{'family':>10} {'N':>5} {'ours [ms]':>10} {'LKH [s]':>8} {'ratio med':>9} "
+        f"{'ratio max':>9}"
+    )
+    for n in sizes:
+        for family in ("uniform", "gaussian", "clustered"):
+            t_ours, t_lkh, ratios = [], [], []
+            for i in range(instances):
+                pts = _points(family, n, np.random.default_rng((seed, i, n)))
+                ref, cpu = _lkh_cached(lkh_cache, f"{family}/{n}/{seed}/{i}", pts)
+                t_lkh.append(cpu)
+                if only_lkh:
+                    continue
+                cpu = []
+                for _ in range(3):  # the same tour each time: the least CPU time of three
+                    t0 = time.process_time()
+                    ours = open_tour(pts)
+                    cpu.append(time.process_time() - t0)
+                t_ours.append(min(cpu))
+                ratios.append(ours.length / ref)
+            if only_lkh:
+                print(f"{family:>10} {n:>5} {'':>10} {np.median(t_lkh):>8.1f}", flush=True)
+                continue
             print(
-                f"{family:>10} {n:>5} {1e3 * t_ours:>10.1f} {1e3 * t_lkh:>9.0f} "
-                f"{ours.length / ref.length:>7.4f}",
+                f"{family:>10} {n:>5} {1e3 * np.median(t_ours):>10.1f} "
+                f"{np.median(t_lkh):>8.1f} {np.median(ratios):>9.4f} {np.max(ratios):>9.4f}",
                 flush=True,
             )
 

@@ -46,7 +46,7 @@ def test_close_to_lkh_on_gaussian_samples(dim):
     r = open_tour(pts, rng=np.random.default_rng(0))
     assert sorted(r.order.tolist()) == list(range(300))
     ref = open_tour(pts, solver="lkh")
-    assert r.length <= 1.02 * ref.length
+    assert r.length <= 1.015 * ref.length  # single instances; the <= 1.01 goal is a median
     # the solver's speed is a benchmark figure (benchmarks/search_speed.py), not a test
 
 
@@ -70,3 +70,39 @@ def test_seeded_and_bad_input():
             open_tour(bad)
     with pytest.raises(PlanningError):
         open_tour(pts, solver="ga")
+
+
+def test_clustered_points_close_to_lkh():
+    # 8 tight clusters: the order of the clusters is the hard part (Delaunay candidates and
+    # double bridges of any length); the tour is the same on every call
+    rng = np.random.default_rng(5)
+    centres = rng.uniform(-0.02, 0.02, (8, 2))
+    pts = centres[rng.integers(0, 8, 200)] + rng.normal(0.0, 0.002, (200, 2))
+    a, b = open_tour(pts), open_tour(pts)
+    np.testing.assert_array_equal(a.order, b.order)
+    assert sorted(a.order.tolist()) == list(range(200))
+    assert a.length <= 1.025 * open_tour(pts, solver="lkh").length  # 1.018 measured
+
+
+def test_duplicate_points_fall_back_and_stay_valid():
+    # repeated points make qhull's triangulation degenerate; 1-D points have none at all
+    base = np.random.default_rng(1).uniform(size=(20, 2))
+    pts = np.vstack([base, base, base[:5]])
+    r = open_tour(pts)
+    assert sorted(r.order.tolist()) == list(range(len(pts)))
+    assert r.length == pytest.approx(open_tour(base).length, rel=0.05)
+    line = np.random.default_rng(2).uniform(0, 1, (30, 1))
+    assert open_tour(line).length == pytest.approx(line.max())  # sweep out from 0
+
+
+def test_lin_kernighan_chains_keep_a_valid_near_optimal_tour(monkeypatch):
+    # the chains run above tsp._LK_FROM points; lowered here to keep the instance small
+    import teachfit.trajectories.tsp as tsp
+
+    monkeypatch.setattr(tsp, "_LK_FROM", 50)
+    pts = np.random.default_rng(7).uniform(-1, 1, size=(150, 3))
+    a, b = open_tour(pts), open_tour(pts)
+    np.testing.assert_array_equal(a.order, b.order)
+    assert sorted(a.order.tolist()) == list(range(150))
+    assert a.length == pytest.approx(path_length(np.zeros(3), pts, a.order))
+    assert a.length <= 1.02 * open_tour(pts, solver="lkh").length

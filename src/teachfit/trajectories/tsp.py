@@ -5,10 +5,10 @@ zero distance from every node and the edge ``(dummy, start)`` may never be remov
 tour ``start → p_1 → … → p_N → dummy → start`` then costs exactly the open path.
 
 ``solver="fast"`` (default): nearest-neighbour construction, then the compiled local search
-of :mod:`teachfit.trajectories.tsp_kernel` (2-opt and Or-opt over nearest and quadrant
-neighbours from ``scipy.spatial.cKDTree``, then a fixed number of seeded double-bridge kicks;
-why it is written here is said there). ``solver="lkh"`` calls LKH-3 through ``elkai`` (slow,
-the reference quality of the benchmark).
+of :mod:`teachfit.trajectories.tsp_kernel` (2-opt, Or-opt and Lin-Kernighan chains over the
+nearest and Delaunay neighbours from ``scipy.spatial``, then a fixed number of seeded
+double-bridge kicks; why it is written here is said there). ``solver="lkh"`` calls LKH-3
+through ``elkai`` (slow, the reference quality of the benchmark).
 
 Distances are Euclidean after scaling each coordinate by ``weights`` (e.g. ``(1, 1, ℓ)`` to
 count a rotation about z as ℓ metres per radian).
@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy.spatial import cKDTree
+from scipy.spatial import Delaunay, QhullError, cKDTree
 from scipy.spatial.distance import cdist
 
 from teachfit.core.errors import PlanningError
@@ -49,21 +49,6 @@ def path_length(start: np.ndarray, points: np.ndarray, order: np.ndarray, weight
     return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 
-def _nearest_neighbour(x: np.ndarray) -> list[int]:
-    """Greedy path from node 0 always to the nearest unvisited node."""
-    n = x.shape[0]
-    left = np.ones(n, dtype=bool)
-    left[0] = False
-    order, cur = [0], 0
-    for _ in range(n - 1):
-        dd = np.einsum("ij,ij->i", x - x[cur], x - x[cur])
-        dd[~left] = np.inf
-        cur = int(np.argmin(dd))
-        left[cur] = False
-        order.append(cur)
-    return order
-
-
 def _quadrant_neighbours(x: np.ndarray, k: int, per_quadrant: int = 2) -> np.ndarray:
     """Candidate lists, shape (n, W): the ``k`` nearest nodes plus the ``per_quadrant`` nearest
     in each quadrant of the first two coordinates (among the 40 nearest), nearest first, padded
@@ -79,7 +64,8 @@ def _quadrant_neighbours(x: np.ndarray, k: int, per_quadrant: int = 2) -> np.nda
     keep[np.arange(n), first_own] = ~own[np.arange(n), first_own]
     keep[np.arange(n), -1] &= own.any(axis=1)  # rows without self: drop the farthest instead
     idx = idx[keep].reshape(n, q)
-    d = x[idx, :2] - x[:, None, :2]
+    xy = x[:, :2] if x.shape[1] >= 2 else np.column_stack([x, np.zeros(n)])
+    d = xy[idx] - xy[:, None]
     quad = (d[..., 0] >= 0).astype(int) + 2 * (d[..., 1] >= 0).astype(int)
     mask = np.zeros_like(idx, dtype=bool)
     mask[:, :k] = True
@@ -94,10 +80,36 @@ def _quadrant_neighbours(x: np.ndarray, k: int, per_quadrant: int = 2) -> np.nda
     return np.where(col < count[:, None], out, last).astype(np.int64)
 
 
+def _candidates(x: np.ndarray, k: int, width: int = 10) -> np.ndarray:
+    """Candidate lists, shape (n, W <= width): the ``k`` nearest nodes and the Delaunay
+    neighbours (2-D and 3-D points), nearest first, padded by repeating the last.
+
+    Delaunay edges hold nearly all edges of an optimal tour, including the long ones between
+    clusters that no short nearest-neighbour list reaches; degenerate point sets (qhull
+    fails) and other dimensions fall back to :func:`_quadrant_neighbours`."""
+    from teachfit.trajectories.tsp_moves import merge_candidates
+
+    n, dim = x.shape
+    if dim not in (2, 3) or n <= dim + 1:
+        return _quadrant_neighbours(x, k)
+    try:
+        tri = Delaunay(x)
+    except QhullError:
+        return _quadrant_neighbours(x, k)
+    indptr, indices = tri.vertex_neighbor_vertices
+    _, near = cKDTree(x).query(x, k=min(k, n - 1) + 1)
+    width = min(width, n - 1)
+    return merge_candidates(x, np.atleast_2d(near).astype(np.int64), indptr, indices, width)
+
+
 # kick size and acceptance of the iterated local search (measured in
 # benchmarks/search_speed.py: larger windows and a little threshold accepting win)
-_WINDOW = 50
+_WINDOW = 1 << 30  # segments of any length (clusters move as a whole)
 _THRESHOLD = 0.1  # of the mean nearest-neighbour edge
+_DEPTH, _BREADTH = 3, 1  # Lin-Kernighan chain: flips at most, alternatives at its first step
+# up to this many points the chain is off and the kicks are 5 N: as close to LKH as 3 N kicks
+# with chains, in half the time (300 points, benchmarks/search_speed.py)
+_LK_FROM = 300
 
 
 def _compiled(
@@ -105,17 +117,35 @@ def _compiled(
 ) -> list[int]:
     """Nearest-neighbour path improved by :func:`teachfit.trajectories.tsp_kernel.improve_tour`."""
     from teachfit.trajectories.tsp_kernel import improve_tour
+    from teachfit.trajectories.tsp_moves import nearest_neighbour_path
 
     n = x.shape[0]  # node 0 = start, 1..n-1 = points; dummy = n
-    neigh = _quadrant_neighbours(x, n_neighbours)
-    tour = np.array(_nearest_neighbour(x) + [n], dtype=np.int64)
+    neigh = _candidates(x, n_neighbours)
+    tour = np.append(nearest_neighbour_path(x, neigh), n)
     draws = rng.integers(0, 1 << 30, size=(n_kicks, 3), dtype=np.int64)
     scale = float(np.ptp(x, axis=0).max()) or 1.0
     d0 = np.linalg.norm(np.diff(x[tour[:-1]], axis=0), axis=1).mean()
     out = improve_tour(
-        np.ascontiguousarray(x), neigh, tour, draws, _WINDOW, 1e-12 * scale, _THRESHOLD * d0
+        np.ascontiguousarray(x),
+        neigh,
+        tour,
+        draws,
+        _WINDOW,
+        1e-12 * scale,
+        _THRESHOLD * d0,
+        _DEPTH if x.shape[0] - 1 > _LK_FROM else 0,
+        _BREADTH,
     )
     return [int(v) for v in out]
+
+
+def _default_kicks(n: int) -> int:
+    """Kicks of the iterated local search: 5 N up to 300 points (≈ 20-30 ms, no LK chains),
+    then 3 N (N / 300)^0.75 (measured in benchmarks/search_speed.py: larger sets need more kicks
+    per point to stay within 1 % of LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
+    if n <= _LK_FROM:
+        return 5 * n
+    return int(round(3 * n * (n / _LK_FROM) ** 0.75))
 
 
 def _lkh(x: np.ndarray, runs: int) -> list[int]:
@@ -161,7 +191,8 @@ def open_tour(
     n_neighbours : int
         Candidate-list size K of the local search.
     n_kicks : int, optional
-        Iterated-local-search kicks; default ``4 N`` (≈ 20 ms for N = 300). A fixed count,
+        Iterated-local-search kicks; default ``5 N`` up to 300 points (≈ 20-30 ms CPU for
+        N = 300), ``3 N (N / 300)^0.75`` beyond. A fixed count,
         not a time budget: the same input gives the same tour on every machine.
     lkh_runs : int
         LKH ``RUNS`` parameter.
@@ -189,7 +220,7 @@ def open_tour(
     else:
         if solver == "fast":
             rng = np.random.default_rng(0) if rng is None else rng
-            kicks = 4 * n if n_kicks is None else int(n_kicks)
+            kicks = _default_kicks(n) if n_kicks is None else int(n_kicks)
             tour = _compiled(x, rng, n_neighbours, kicks)
         elif solver == "lkh":
             tour = _lkh(x, lkh_runs)

@@ -1,10 +1,13 @@
-"""Compiled local search of the open-tour solver (numba): 2-opt, Or-opt and local kicks.
+"""Compiled local search of the open-tour solver (numba): 2-opt, Or-opt, Lin-Kernighan chains
+and segment-swap kicks.
 
 Why written here: the maintained packages miss one of the three things TSHIX needs. LKH-3
 (``elkai``) is 20-40x over the time budget (0.7 s for 300 points); ``fast-tsp`` stops on a
 wall-clock budget, so its tours change with the machine's load (the same seed must give the
-same tour); OR-Tools' guided local search is also time-bounded. This kernel runs a fixed,
-seeded number of moves: the same input gives the same tour on every machine.
+same tour) and it has no iteration-count mode; OR-Tools' guided local search with a solution
+limit is deterministic but was 1.05-1.24 x LKH in 25-500 ms (measured on the 300-point sets of
+``benchmarks/search_speed.py``). This kernel runs a fixed, seeded number of moves: the same
+input gives the same tour on every machine.
 
 The tour is a path ``tour[0] = start, ..., tour[M-1] = dummy`` over ``M = N + 2`` nodes (node 0
 the start, nodes ``1..N`` the points, node ``M-1`` a dummy at distance 0 from every node), both
@@ -15,10 +18,16 @@ points costs exactly the open tour. Moves (all in O(segment) time on arrays):
   ``(t_lo, t_hi), (t_lo+1, t_hi+1)``;
 - **Or-opt**: move a segment of 1-3 nodes between two neighbours elsewhere, either way round
   (done by two or three reversals);
+- **Lin-Kernighan chain** (when neither improves): a sequence of up to ``depth`` 2-opt flips
+  that keep ``t1`` fixed, each adding an edge from the last free end to a candidate
+  neighbour, the partial gain kept positive; the chain is cut at its best closed gain. At the
+  dummy (the free end of the open tour) the chain may break the longest edge of the tour.
 
-both restricted to K nearest neighbours with don't-look bits. Then **iterated local search**:
-a local double bridge (two adjacent segments of at most ``window`` nodes swapped), local
-search from its six end nodes, kept only if the tour got shorter.
+all restricted to candidate lists (nearest and Delaunay neighbours) with don't-look bits
+(a queue of nodes to look at). Then **iterated local search**: a double bridge (two adjacent
+segments of any length swapped, ``A B C D -> A C B D``; whole clusters of points move), local
+search from its six end nodes, kept when at most ``threshold`` longer (threshold accepting);
+the shortest tour seen is returned.
 """
 
 from __future__ import annotations
@@ -26,48 +35,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-
-@njit(cache=True)
-def _d(x: np.ndarray, a: int, b: int, dummy: int) -> float:
-    if a == dummy or b == dummy:
-        return 0.0
-    s = 0.0
-    for k in range(x.shape[1]):
-        t = x[a, k] - x[b, k]
-        s += t * t
-    return np.sqrt(s)
-
-
-@njit(cache=True)
-def _reverse(tour: np.ndarray, pos: np.ndarray, i: int, j: int) -> None:
-    """Reverse ``tour[i..j]`` in place and keep ``pos`` (node -> index) in step."""
-    while i < j:
-        a, b = tour[i], tour[j]
-        tour[i], tour[j] = b, a
-        pos[b], pos[a] = i, j
-        i += 1
-        j -= 1
-
-
-@njit(cache=True)
-def _move_segment(
-    tour: np.ndarray, pos: np.ndarray, s: int, e: int, q: int, flip: bool
-) -> tuple[int, int]:
-    """Move ``tour[s..e]`` between ``tour[q]`` and ``tour[q+1]`` (``q`` outside ``s-1..e``),
-    reversed if ``flip``; returns the index range that changed."""
-    n_seg = e - s + 1
-    if q > e:  # A B -> B A, with B = tour[e+1..q]
-        _reverse(tour, pos, s, q)  # rev(B) rev(A)
-        _reverse(tour, pos, s, q - n_seg)  # B rev(A)
-        if not flip:
-            _reverse(tour, pos, q - n_seg + 1, q)  # B A
-        return s, q
-    # B A -> A B, with B = tour[q+1..s-1]
-    _reverse(tour, pos, q + 1, e)  # rev(A) rev(B)
-    _reverse(tour, pos, q + 1 + n_seg, e)  # rev(A) B
-    if not flip:
-        _reverse(tour, pos, q + 1, q + n_seg)  # A B
-    return q + 1, e
+from teachfit.trajectories.tsp_moves import _d, _lk_node, _move_segment, _reverse
 
 
 @njit(cache=True)
@@ -169,6 +137,8 @@ def _local_search(
     eps: float,
     queue: np.ndarray,
     inq: np.ndarray,
+    flips: np.ndarray,
+    breadth: int,
 ) -> float:
     """Local search from the nodes ``seeds`` until no move improves; returns the total gain."""
     head_tail = np.zeros(2, dtype=np.int64)
@@ -190,6 +160,18 @@ def _local_search(
                 if 0 <= k < tour.shape[0]:
                     _push(queue, inq, head_tail, tour[k])
             _push(queue, inq, head_tail, a)
+            continue
+        if flips.shape[0] == 0:
+            continue
+        delta, n_flips = _lk_node(x, neigh, tour, pos, a, eps, flips, breadth)
+        if delta > 0.0:
+            gain += delta
+            for r in range(n_flips):
+                lo, hi = flips[r, 0], flips[r, 1]
+                for k in (lo - 1, lo, hi, hi + 1):
+                    if 0 <= k < tour.shape[0]:
+                        _push(queue, inq, head_tail, tour[k])
+            _push(queue, inq, head_tail, a)
     return gain
 
 
@@ -202,6 +184,8 @@ def improve_tour(
     window: int,
     eps: float,
     threshold: float = 0.0,
+    depth: int = 6,
+    breadth: int = 3,
 ) -> np.ndarray:
     """Local search, then one kick per row of ``draws`` (three non-negative ints each).
 
@@ -224,8 +208,9 @@ def improve_tour(
         pos[tour[k]] = k
     queue = np.empty(m, dtype=np.int64)
     inq = np.zeros(m, dtype=np.bool_)
+    flips = np.zeros((depth, 2), dtype=np.int64)
     all_nodes = np.arange(m - 1)
-    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq)
+    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq, flips, breadth)
     inner = m - 2  # movable positions 1..m-2
     if inner < 4:
         return tour
@@ -258,7 +243,7 @@ def improve_tour(
         _move_segment(tour, pos, a, b_end, c_end, True)  # A B C D -> A C rev(B) D
         _reverse(tour, pos, c_end - lb + 1, c_end)  # -> A C B D
         ends[0], ends[1], ends[2], ends[3], ends[4], ends[5] = pa, na, b0, b1, c0, c1
-        gain = delta + _local_search(x, neigh, tour, pos, ends, eps, queue, inq)
+        gain = delta + _local_search(x, neigh, tour, pos, ends, eps, queue, inq, flips, breadth)
         if gain <= eps - threshold:  # longer than accepted: undo
             tour[:] = saved_tour
             pos[:] = saved_pos
