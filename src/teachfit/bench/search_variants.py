@@ -105,6 +105,7 @@ def run_variants(
     n_points: int | None = None,
     workers: int | None = None,
     progress: Progress = None,
+    ergodic: bool = True,
 ) -> list[VariantResult]:
     """:func:`run_variant` on ``n_variants`` grid points of ``task`` drawn with ``seed``."""
     if task not in PROTOCOLS:
@@ -112,7 +113,7 @@ def run_variants(
     if n_starts < 1:
         raise TeachfitError(f"number of starts must be >= 1, got {n_starts}")
     return [
-        run_variant(v, seed, n_starts, n_points, workers, progress)
+        run_variant(v, seed, n_starts, n_points, workers, progress, ergodic)
         for v in sample_variants(task, n_variants, seed)
     ]
 

@@ -91,6 +91,13 @@ def bench_search(
     plot: Annotated[
         Path, o.plot("with --variants, success against each variant parameter (one per task)")
     ] = Path("search_variants.png"),
+    ergodic: Annotated[
+        bool,
+        typer.Option(
+            help="with --variants, also run the ergodic baseline (--no-ergodic: TSHIX, the "
+            "goal's method, only: half the executions)"
+        ),
+    ] = True,
 ) -> None:
     """The search paper's experiments (Ehlers et al. 2019) in simulation, beside its numbers.
 
@@ -110,7 +117,7 @@ def bench_search(
         if names is None or task is not None:
             raise TeachfitError("--variants runs --table 1, 3 or all, and takes no --task")
         for name in names:
-            _variants(name, variants, seed, starts or 20, points, workers, markdown, plot)
+            _variants(name, variants, seed, starts or 20, points, workers, markdown, plot, ergodic)
         return
     if task is not None:
         _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
@@ -194,6 +201,7 @@ def _variants(
     workers: int | None,
     markdown: Path | None,
     figure: Path,
+    ergodic: bool = True,
 ) -> None:
     from matplotlib.figure import Figure
 
@@ -204,9 +212,10 @@ def _variants(
     if figure.suffix.lower().lstrip(".") not in Figure().canvas.get_supported_filetypes():
         raise TeachfitError(f"cannot write figure {figure}: unknown image format; use .png")
     with progress_bar() as bar:
-        job = bar.add_task(f"{task} variants: TSHIX and ergodic", total=2 * n * starts)
+        what = "TSHIX and ergodic" if ergodic else "TSHIX"
+        job = bar.add_task(f"{task} variants: {what}", total=(1 + ergodic) * n * starts)
         results = sv.run_variants(
-            task, n, seed, starts, points, workers, progress=lambda: bar.advance(job)
+            task, n, seed, starts, points, workers, lambda: bar.advance(job), ergodic
         )
     protocol, default_points, demos = sv.PROTOCOLS[task]
     title = (
@@ -220,7 +229,8 @@ def _variants(
         by = {row.method: row.ours for row in r.rows}
         for m in ("tshix", "ergodic"):
             s = by.get(m)
-            cells.append(r.why[:60] if s is None else _rate(s.successes, s.trials, s.low, s.high))
+            why = r.why[:60] or "not run"
+            cells.append(why if s is None else _rate(s.successes, s.trials, s.low, s.high))
         lines.append(cells)
     table = Table(title=title)
     for col in cols:
