@@ -19,3 +19,11 @@ def test_one_variant_runs_tshix_and_ergodic_on_the_same_starts(tmp_path):
     assert data[0]["values"] == {"peg_diameter_mm": 20.0, "friction": 0.3}
     fig = success_by_parameter(data, "test", goal=0.9)
     assert len(fig.axes) == 2 and fig.axes[0].get_legend() is not None
+
+
+def test_without_ergodic_only_the_tshix_row_is_run():
+    v = Variant("peg2d", (("peg_diameter_mm", 20.0), ("friction", 0.3)), ())
+    ticks = []
+    res = run_variant(v, 0, 1, 8, 0, lambda: ticks.append(1), ergodic=False)  # a short tour
+    assert [r.method for r in res.rows] == ["tshix"] and len(ticks) == 1
+    assert res.rows[0].ours.trials == 1

@@ -39,12 +39,17 @@ def test_feedforward_from_the_dynamics_model(peg_model):
     traj = plan_search(model, "tshix", 30, np.random.default_rng(0))
     start = task.contact_pose([0.02, 0.0])
     sp = search_setpoints(traj, task, start, model)
-    expected = model.feedforward_along(traj.t, traj.states)
-    assert np.allclose(sp.wrench_ff[:, :2], expected)
+    gmr = model.feedforward_along(traj.t, traj.states)
+    ff = sp.wrench_ff[:, :2]
     assert np.allclose(sp.wrench_ff[:, 2:], 0.0)
     # the teacher pushed against friction: the action points along the motion on average
     vel = np.gradient(traj.states, traj.t, axis=0)
-    assert np.mean(np.sum(vel * expected, axis=1)) > 0
+    assert np.mean(np.sum(vel * gmr, axis=1)) > 0
+    # what is commanded is the GMR's force along the motion, never across or backwards
+    u = vel / np.linalg.norm(vel, axis=1, keepdims=True)
+    along = np.sum(gmr * u, axis=1)
+    assert np.allclose(ff, np.clip(along, 0, None)[:, None] * u)
+    assert np.allclose(ff[:, 0] * u[:, 1] - ff[:, 1] * u[:, 0], 0.0)
 
 
 def test_search_finds_the_hole_from_the_demo_start(peg_model):
@@ -86,3 +91,18 @@ def test_passes_append_resampled_tshix_passes(peg_model):
         plan_search(model, "ergodic", 40, np.random.default_rng(5), passes=2)
     with pytest.raises(TeachfitError, match="passes"):
         plan_search(model, "tshix", 40, np.random.default_rng(5), passes=0)
+
+
+def test_follower_config_from_the_task():
+    from teachfit.execution.search import task_follow_config
+    from teachfit.skills.follow import FollowConfig
+
+    base = FollowConfig()
+    cfg = task_follow_config(get_task("peg2d"))
+    assert (cfg.stiffness_along, cfg.stiffness_across) == (1500.0, 150.0)
+    assert cfg.hold_depth == pytest.approx(0.001) and cfg.hold_stiffness == 150.0
+    slick = task_follow_config(get_task("peg2d", friction=0.8))  # same lag as at 0.3
+    assert slick.stiffness_along * 0.3 == pytest.approx(base.stiffness_along * 0.8)
+    assert slick.hold_stiffness == slick.stiffness_across == pytest.approx(400.0)
+    socket = task_follow_config(get_task("socket3d"))  # no hints: the defaults
+    assert socket == base

@@ -37,3 +37,23 @@ def test_a_light_felt_press_is_pushed_harder_slowly_and_bounded():
 
 def test_no_correction_out_of_contact():
     assert np.all(_pushes(0.3, 0.5) == 6.0)  # over a hole or in the air: the plain push
+
+
+def test_once_held_the_lateral_stiffness_is_the_hold_stiffness_every_way():
+    t = np.array([0.0, 10.0])
+    pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    traj = SetpointTrajectory.from_path(t, pos, np.tile([1.0, 0, 0, 0], (2, 1)))
+    cfg = FollowConfig(hold_depth=0.001, hold_stiffness=200.0)
+    run = FollowSetpoints(traj, cfg).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    cmd = MPCommand()
+    run.command(pc, cmd)  # sliding: stiff along x, soft across
+    assert cmd.stiffness_full[0, 0] == 1500.0 and cmd.stiffness_full[1, 1] == 150.0
+    pc.p[:] = (0.003, 0.0005, -0.0012)  # sank 1.2 mm: held where it is, relaxed sideways
+    cmd = MPCommand()
+    run.command(pc, cmd)
+    assert np.allclose(pc.p_d[:2], (0.003, 0.0005)) and np.all(cmd.twist[:2] == 0.0)
+    assert np.allclose(cmd.stiffness_full[:2, :2], 200.0 * np.eye(2))
+    with pytest.raises(Exception, match="hold_stiffness"):
+        FollowConfig(hold_stiffness=-1.0)

@@ -86,3 +86,15 @@ def test_friction_parameter_reaches_the_scene():
 
     xml = build_scene(get_task("peg2d", friction=0.7))
     assert 'friction="0.7 ' in xml and 'friction="0.3 ' not in xml
+
+
+def test_search_follower_hints_follow_friction_and_chamfers():
+    default = get_task("peg2d")
+    assert default.stiffness_scale == 1.0  # the default cell's follower is unchanged
+    assert get_task("peg2d", friction=0.2).stiffness_scale == 1.0
+    assert get_task("peg2d", friction=0.8).stiffness_scale == pytest.approx(0.8 / 0.3)
+    # the hold comes once the tip is below the hole's chamfer: short of the chamfers' depth
+    assert default.search_hold_depth == pytest.approx(0.001)
+    assert default.search_hold_depth < default.hold_depth
+    sharp = get_task("peg2d", peg_chamfer=0.0, hole_chamfer=0.0)
+    assert sharp.search_hold_depth == pytest.approx(0.0005)

@@ -52,7 +52,9 @@ class FollowConfig:
     below its height on entering the node (the part dropped into the hole), the x-y set-point
     stays where the part is and only the push goes on, as a person who feels the part drop
     stops moving it sideways (dragged on, a part caught in a hole with high friction wedges
-    instead of sliding in).
+    instead of sliding in). ``hold_stiffness`` (N/m, None: unchanged): the lateral stiffness,
+    the same in every x-y direction, once held, so that the chamfers can centre the pressed
+    part (a hand that felt the drop also relaxes sideways).
     """
 
     stiffness_along: float = 1500.0
@@ -66,6 +68,7 @@ class FollowConfig:
     anchor: str = "frame"
     press_feel: float = 0.0
     hold_depth: float | None = None
+    hold_stiffness: float | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -84,6 +87,10 @@ class FollowConfig:
             math.isfinite(self.hold_depth) and self.hold_depth > 0
         ):
             raise SkillError(f"follow: hold_depth must be > 0, got {self.hold_depth}")
+        if self.hold_stiffness is not None and not (
+            math.isfinite(self.hold_stiffness) and self.hold_stiffness >= 0
+        ):
+            raise SkillError(f"follow: hold_stiffness must be >= 0, got {self.hold_stiffness}")
         if self.anchor not in ("frame", "entry"):
             raise SkillError(f"follow: anchor must be 'frame' or 'entry', got {self.anchor!r}")
 
@@ -154,7 +161,13 @@ class _FollowRun(PrimitiveRun):
                 pc.p_d[:2] = self.hold
                 out.twist[:2] = 0.0
                 out.wrench[:2] = 0.0
-        if cfg.aligned:
+        if self.hold is not None and cfg.hold_stiffness is not None:
+            k = cfg.hold_stiffness
+            out.stiffness_full[:] = aligned_stiffness(
+                self.direction, k, k, cfg.stiffness_z, self.rot_k
+            )
+            out.full = True
+        elif cfg.aligned:
             out.stiffness_full[:] = aligned_stiffness(
                 self.direction, cfg.stiffness_along, cfg.stiffness_across, cfg.stiffness_z,
                 self.rot_k,

@@ -108,6 +108,27 @@ class Peg2D(Task):
         """Sinking (m) that means the peg is in the bore: both chamfers' depth plus 0.5 mm."""
         return self.params.peg_chamfer + self.params.hole_chamfer + 0.0005
 
+    @property
+    def search_hold_depth(self) -> float:
+        """Sinking (m) at which a search executor stops moving the peg sideways: the hole's
+        chamfer plus 0.5 mm. The peg's flat tip (radius ``r - peg_chamfer``) only gets below
+        the hole's chamfer inside the bore, i.e. within ``clearance / 2 + peg_chamfer`` of
+        the axis, where pressed down with a soft hand its own chamfer centres it; dragged on
+        from there at high friction it wedges on the bore's edge at the chamfers' depth
+        (1.5 mm by default, short of :attr:`hold_depth`)."""
+        return self.params.hole_chamfer + 0.0005
+
+    @property
+    def stiffness_scale(self) -> float:
+        """Factor (>= 1) on a follower's lateral stiffness that keeps the sliding peg's lag
+        behind its set-point what it is at the default friction: the lag is ``friction *
+        load / stiffness``, so the stiffness grows with the friction above the default's
+        (0.8: x 2.67; with a 6 N push along the motion 1.2 mm instead of 3.2 mm at 1500 N/m,
+        across it 12 mm instead of 32 mm at 150 N/m; at or below the default friction: 1, the
+        default cell's follower unchanged). Too soft a follower on a
+        high-friction top cuts a tour's turns by the lag and misses holes the plan crosses."""
+        return max(1.0, self.params.friction / DEFAULT_FRICTION)
+
     def teacher_hints(self) -> dict[str, float]:
         """The blind teacher's sweep scaled to this cell (m, s; TeacherStyle fields).
 
