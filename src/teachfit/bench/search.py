@@ -327,10 +327,12 @@ def table3(
     starts = task.protocol.protocol_starts("table3", n_starts, np.random.default_rng(seed + 1))
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
 
+    planned = cache(lambda: _planned_tshix(two, n_points, seeds))  # planned once for both rows
+
     def sized(method: str) -> list[SearchJob]:
         """The random walk of the mean TSHIX (2 demos) x-y length, or the ergodic trajectory
         of its weighted length."""
-        length, xy = _planned_tshix(two, n_points, seeds)
+        length, xy = planned()
         if method == "random-walk":
             steps = max(1, int(xy / 0.003))  # random-walk moves average 3 mm: equal x-y length
             return _jobs("socket3d", {}, two, starts, "random-walk", steps, seeds)
