@@ -36,6 +36,7 @@ import numpy as np
 from teachfit.tasks.geometry.prism_hole import PrismHoleParams, PrismHoleTask
 from teachfit.tasks.params import doc_field
 from teachfit.tasks.scene.prism_hole import KeyScene
+from teachfit.tasks.scene.prisms import rectangle
 
 
 @dataclass(frozen=True)
@@ -63,6 +64,17 @@ class KeyParams(PrismHoleParams):
     slot_chamfer: float = doc_field(
         "45-degree chamfer on the slot's entry edges (m)", 0.0008, at_least=0
     )
+    ward_depth: float = doc_field(
+        "depth of the keyway's two wards into the slot, = the blade's grooves (m; 0: plain slot)",
+        0.0005,
+        at_least=0,
+    )
+    ward_chamfer: float = doc_field(
+        "45-degree chamfer on the wards' slot-facing edges (m)", 0.0, at_least=0
+    )
+    profile_middle: float = doc_field(
+        "width of the blade's full-thickness middle between its two grooves (m)", 0.002, above=0
+    )
     bow_width: float = doc_field("width of the key bow above the blade (m)", 0.020, above=0)
     bow_thickness: float = doc_field("thickness of the bow (m)", 0.003, above=0)
     bow_height: float = doc_field("height of the bow (m)", 0.015, above=0)
@@ -74,6 +86,9 @@ class KeyParams(PrismHoleParams):
     hole_yaw_sigma: float = doc_field("std of the taught hole yaw (rad)", 0.0175, at_least=0)
     demo_offset: float = doc_field(
         "distance of the blind teacher's start from the hole (m)", 0.008, above=0
+    )
+    fixed_tilt: float = doc_field(
+        "the skill's initial tilt, fixed and not learned on the key (rad)", 0.1, at_least=0
     )
 
     def check(self) -> None:
@@ -89,6 +104,18 @@ class KeyParams(PrismHoleParams):
         self.require(
             self.blade_chamfer < self.blade_thickness / 2,
             "blade_chamfer must be smaller than half the blade thickness",
+        )
+        self.require(
+            self.ward_depth < self.blade_thickness / 2,
+            "ward_depth must be smaller than half the blade thickness (the grooved blade)",
+        )
+        self.require(
+            self.blade_chamfer < (self.blade_thickness - self.ward_depth) / 2,
+            "blade_chamfer must be smaller than half the grooved blade's thickness",
+        )
+        self.require(
+            self.profile_middle + self.clearance < self.blade_width - 2 * self.blade_chamfer,
+            "profile_middle leaves no groove (it must be well below blade_width)",
         )
         super().check()
         self.require(
@@ -128,9 +155,42 @@ class Key(PrismHoleTask):
     rz_period: ClassVar[float] = float(np.pi)
 
     @property
+    def skill_fixed(self) -> dict[str, float]:
+        """Learned skill parameters the key fixes: the initial tilt (seed B: "we omit the
+        learning of the initial alignment and set it to [x] rad")."""
+        return {"tilt": self.params.fixed_tilt}
+
+    @property
+    def skill_context(self) -> dict[str, float]:
+        """Context the key sets: the lateral move counts as constrained once the blade's
+        trailing rim is halfway down the lock face's entry chamfer, the edge it drops over (the
+        skill measures the TCP, the tip's centre, which the fixed tilt holds
+        ``blade_width / 2 * sin(fixed_tilt)`` above that rim). The skill's default (the TCP
+        1 mm down) lies below the chamfer: it needs the blade already in the wards."""
+        p = self.params
+        lift = p.blade_width / 2 * float(np.sin(p.fixed_tilt))
+        return {"drop_depth": p.slot_chamfer - lift}
+
+    @property
     def yaw_lever(self) -> float:
         p = self.params
         return p.blade_width + p.blade_thickness
+
+    def blade_pieces(self) -> list[tuple[str, np.ndarray]]:
+        """The blade's cross-section (TCP frame, m) as convex rectangles ``(name, (4, 2))``.
+
+        Plain (``ward_depth = 0``): one ``blade_width x blade_thickness`` rectangle. Warded: a
+        Z-shaped profile of two overlapping rectangles, its north face grooved ``ward_depth``
+        deep east of the ``profile_middle`` and its south face west of it, so that each groove
+        rides on one ward of the keyway.
+        """
+        p = self.params
+        hw, ht = p.blade_width / 2, p.blade_thickness / 2
+        if p.ward_depth == 0:
+            return [("key_blade", rectangle(hw, ht))]
+        m, w = p.profile_middle / 2, p.ward_depth
+        west = np.array([[m, ht], [-hw, ht], [-hw, -ht + w], [m, -ht + w]])
+        return [("key_blade_west", west), ("key_blade_east", -west)]
 
     @property
     def slot_half_size(self) -> tuple[float, float]:
