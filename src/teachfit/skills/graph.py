@@ -15,7 +15,6 @@ domain, or a primitive whose resolved values are invalid (e.g. a negative speed)
 
 from __future__ import annotations
 
-
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
