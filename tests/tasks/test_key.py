@@ -1,4 +1,4 @@
-"""The ``key`` task: a flat blade into a narrow chamfered slot."""
+"""The ``key`` task: a grooved blade into a narrow warded keyway."""
 
 from __future__ import annotations
 

@@ -1,10 +1,12 @@
-"""Scenes of the prism-hole cells: ``puzzle`` (a triangle) and ``key`` (a slot).
+"""Scenes of the prism-hole cells: ``puzzle`` (a triangle) and ``key`` (a warded slot).
 
 Both cut a convex polygonal hole into a square block (half side ``block_half_width``, top at
 ``block_height``, world z) turned by ``hole_yaw`` about world z. The hole is built from one
 convex piece per hole edge, the part of the block beyond that edge's line
 (:func:`~teachfit.tasks.scene.prisms.beyond_edge_block`, optionally chamfered), plus a box
-below the hole's bottom. The held part is a prism whose bottom-face centre is the TCP. Lengths
+below the hole's bottom, and any convex pieces standing in the hole (:meth:`PrismHoleScene.
+hole_wards`: the key's wards, :func:`~teachfit.tasks.scene.prisms.chamfered_block`). The held
+part is a prism (the key: two) whose bottom-face centre is the TCP. Lengths
 in metres, angles in radians, the fixture's body frame is the hole frame at the block's foot.
 """
 
@@ -98,7 +100,7 @@ class PuzzleScene(PrismHoleScene):
 
 
 class KeyScene(PrismHoleScene):
-    """``key``: a rectangular chamfered slot; a chamfered flat blade under a wider bow."""
+    """``key``: a rectangular chamfered slot with two wards; a grooved blade under a bow."""
 
     task: Key
 

@@ -1,4 +1,4 @@
-"""Convex prisms for polygonal holes and parts (triangle puzzle, key slot).
+"""Convex prisms for polygonal holes and parts (triangle puzzle, key slot and wards).
 
 MuJoCo collides a mesh as its convex hull, so a plate with a convex polygonal hole is built
 from one piece per hole edge: the part of the plate's square outline *beyond* that edge's line,
