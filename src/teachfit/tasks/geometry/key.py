@@ -28,8 +28,9 @@ How hard (issue 16, part 4), from the paper's words (Sec. V) and real keys:
 
 Random (Latin hypercube) parameters succeed in 25 % [17, 35] of 80 executions on the two
 set-ups of ``teachfit bench learning --random-rate 10 --tasks key --experiments 2`` and in
-43 % [37, 50] over six set-ups (the plain slot: 100 %); CMA-ES finds feasible parameters in its
-first trial (BENCHMARKS.md, seed B, session 7).
+41 % [37, 45] of 480 over twelve set-ups (the plain slot: 100 %); CMA-ES finds feasible
+parameters on 5 of 6 set-ups within 20 trials, on average by trial 1.4 (BENCHMARKS.md, seed B,
+session 7).
 
 Geometry (:mod:`teachfit.tasks.geometry.prism_hole`). The slot is a rectangle
 ``blade_width + clearance`` (along the hole frame's x) by ``blade_thickness + clearance``
