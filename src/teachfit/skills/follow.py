@@ -33,6 +33,7 @@ from teachfit.skills.graph import Node, Skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
+from teachfit.skills.tilt import LATERAL, TiltConfig, TiltState
 
 
 @dataclass(frozen=True)
@@ -54,7 +55,9 @@ class FollowConfig:
     stops moving it sideways (dragged on, a part caught in a hole with high friction wedges
     instead of sliding in). ``hold_stiffness`` (N/m, None: unchanged): the lateral stiffness,
     the same in every x-y direction, once held, so that the chamfers can centre the pressed
-    part (a hand that felt the drop also relaxes sideways).
+    part (a hand that felt the drop also relaxes sideways). ``tilt`` (None: upright): search
+    with the part tilted, and on the drop slide it to the hole's wall and align it upright
+    (:mod:`teachfit.skills.tilt`; its align phase is a hold, with ``hold_stiffness``).
     """
 
     stiffness_along: float = 1500.0
@@ -69,6 +72,7 @@ class FollowConfig:
     press_feel: float = 0.0
     hold_depth: float | None = None
     hold_stiffness: float | None = None
+    tilt: TiltConfig | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -127,6 +131,7 @@ class _FollowRun(PrimitiveRun):
         self.hold: np.ndarray | None = None  # x-y where the part dropped (hold_depth)
         self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
         self.press_correction = 0.0  # N, the felt-press loop's integral (press_feel > 0)
+        self.tilt = None if cfg.tilt is None else TiltState(cfg.tilt, traj.pos)
 
     def enter(self, pc: Percept) -> None:
         self.direction[:] = (1.0, 0.0)
@@ -135,6 +140,8 @@ class _FollowRun(PrimitiveRun):
         pc.done = False
         self.press_correction = 0.0
         self.z0, self.hold = float(pc.p[2]), None
+        if self.tilt is not None:
+            self.tilt.reset(self.z0)
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
@@ -154,7 +161,9 @@ class _FollowRun(PrimitiveRun):
                 lim = 0.5 * cfg.push_force
                 self.press_correction = min(lim, max(-lim, self.press_correction + step))
             out.wrench[2] -= self.press_correction
-        if cfg.hold_depth is not None:
+        if self.tilt is not None:
+            self._tilted(pc, out, quat)
+        elif cfg.hold_depth is not None:
             if self.hold is None and self.z0 - pc.p[2] >= cfg.hold_depth:
                 self.hold = pc.p[:2].copy()
             if self.hold is not None:
@@ -176,6 +185,21 @@ class _FollowRun(PrimitiveRun):
         else:
             out.stiffness[:] = self.diag
         pc.done = pc.t_node >= self.traj.duration
+
+    def _tilted(self, pc: Percept, out: MPCommand, quat: np.ndarray) -> None:
+        tilt = self.tilt
+        assert tilt is not None
+        if tilt.step(pc) and self.hold is None:
+            self.hold = pc.p[:2].copy()
+        tilt.orient(pc.q_d, quat, pc.t_node)
+        if tilt.phase == LATERAL:
+            self.direction[:] = tilt.d
+            tilt.lateral(pc, out.twist)
+            out.wrench[:2] = 0.0
+        elif self.hold is not None:
+            pc.p_d[:2] = self.hold
+            out.twist[:2] = 0.0
+            out.wrench[:2] = 0.0
 
 
 def follow_skill(

@@ -23,6 +23,10 @@ from teachfit.tasks.scene.round_hole import Peg2DScene
 #: at the default friction, which its default sweep suits (see Peg2D.teacher_hints)
 DEFAULT_PITCH, DEFAULT_HALFWIDTH, DEFAULT_FRICTION = 0.0025, 0.015, 0.3
 TEACHER_STIFFNESS, TEACHER_SPEED, TEACHER_LOAD = 600.0, 0.012, 7.0
+#: a search's tilt for sharp-edged holes (rad), and the capture half-width (m) below which it
+#: tilts: straight passes with Ø 8 mm, 0.2 mm, tilted 0.25 rad, drop in up to 2 mm off the
+#: axis (0.1 mm upright), so chamfered holes (>= 1.6 mm) are searched upright as before
+SEARCH_TILT, TILT_BELOW = 0.25, 0.001
 
 
 @dataclass(frozen=True)
@@ -128,6 +132,12 @@ class Peg2D(Task):
         default cell's follower unchanged). Too soft a follower on a
         high-friction top cuts a tour's turns by the lag and misses holes the plan crosses."""
         return max(1.0, self.params.friction / DEFAULT_FRICTION)
+
+    @property
+    def search_tilt(self) -> float:
+        """Tilt (rad) of a search executor's peg: :data:`SEARCH_TILT` where the upright
+        capture half-width is under :data:`TILT_BELOW` (sharp edges), else 0 (upright)."""
+        return SEARCH_TILT if self.capture_halfwidth < TILT_BELOW else 0.0
 
     def teacher_hints(self) -> dict[str, float]:
         """The blind teacher's sweep scaled to this cell (m, s; TeacherStyle fields).

@@ -1,0 +1,139 @@
+"""Searching with a tilted part: tilt, feel the drop, slide to the wall, align (seed B's
+``tilt``, ``lateral`` and ``align`` primitives inside a search follower).
+
+An upright sharp-edged peg drops into its hole only when its axis passes within the radial
+clearance of the hole's (0.1-0.25 mm in the peg2d variants). Tilted by ``angle`` about the
+horizontal axis z x d, its lowest point is one rim point, ``d`` (a fixed task-frame direction:
+by default from the trajectory's start toward its centroid, the part leaning toward where it
+searches) from the axis; that point drops as soon as it is over the hole, which it is for any axis
+position within about a hole radius of the point one peg radius behind the hole centre
+(millimetres, not tenths). :class:`TiltState` then runs three phases:
+
+1. *search*: the follower's set-points, the orientation tilted; the reference height is the
+   highest the TCP has been (the tilted part rests one ``r sin(angle)`` above the surface);
+2. *lateral*: once the TCP sank ``drop_depth`` below it, the x-y set-point moves from the
+   TCP along ``d`` at ``lateral_speed`` for at most ``lateral_reach`` (the hole's diameter):
+   the low rim slides across the hole until its far wall stops it (the TCP's speed along
+   ``d`` while the set-point runs ahead: it leads the TCP by ``stall_lag``);
+3. *align*: x-y held where the TCP is (the follower's soft hold stiffness), the tilt goes to
+   zero linearly over ``align_time`` while the push goes on: turning about the rim that
+   rests on the far wall, the part swings over the hole and slides in.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teachfit.core.errors import SkillError
+from teachfit.core.geometry import quat_mul_into
+from teachfit.skills.percept import Percept
+
+#: time (s) the lateral phase waits at its full reach before aligning anyway
+SETTLE = 0.5
+#: phases of a tilted search
+SEARCH, LATERAL, ALIGN = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class TiltConfig:
+    """A tilted search (rad, m, m/s, s): see the module docstring."""
+
+    angle: float = 0.15
+    direction: float | None = None
+    drop_depth: float = 5e-4
+    lateral_reach: float = 0.02
+    lateral_speed: float = 0.005
+    stall_lag: float = 0.003
+    align_time: float = 0.5
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.angle) and 0.0 < self.angle < 0.6):
+            raise SkillError(f"tilt: angle must be in (0, 0.6) rad, got {self.angle}")
+        if self.direction is not None and not math.isfinite(self.direction):
+            raise SkillError(f"tilt: direction must be finite, got {self.direction}")
+        for name in ("drop_depth", "lateral_reach", "lateral_speed", "stall_lag", "align_time"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise SkillError(f"tilt: {name} must be > 0, got {value}")
+
+    def unit(self, path: np.ndarray) -> np.ndarray:
+        """The tilt direction ``d`` (2,), task frame: the low rim's side; without a
+        ``direction``, from the first of the ``path`` points (N, >= 2; m) to their centroid
+        (+x if they are all one point)."""
+        if self.direction is not None:
+            return np.array([math.cos(self.direction), math.sin(self.direction)])
+        pts = np.asarray(path, dtype=float)[:, :2]
+        v = pts.mean(axis=0) - pts[0]
+        n = float(np.hypot(v[0], v[1]))
+        return v / n if n > 1e-9 else np.array([1.0, 0.0])
+
+
+def wedge_lag(angle: float, friction: float, load: float, stiffness: float) -> float:
+    """Twice the set-point lead (m) that slides a part tilted by ``angle`` (rad) across a
+    hole edge under its tip face: the edge pushes back along the face's normal, so moving on
+    takes ``load (tan(angle) + friction) / (1 - friction tan(angle))`` (N) at ``stiffness``
+    (N/m); twice that, and the part is blocked (the far wall), not sliding."""
+    tan = math.tan(angle)
+    denom = max(1e-3, 1.0 - friction * tan)
+    return 2.0 * load * (tan + friction) / denom / stiffness
+
+
+class TiltState:
+    """One tilted search's phase and the set-points it overrides (see the module docstring);
+    ``path`` (N, 3; m): the followed trajectory's positions, for the default direction."""
+
+    def __init__(self, cfg: TiltConfig, path: np.ndarray) -> None:
+        self.cfg, self.d = cfg, cfg.unit(path)
+        s = math.sin(0.5 * cfg.angle)  # about z x d = (-d_y, d_x, 0): lowers the +d rim
+        self.q_tilt = np.array([math.cos(0.5 * cfg.angle), -self.d[1] * s, self.d[0] * s, 0.0])
+        self.reset(0.0)
+
+    def reset(self, z: float) -> None:
+        self.phase, self.z_top, self.t0 = SEARCH, z, 0.0
+        self.origin = np.zeros(2)
+
+    def angle(self, t: float) -> float:
+        """The tilt (rad) at node time ``t``: full until aligning, then down to 0."""
+        if self.phase != ALIGN:
+            return self.cfg.angle
+        return self.cfg.angle * max(0.0, 1.0 - (t - self.t0) / self.cfg.align_time)
+
+    def orient(self, out: np.ndarray, quat: np.ndarray, t: float) -> None:
+        """``out`` = ``quat`` tilted by the phase's angle about z x d (world-side product)."""
+        a = self.angle(t)
+        if a >= self.cfg.angle:
+            quat_mul_into(out, self.q_tilt, quat)
+        elif a > 0.0:
+            s = math.sin(0.5 * a)
+            q = np.array([math.cos(0.5 * a), -self.d[1] * s, self.d[0] * s, 0.0])
+            quat_mul_into(out, q, quat)
+        else:
+            out[:] = quat
+
+    def step(self, pc: Percept) -> bool:
+        """Advance the phase from the measured TCP; True when it should hold x-y (align)."""
+        z, t = float(pc.p[2]), pc.t_node
+        if self.phase == SEARCH:
+            self.z_top = max(self.z_top, z)
+            if self.z_top - z >= self.cfg.drop_depth:
+                self.phase, self.t0 = LATERAL, t
+                lead = float(np.dot(pc.p_d[:2] - pc.p[:2], self.d))  # the spring's pull on
+                self.origin[:] = pc.p[:2] + max(0.0, lead) * self.d  # the part, kept
+        if self.phase == LATERAL:
+            s = min(self.cfg.lateral_reach, self.cfg.lateral_speed * (t - self.t0))
+            lead = s - float(np.dot(pc.p[:2] - self.origin, self.d))
+            stalled = lead > self.cfg.stall_lag
+            spent = t - self.t0 > self.cfg.lateral_reach / self.cfg.lateral_speed + SETTLE
+            if stalled or spent:
+                self.phase, self.t0 = ALIGN, t
+        return self.phase == ALIGN
+
+    def lateral(self, pc: Percept, twist: np.ndarray) -> None:
+        """In the lateral phase: the x-y set-point and velocity along ``d`` from the drop."""
+        cfg = self.cfg
+        s = min(cfg.lateral_reach, cfg.lateral_speed * (pc.t_node - self.t0))
+        pc.p_d[:2] = self.origin + s * self.d
+        twist[:2] = cfg.lateral_speed * self.d if s < cfg.lateral_reach else 0.0
