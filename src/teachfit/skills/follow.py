@@ -98,6 +98,12 @@ class FollowConfig:
         if self.anchor not in ("frame", "entry"):
             raise SkillError(f"follow: anchor must be 'frame' or 'entry', got {self.anchor!r}")
 
+    @property
+    def extra_time(self) -> float:
+        """Time (s) the follower may need past ``settle_time``: a tilted search's lateral
+        and align phases (0 upright)."""
+        return 0.0 if self.tilt is None else self.tilt.extra_time
+
 
 @dataclass(frozen=True)
 class FollowSetpoints(Primitive):
@@ -207,11 +213,12 @@ def follow_skill(
 ) -> Skill:
     """A one-node skill that follows ``trajectory`` until the task's detector fires.
 
-    Its error exits: the time budget ``duration + settle_time`` and the force limit; the
+    Its error exits: the time budget ``duration + settle_time`` (plus a tilted search's
+    ``extra_time``) and the force limit; the
     execution engine reports them as ``TIMEOUT`` and ``FORCE_LIMIT``.
     """
     cfg = config or FollowConfig()
-    horizon = trajectory.duration + cfg.settle_time
+    horizon = trajectory.duration + cfg.settle_time + cfg.extra_time
     error = Any_((TimeAbove(horizon), ForceAbove(cfg.max_force, axis="norm")))
     node = Node(name, FollowSetpoints(trajectory, cfg), error=error, doc=trajectory.name)
     return Skill(

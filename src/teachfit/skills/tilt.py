@@ -59,6 +59,12 @@ class TiltConfig:
             if not (math.isfinite(value) and value > 0):
                 raise SkillError(f"tilt: {name} must be > 0, got {value}")
 
+    @property
+    def extra_time(self) -> float:
+        """The longest the lateral and align phases take (s): a drop at the trajectory's end
+        still gets them before the time budget runs out."""
+        return self.lateral_reach / self.lateral_speed + SETTLE + self.align_time
+
     def unit(self, path: np.ndarray) -> np.ndarray:
         """The tilt direction ``d`` (2,), task frame: the low rim's side; without a
         ``direction``, from the first of the ``path`` points (N, >= 2; m) to their centroid
