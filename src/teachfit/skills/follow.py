@@ -33,7 +33,7 @@ from teachfit.skills.graph import Node, Skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
-from teachfit.skills.tilt import LATERAL, TiltConfig, TiltState
+from teachfit.skills.tilt import ALIGN, LATERAL, SEARCH, TiltConfig, TiltState
 
 
 @dataclass(frozen=True)
@@ -138,6 +138,9 @@ class _FollowRun(PrimitiveRun):
         self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
         self.press_correction = 0.0  # N, the felt-press loop's integral (press_feel > 0)
         self.tilt = None if cfg.tilt is None else TiltState(cfg.tilt, traj.pos)
+        self.paused = 0.0  # s of node time outside a tilted search's search phase
+        self.blend = np.zeros(2)  # m, x-y offset back to the trajectory after a retry
+        self.blend_t0, self.blend_time = 0.0, 0.0
 
     def enter(self, pc: Percept) -> None:
         self.direction[:] = (1.0, 0.0)
@@ -148,11 +151,15 @@ class _FollowRun(PrimitiveRun):
         self.z0, self.hold = float(pc.p[2]), None
         if self.tilt is not None:
             self.tilt.reset(self.z0)
+        self.paused, self.blend_time = 0.0, 0.0
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
-        pos, quat, vel, ff = self.traj.sample(pc.t_node)
+        t_traj = pc.t_node - self.paused
+        pos, quat, vel, ff = self.traj.sample(t_traj)
         pc.p_d[:] = pos + self.offset
+        if pc.t_node - self.blend_t0 < self.blend_time:
+            pc.p_d[:2] += self.blend * (1.0 - (pc.t_node - self.blend_t0) / self.blend_time)
         pc.q_d[:] = quat
         if math.hypot(vel[0], vel[1]) > 1e-6:
             self.direction[:] = vel[:2]
@@ -190,13 +197,22 @@ class _FollowRun(PrimitiveRun):
             out.full = True
         else:
             out.stiffness[:] = self.diag
-        pc.done = pc.t_node >= self.traj.duration
+        pc.done = t_traj >= self.traj.duration
 
     def _tilted(self, pc: Percept, out: MPCommand, quat: np.ndarray) -> None:
         tilt = self.tilt
         assert tilt is not None
+        before = tilt.phase
         if tilt.step(pc) and self.hold is None:
             self.hold = pc.p[:2].copy()
+        if tilt.phase != SEARCH:
+            self.paused += pc.dt
+        elif before == ALIGN:  # missed: back to the trajectory from where the part stands
+            self.hold = None
+            self.blend[:] = pc.p[:2] - pc.p_d[:2]
+            self.blend_t0 = pc.t_node
+            self.blend_time = max(0.2, float(np.hypot(*self.blend)) / tilt.cfg.lateral_speed)
+            pc.p_d[:2] = pc.p[:2]
         tilt.orient(pc.q_d, quat, pc.t_node)
         if tilt.phase == LATERAL:
             self.direction[:] = tilt.d
