@@ -65,8 +65,28 @@ def test_phases_tilt_drop_slide_to_the_wall_and_align():
     assert np.allclose(pc.p_d[:2], (0.0102, 0.0)) and np.all(cmd.twist[:2] == 0.0)
     assert wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.1)
     assert np.allclose(cmd.stiffness_full[:2, :2], 200.0 * np.eye(2))
-    _tick(run, pc, (0.0102, 0.0, -0.002), 2.2)
+    _tick(run, pc, (0.0102, 0.0, 0.0), 2.2)
     assert np.allclose(pc.q_d, (1.0, 0.0, 0.0, 0.0))  # upright
+    _tick(run, pc, (0.0102, 0.0, 0.0), 2.5)  # upright 0.4 s, not sinking: still waiting
+    assert state.phase == ALIGN
+    _tick(run, pc, (0.0102, 0.0, 0.0), 2.7)  # on the edge: missed, search on, tilted
+    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.2)
+    assert np.allclose(pc.p_d[:2], (0.0102, 0.0))  # from where the part stands ...
+    run.command(pc, MPCommand())  # ... back to the trajectory where it was left (t = 1 s)
+    assert run.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
+
+
+def test_no_drop_is_felt_while_the_part_still_tilts():
+    traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
+    run = FollowSetpoints(traj, FollowConfig(tilt=TiltConfig())).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    _tick(run, pc, (0.0, 0.0, 0.003), 0.05)  # bounced up while tilting
+    _tick(run, pc, (0.0, 0.0, 0.002), 0.25)
+    _tick(run, pc, (0.0, 0.0, 0.002), 0.35)  # settled 1 mm lower: not a drop
+    assert run.tilt.phase == SEARCH
+    _tick(run, pc, (0.0, 0.0, 0.0014), 0.5)
+    assert run.tilt.phase == LATERAL
 
 
 def test_state_reset_starts_a_new_search():

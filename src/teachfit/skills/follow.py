@@ -140,7 +140,7 @@ class _FollowRun(PrimitiveRun):
         self.tilt = None if cfg.tilt is None else TiltState(cfg.tilt, traj.pos)
         self.paused = 0.0  # s of node time outside a tilted search's search phase
         self.blend = np.zeros(2)  # m, x-y offset back to the trajectory after a retry
-        self.blend_t0, self.blend_time = 0.0, 0.0
+        self.blend_t0, self.blend_time, self.t_last = 0.0, 0.0, 0.0
 
     def enter(self, pc: Percept) -> None:
         self.direction[:] = (1.0, 0.0)
@@ -151,7 +151,7 @@ class _FollowRun(PrimitiveRun):
         self.z0, self.hold = float(pc.p[2]), None
         if self.tilt is not None:
             self.tilt.reset(self.z0)
-        self.paused, self.blend_time = 0.0, 0.0
+        self.paused, self.blend_time, self.t_last = 0.0, 0.0, 0.0
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
@@ -205,9 +205,10 @@ class _FollowRun(PrimitiveRun):
         before = tilt.phase
         if tilt.step(pc) and self.hold is None:
             self.hold = pc.p[:2].copy()
-        if tilt.phase != SEARCH:
-            self.paused += pc.dt
-        elif before == ALIGN:  # missed: back to the trajectory from where the part stands
+        elapsed, self.t_last = pc.t_node - self.t_last, pc.t_node
+        if before != SEARCH:  # the trajectory's clock stood still since the drop
+            self.paused += elapsed
+        if tilt.phase == SEARCH and before == ALIGN:  # missed: back to the trajectory
             self.hold = None
             self.blend[:] = pc.p[:2] - pc.p_d[:2]
             self.blend_t0 = pc.t_node
