@@ -206,14 +206,16 @@ def task_follow_config(task: Task) -> FollowConfig:
 
 def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
     """The tilted search where the task asks for one (``search_tilt`` > 0, rad; see
-    :mod:`teachfit.skills.tilt`): the low rim slides up to a hole diameter after the drop."""
+    :mod:`teachfit.skills.tilt`): the drop felt at half the upright hold depth (a tilted peg
+    rests steadily on a flat top; its drop is ~ tan(tilt) x how far the rim is past the edge),
+    the low rim slid up to a hole diameter after it."""
     angle = float(getattr(task, "search_tilt", 0.0))
     if angle <= 0.0:
         return None
     p = task.params
     return TiltConfig(
         angle=angle,
-        drop_depth=float(task.search_hold_depth),
+        drop_depth=0.5 * float(task.search_hold_depth),
         lateral_reach=p.peg_diameter + p.clearance,
         stall_lag=wedge_lag(angle, p.friction, load, stiffness),
     )

@@ -77,6 +77,8 @@ class TeacherStyle:
     #: tilt of the held part (rad, 0: upright): leaning toward where it searches, the hand
     #: slides it to the hole's wall and turns it upright once it drops in (skills/tilt.py)
     tilt: float = 0.0
+    #: how far (m) the tilted hand slides a dropped part at most (0: ``sweep_halfwidth``)
+    tilt_reach: float = 0.0
 
     def __post_init__(self) -> None:
         if self.pattern not in PATTERNS:
@@ -376,11 +378,12 @@ def follow_config(style: TeacherStyle) -> FollowConfig:
 
 def _tilt(style: TeacherStyle) -> TiltConfig | None:
     """The hand's tilted search (``style.tilt`` > 0): it feels the drop at ``hold_depth``
-    (0.5 mm without one), slides the part on by ``sweep_halfwidth`` (its soft arm pressing
-    the low rim on the hole's far wall as it goes) and turns it upright."""
+    (0.5 mm without one), slides the part on by up to ``sweep_halfwidth`` or ``tilt_reach``
+    (its soft arm pressing the low rim on the hole's far wall as it goes) and turns it
+    upright."""
     if style.tilt <= 0.0:
         return None
-    drop, reach = style.hold_depth or 5e-4, style.sweep_halfwidth
+    drop, reach = style.hold_depth or 5e-4, max(style.sweep_halfwidth, style.tilt_reach)
     return TiltConfig(angle=style.tilt, drop_depth=drop, lateral_reach=reach, stall_lag=reach)
 
 

@@ -166,6 +166,7 @@ class Peg2D(Task):
             "max_duration": float(min(600.0, max(60.0, duration))),
             "hold_depth": self.hold_depth,
         }
-        if tilt > 0:  # sharp edges: the hand tilts the peg as the searcher does
-            hints["tilt"] = tilt
+        if tilt > 0:  # sharp edges: the hand tilts the peg as the searcher does and slides
+            hints["tilt"] = tilt  # it across the hole after the drop
+            hints["tilt_reach"] = self.params.peg_diameter + self.params.clearance
         return hints
