@@ -33,7 +33,7 @@ from teachfit.skills.graph import Node, Skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
-from teachfit.skills.tilt import ALIGN, LATERAL, SEARCH, TiltConfig, TiltState
+from teachfit.skills.tilt import LATERAL, SEARCH, TiltConfig, TiltState
 
 
 @dataclass(frozen=True)
@@ -208,7 +208,7 @@ class _FollowRun(PrimitiveRun):
         elapsed, self.t_last = pc.t_node - self.t_last, pc.t_node
         if before != SEARCH:  # the trajectory's clock stood still since the drop
             self.paused += elapsed
-        if tilt.phase == SEARCH and before == ALIGN:  # missed: back to the trajectory
+        if tilt.phase == SEARCH and before != SEARCH:  # missed: back to the trajectory
             self.hold = None
             self.blend[:] = pc.p[:2] - pc.p_d[:2]
             self.blend_t0 = pc.t_node

@@ -15,7 +15,8 @@ position within about a hole radius of the point one peg radius behind the hole 
 2. *lateral*: once the TCP sank ``drop_depth`` below it, the x-y set-point moves from the
    TCP along ``d`` at ``lateral_speed``: the low rim slides across the hole until its far
    wall stops it (the set-point then leads the TCP by ``stall_lag``), or the TCP has gone
-   ``lateral_reach`` (the hole's diameter);
+   ``lateral_reach`` (the hole's diameter); back up within half ``drop_depth`` of the
+   reference height, the rim rode out over the edge: the search goes on;
 3. *align*: x-y held where the TCP is (the follower's soft hold stiffness), the tilt goes to
    zero linearly over ``align_time`` while the push goes on: turning about the rim that
    rests on the far wall, the part swings over the hole and slides in. Upright and not
@@ -150,7 +151,9 @@ class TiltState:
             lead = self.cfg.lateral_speed * (t - self.t0) - travel
             stalled = lead > self.cfg.stall_lag
             spent = travel >= self.cfg.lateral_reach or t - self.t0 > self.cfg.lateral_time
-            if stalled or spent:
+            if self.z_top - z < 0.5 * self.cfg.drop_depth:  # back up: the rim rode out over
+                self.phase, self.t0 = SEARCH, t  # the edge (a shallow drop), search on
+            elif stalled or spent:
                 self.phase, self.t0 = ALIGN, t
         elif self.phase == ALIGN:
             since = t - self.t0 - self.cfg.align_time
