@@ -106,3 +106,20 @@ def test_follower_config_from_the_task():
     assert slick.hold_stiffness == slick.stiffness_across == pytest.approx(400.0)
     socket = task_follow_config(get_task("socket3d"))  # no hints: the defaults
     assert socket == base
+
+
+def test_sharp_edged_holes_are_searched_tilted_chamfered_ones_upright():
+    from teachfit.execution.search import task_follow_config
+    from teachfit.skills.follow import FollowConfig
+    from teachfit.tasks.variants import grid
+
+    default = task_follow_config(get_task("peg2d"))  # the default cell's follower as before
+    assert default == FollowConfig(hold_depth=default.hold_depth, hold_stiffness=150.0)
+    assert default.tilt is None
+    for v in grid("peg2d"):
+        task = v.make()
+        tilt = task_follow_config(task).tilt
+        assert (tilt is None) == bool(dict(v.values)["chamfers"]), v.label
+        if tilt is not None:
+            hole = task.params.peg_diameter + task.params.clearance
+            assert tilt.lateral_reach == pytest.approx(hole)

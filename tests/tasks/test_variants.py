@@ -40,7 +40,10 @@ def test_peg2d_teacher_hints_follow_the_capture_width_and_friction():
     for name in ("spiral_pitch", "sweep_halfwidth", "max_duration"):
         assert getattr(default, name) == getattr(TeacherStyle(), name)
     sharp = style_for(get_task("peg2d", clearance=0.0003, peg_chamfer=0.0, hole_chamfer=0.0))
-    assert sharp.spiral_pitch <= 1.6 * 0.00015 + 1e-12  # rows within the 0.15 mm capture
+    # sharp edges: the hand tilts the peg, rows within the tilted peg's 1 mm capture
+    assert sharp.tilt == 0.25 and sharp.spiral_pitch <= 1.6 * 0.001 + 1e-12
+    assert sharp.tilt_reach == pytest.approx(0.0203)  # slid across the hole after the drop
+    assert default.tilt == 0.0
     assert sharp.max_duration > default.max_duration and sharp.hold_depth == pytest.approx(5e-4)
     sticky = style_for(get_task("peg2d", friction=0.8))
     assert sticky.sweep_halfwidth > default.sweep_halfwidth

@@ -31,7 +31,7 @@ def run_trajectory(
     limit is hit: a one-node skill (:func:`~teachfit.skills.follow.follow_skill`) run by the
     engine. Never raises for a fault: the result says what happened."""
     cfg = config or FollowConfig()
-    budget = trajectory.duration + cfg.settle_time + 2.0
+    budget = trajectory.duration + cfg.settle_time + cfg.extra_time + 2.0
     exec_cfg = ExecConfig(
         command_rate=command_rate, log_rate=log_rate, max_time=budget, recovery_time=0.0
     )

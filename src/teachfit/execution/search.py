@@ -22,6 +22,7 @@ from teachfit.execution.follow import run_trajectory
 from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.skills.follow import FollowConfig
+from teachfit.skills.tilt import TiltConfig, wedge_lag
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
@@ -189,7 +190,7 @@ def task_follow_config(task: Task) -> FollowConfig:
     (``peg2d``) the lateral stiffnesses times ``stiffness_scale`` (the friction lag of the
     sliding part kept what it is at the default friction) and a hold once the part sank
     ``search_hold_depth``: pressed in with the across stiffness in every direction, not
-    dragged on (it would wedge)."""
+    dragged on (it would wedge); where it has a ``search_tilt`` (sharp edges), tilted."""
     hold = getattr(task, "search_hold_depth", None)
     scale = float(getattr(task, "stiffness_scale", 1.0))
     base = FollowConfig()
@@ -199,6 +200,24 @@ def task_follow_config(task: Task) -> FollowConfig:
         stiffness_across=across,
         hold_depth=hold,
         hold_stiffness=None if hold is None else across,
+        tilt=_tilt(task, scale * base.stiffness_along, base.push_force),
+    )
+
+
+def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
+    """The tilted search where the task asks for one (``search_tilt`` > 0, rad; see
+    :mod:`teachfit.skills.tilt`): the drop felt at half the upright hold depth (a tilted peg
+    rests steadily on a flat top; its drop is ~ tan(tilt) x how far the rim is past the edge),
+    the low rim slid up to a hole diameter after it."""
+    angle = float(getattr(task, "search_tilt", 0.0))
+    if angle <= 0.0:
+        return None
+    p = task.params
+    return TiltConfig(
+        angle=angle,
+        drop_depth=0.5 * float(task.search_hold_depth),
+        lateral_reach=p.peg_diameter + p.clearance,
+        stall_lag=wedge_lag(angle, p.friction, load, stiffness),
     )
 
 

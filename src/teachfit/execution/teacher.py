@@ -39,6 +39,7 @@ from teachfit.execution.teacher_cache import cache_key, cached
 from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills.follow import FollowConfig
+from teachfit.skills.tilt import TiltConfig
 from teachfit.tasks.base import Task
 
 PATTERNS = ("sweep", "spiral", "zigzag")
@@ -73,6 +74,11 @@ class TeacherStyle:
     record_rate: float = 100.0
     #: sinking (m) after which the hand stops moving the part sideways (None: never)
     hold_depth: float | None = None
+    #: tilt of the held part (rad, 0: upright): leaning toward where it searches, the hand
+    #: slides it to the hole's wall and turns it upright once it drops in (skills/tilt.py)
+    tilt: float = 0.0
+    #: how far (m) the tilted hand slides a dropped part at most (0: ``sweep_halfwidth``)
+    tilt_reach: float = 0.0
 
     def __post_init__(self) -> None:
         if self.pattern not in PATTERNS:
@@ -366,7 +372,19 @@ def follow_config(style: TeacherStyle) -> FollowConfig:
         settle_time=0.0,
         press_feel=style.press_feel,
         hold_depth=style.hold_depth,
+        tilt=_tilt(style),
     )
+
+
+def _tilt(style: TeacherStyle) -> TiltConfig | None:
+    """The hand's tilted search (``style.tilt`` > 0): it feels the drop at ``hold_depth``
+    (0.5 mm without one), slides the part on by up to ``sweep_halfwidth`` or ``tilt_reach``
+    (its soft arm pressing the low rim on the hole's far wall as it goes) and turns it
+    upright."""
+    if style.tilt <= 0.0:
+        return None
+    drop, reach = style.hold_depth or 5e-4, max(style.sweep_halfwidth, style.tilt_reach)
+    return TiltConfig(angle=style.tilt, drop_depth=drop, lateral_reach=reach, stall_lag=reach)
 
 
 def press_wander(style: TeacherStyle, n: int, dt: float, rng: np.random.Generator) -> np.ndarray:

@@ -12,6 +12,7 @@ from teachfit.skills.params import (
     read_params_toml,
     write_params_toml,
 )
+from teachfit.skills.tilt import TiltConfig
 
 __all__ = [
     "SKILLS",
@@ -22,6 +23,7 @@ __all__ = [
     "Node",
     "Skill",
     "SkillParams",
+    "TiltConfig",
     "Transition",
     "follow_skill",
     "get_skill",

@@ -33,6 +33,7 @@ from teachfit.skills.graph import Node, Skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
+from teachfit.skills.tilt import LATERAL, SEARCH, TiltConfig, TiltState
 
 
 @dataclass(frozen=True)
@@ -54,7 +55,9 @@ class FollowConfig:
     stops moving it sideways (dragged on, a part caught in a hole with high friction wedges
     instead of sliding in). ``hold_stiffness`` (N/m, None: unchanged): the lateral stiffness,
     the same in every x-y direction, once held, so that the chamfers can centre the pressed
-    part (a hand that felt the drop also relaxes sideways).
+    part (a hand that felt the drop also relaxes sideways). ``tilt`` (None: upright): search
+    with the part tilted, and on the drop slide it to the hole's wall and align it upright
+    (:mod:`teachfit.skills.tilt`; its align phase is a hold, with ``hold_stiffness``).
     """
 
     stiffness_along: float = 1500.0
@@ -69,6 +72,7 @@ class FollowConfig:
     press_feel: float = 0.0
     hold_depth: float | None = None
     hold_stiffness: float | None = None
+    tilt: TiltConfig | None = None
 
     def __post_init__(self) -> None:
         for name in (
@@ -93,6 +97,12 @@ class FollowConfig:
             raise SkillError(f"follow: hold_stiffness must be >= 0, got {self.hold_stiffness}")
         if self.anchor not in ("frame", "entry"):
             raise SkillError(f"follow: anchor must be 'frame' or 'entry', got {self.anchor!r}")
+
+    @property
+    def extra_time(self) -> float:
+        """Time (s) the follower may need past ``settle_time``: a tilted search's lateral
+        and align phases (0 upright)."""
+        return 0.0 if self.tilt is None else self.tilt.extra_time
 
 
 @dataclass(frozen=True)
@@ -127,6 +137,10 @@ class _FollowRun(PrimitiveRun):
         self.hold: np.ndarray | None = None  # x-y where the part dropped (hold_depth)
         self.diag = np.array([cfg.stiffness_along] * 2 + [cfg.stiffness_z] + list(self.rot_k))
         self.press_correction = 0.0  # N, the felt-press loop's integral (press_feel > 0)
+        self.tilt = None if cfg.tilt is None else TiltState(cfg.tilt, traj.pos)
+        self.paused = 0.0  # s of node time outside a tilted search's search phase
+        self.blend = np.zeros(2)  # m, x-y offset back to the trajectory after a retry
+        self.blend_t0, self.blend_time, self.t_last = 0.0, 0.0, 0.0
 
     def enter(self, pc: Percept) -> None:
         self.direction[:] = (1.0, 0.0)
@@ -135,11 +149,17 @@ class _FollowRun(PrimitiveRun):
         pc.done = False
         self.press_correction = 0.0
         self.z0, self.hold = float(pc.p[2]), None
+        if self.tilt is not None:
+            self.tilt.reset(self.z0)
+        self.paused, self.blend_time, self.t_last = 0.0, 0.0, 0.0
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
-        pos, quat, vel, ff = self.traj.sample(pc.t_node)
+        t_traj = pc.t_node - self.paused
+        pos, quat, vel, ff = self.traj.sample(t_traj)
         pc.p_d[:] = pos + self.offset
+        if pc.t_node - self.blend_t0 < self.blend_time:
+            pc.p_d[:2] += self.blend * (1.0 - (pc.t_node - self.blend_t0) / self.blend_time)
         pc.q_d[:] = quat
         if math.hypot(vel[0], vel[1]) > 1e-6:
             self.direction[:] = vel[:2]
@@ -154,7 +174,9 @@ class _FollowRun(PrimitiveRun):
                 lim = 0.5 * cfg.push_force
                 self.press_correction = min(lim, max(-lim, self.press_correction + step))
             out.wrench[2] -= self.press_correction
-        if cfg.hold_depth is not None:
+        if self.tilt is not None:
+            self._tilted(pc, out, quat)
+        elif cfg.hold_depth is not None:
             if self.hold is None and self.z0 - pc.p[2] >= cfg.hold_depth:
                 self.hold = pc.p[:2].copy()
             if self.hold is not None:
@@ -175,7 +197,32 @@ class _FollowRun(PrimitiveRun):
             out.full = True
         else:
             out.stiffness[:] = self.diag
-        pc.done = pc.t_node >= self.traj.duration
+        pc.done = t_traj >= self.traj.duration
+
+    def _tilted(self, pc: Percept, out: MPCommand, quat: np.ndarray) -> None:
+        tilt = self.tilt
+        assert tilt is not None
+        before = tilt.phase
+        if tilt.step(pc) and self.hold is None:
+            self.hold = pc.p[:2].copy()
+        elapsed, self.t_last = pc.t_node - self.t_last, pc.t_node
+        if before != SEARCH:  # the trajectory's clock stood still since the drop
+            self.paused += elapsed
+        if tilt.phase == SEARCH and before != SEARCH:  # missed: back to the trajectory
+            self.hold = None
+            self.blend[:] = pc.p[:2] - pc.p_d[:2]
+            self.blend_t0 = pc.t_node
+            self.blend_time = max(0.2, float(np.hypot(*self.blend)) / tilt.cfg.lateral_speed)
+            pc.p_d[:2] = pc.p[:2]
+        tilt.orient(pc.q_d, quat, pc.t_node)
+        if tilt.phase == LATERAL:
+            self.direction[:] = tilt.d
+            tilt.lateral(pc, out.twist)
+            out.wrench[:2] = 0.0
+        elif self.hold is not None:
+            pc.p_d[:2] = self.hold
+            out.twist[:2] = 0.0
+            out.wrench[:2] = 0.0
 
 
 def follow_skill(
@@ -183,11 +230,12 @@ def follow_skill(
 ) -> Skill:
     """A one-node skill that follows ``trajectory`` until the task's detector fires.
 
-    Its error exits: the time budget ``duration + settle_time`` and the force limit; the
+    Its error exits: the time budget ``duration + settle_time`` (plus a tilted search's
+    ``extra_time``) and the force limit; the
     execution engine reports them as ``TIMEOUT`` and ``FORCE_LIMIT``.
     """
     cfg = config or FollowConfig()
-    horizon = trajectory.duration + cfg.settle_time
+    horizon = trajectory.duration + cfg.settle_time + cfg.extra_time
     error = Any_((TimeAbove(horizon), ForceAbove(cfg.max_force, axis="norm")))
     node = Node(name, FollowSetpoints(trajectory, cfg), error=error, doc=trajectory.name)
     return Skill(

@@ -23,6 +23,11 @@ from teachfit.tasks.scene.round_hole import Peg2DScene
 #: at the default friction, which its default sweep suits (see Peg2D.teacher_hints)
 DEFAULT_PITCH, DEFAULT_HALFWIDTH, DEFAULT_FRICTION = 0.0025, 0.015, 0.3
 TEACHER_STIFFNESS, TEACHER_SPEED, TEACHER_LOAD = 600.0, 0.012, 7.0
+#: a search's tilt for sharp-edged holes (rad), and the capture half-width (m) of a peg so
+#: tilted: straight passes with Ø 8 mm, 0.2 mm clearance, μ 0.5-0.8 drop in up to 1-2 mm off
+#: the axis (0.1 mm upright). Holes whose upright capture is wider (chamfered: >= 1.6 mm) are
+#: searched upright, as before
+SEARCH_TILT, TILTED_CAPTURE = 0.25, 0.001
 
 
 @dataclass(frozen=True)
@@ -129,6 +134,12 @@ class Peg2D(Task):
         high-friction top cuts a tour's turns by the lag and misses holes the plan crosses."""
         return max(1.0, self.params.friction / DEFAULT_FRICTION)
 
+    @property
+    def search_tilt(self) -> float:
+        """Tilt (rad) of a searching peg: :data:`SEARCH_TILT` where the upright capture
+        half-width is under the tilted one, :data:`TILTED_CAPTURE` (sharp edges), else 0."""
+        return SEARCH_TILT if self.capture_halfwidth < TILTED_CAPTURE else 0.0
+
     def teacher_hints(self) -> dict[str, float]:
         """The blind teacher's sweep scaled to this cell (m, s; TeacherStyle fields).
 
@@ -138,16 +149,24 @@ class Peg2D(Task):
         sliding peg over the default friction's (``friction * (push + weight) / stiffness``:
         within it of a turn the peg sticks instead of sliding); the time budget grows with
         the raster's length (up to 10 minutes); the teacher stops moving the peg sideways
-        once it sank :attr:`hold_depth` (a hand that feels the drop).
+        once it sank :attr:`hold_depth` (a hand that feels the drop). Where the search
+        tilts (:attr:`search_tilt`, sharp edges), the teacher tilts too and its rows are
+        1.6 tilted capture half-widths apart.
         """
-        pitch = min(DEFAULT_PITCH, 1.6 * self.capture_halfwidth)
+        tilt = self.search_tilt
+        capture = TILTED_CAPTURE if tilt > 0 else self.capture_halfwidth
+        pitch = min(DEFAULT_PITCH, 1.6 * capture)
         lag = (self.params.friction - DEFAULT_FRICTION) * TEACHER_LOAD / TEACHER_STIFFNESS
         half = DEFAULT_HALFWIDTH + max(0.0, lag)
         rows = (self.params.demo_offset + half) / pitch + 1  # start to past the hole
         duration = rows * (2 * half + pitch) / TEACHER_SPEED
-        return {
+        hints: dict[str, float] = {
             "spiral_pitch": pitch,
             "sweep_halfwidth": half,
             "max_duration": float(min(600.0, max(60.0, duration))),
             "hold_depth": self.hold_depth,
         }
+        if tilt > 0:  # sharp edges: the hand tilts the peg as the searcher does and slides
+            hints["tilt"] = tilt  # it across the hole after the drop
+            hints["tilt_reach"] = self.params.peg_diameter + self.params.clearance
+        return hints

@@ -1,0 +1,169 @@
+"""Searching with a tilted part: tilt, feel the drop, slide to the wall, align (seed B's
+``tilt``, ``lateral`` and ``align`` primitives inside a search follower).
+
+An upright sharp-edged peg drops into its hole only when its axis passes within the radial
+clearance of the hole's (0.1-0.25 mm in the peg2d variants). Tilted by ``angle`` about the
+horizontal axis z x d, its lowest point is one rim point, ``d`` (a fixed task-frame direction:
+by default from the trajectory's start toward its centroid, the part leaning toward where it
+searches) from the axis; that point drops as soon as it is over the hole, which it is for any axis
+position within about a hole radius of the point one peg radius behind the hole centre
+(millimetres, not tenths). :class:`TiltState` then runs three phases:
+
+1. *search*: the follower's set-points, the orientation tilted; the reference height is the
+   highest the TCP has been since the tilt settled (the tilted part rests one
+   ``r sin(angle)`` above the surface);
+2. *lateral*: once the TCP sank ``drop_depth`` below it, the x-y set-point moves from the
+   TCP along ``d`` at ``lateral_speed``: the low rim slides across the hole until its far
+   wall stops it (the set-point then leads the TCP by ``stall_lag``), or the TCP has gone
+   ``lateral_reach`` (the hole's diameter); back up within half ``drop_depth`` of the
+   reference height, the rim rode out over the edge: the search goes on;
+3. *align*: x-y held where the TCP is (the follower's soft hold stiffness), the tilt goes to
+   zero linearly over ``align_time`` while the push goes on: turning about the rim that
+   rests on the far wall, the part swings over the hole and slides in. Upright and not
+   sinking ``RETRY`` s later, it missed (it stands on the edge): the search goes on, tilted,
+   from where the trajectory was left (:class:`~teachfit.skills.follow.FollowSetpoints`
+   pauses the trajectory's clock outside the search phase and blends back to it).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from teachfit.core.errors import SkillError
+from teachfit.core.geometry import quat_mul_into
+from teachfit.skills.percept import Percept
+
+#: time (s) the lateral phase waits at its full reach before aligning anyway
+SETTLE = 0.5
+#: time (s) after the search (re)starts before a drop can be felt: the part is still tilting
+#: and bounces up by more than a drop (a Ø 20 mm peg rises 2.5 mm, overshooting by 0.7 mm)
+TILT_SETTLE = 0.3
+#: a part upright for ``RETRY`` s (s) that sank less than ``RETRY_SINK`` (m) since is on the
+#: edge, not in the hole: the search goes on (an inserting part slides in within 0.3 s)
+RETRY, RETRY_SINK = 0.5, 0.001
+#: phases of a tilted search
+SEARCH, LATERAL, ALIGN = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class TiltConfig:
+    """A tilted search (rad, m, m/s, s): see the module docstring."""
+
+    angle: float = 0.15
+    direction: float | None = None
+    drop_depth: float = 5e-4
+    lateral_reach: float = 0.02
+    lateral_speed: float = 0.005
+    stall_lag: float = 0.003
+    align_time: float = 0.5
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.angle) and 0.0 < self.angle < 0.6):
+            raise SkillError(f"tilt: angle must be in (0, 0.6) rad, got {self.angle}")
+        if self.direction is not None and not math.isfinite(self.direction):
+            raise SkillError(f"tilt: direction must be finite, got {self.direction}")
+        for name in ("drop_depth", "lateral_reach", "lateral_speed", "stall_lag", "align_time"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise SkillError(f"tilt: {name} must be > 0, got {value}")
+
+    @property
+    def extra_time(self) -> float:
+        """The longest the lateral and align phases take (s): a drop at the trajectory's end
+        still gets them before the time budget runs out."""
+        return self.lateral_time + self.align_time
+
+    @property
+    def lateral_time(self) -> float:
+        """The longest lateral phase (s): the reach and the stall lead at its speed."""
+        return (self.lateral_reach + self.stall_lag) / self.lateral_speed + SETTLE
+
+    def unit(self, path: np.ndarray) -> np.ndarray:
+        """The tilt direction ``d`` (2,), task frame: the low rim's side; without a
+        ``direction``, from the first of the ``path`` points (N, >= 2; m) to their centroid
+        (+x if they are all one point)."""
+        if self.direction is not None:
+            return np.array([math.cos(self.direction), math.sin(self.direction)])
+        pts = np.asarray(path, dtype=float)[:, :2]
+        v = pts.mean(axis=0) - pts[0]
+        n = float(np.hypot(v[0], v[1]))
+        return v / n if n > 1e-9 else np.array([1.0, 0.0])
+
+
+def wedge_lag(angle: float, friction: float, load: float, stiffness: float) -> float:
+    """Twice the set-point lead (m) that slides a part tilted by ``angle`` (rad) across a
+    hole edge under its tip face: the edge pushes back along the face's normal, so moving on
+    takes ``load (tan(angle) + friction) / (1 - friction tan(angle))`` (N) at ``stiffness``
+    (N/m); twice that, and the part is blocked (the far wall), not sliding."""
+    tan = math.tan(angle)
+    denom = max(1e-3, 1.0 - friction * tan)
+    return 2.0 * load * (tan + friction) / denom / stiffness
+
+
+class TiltState:
+    """One tilted search's phase and the set-points it overrides (see the module docstring);
+    ``path`` (N, 3; m): the followed trajectory's positions, for the default direction."""
+
+    def __init__(self, cfg: TiltConfig, path: np.ndarray) -> None:
+        self.cfg, self.d = cfg, cfg.unit(path)
+        s = math.sin(0.5 * cfg.angle)  # about z x d = (-d_y, d_x, 0): lowers the +d rim
+        self.q_tilt = np.array([math.cos(0.5 * cfg.angle), -self.d[1] * s, self.d[0] * s, 0.0])
+        self.reset(0.0)
+
+    def reset(self, z: float) -> None:
+        self.phase, self.z_top, self.t0, self.z_aligned = SEARCH, z, 0.0, z
+        self.origin = np.zeros(2)
+
+    def angle(self, t: float) -> float:
+        """The tilt (rad) at node time ``t``: full until aligning, then down to 0."""
+        if self.phase != ALIGN:
+            return self.cfg.angle
+        return self.cfg.angle * max(0.0, 1.0 - (t - self.t0) / self.cfg.align_time)
+
+    def orient(self, out: np.ndarray, quat: np.ndarray, t: float) -> None:
+        """``out`` = ``quat`` tilted by the phase's angle about z x d (world-side product)."""
+        a = self.angle(t)
+        if a >= self.cfg.angle:
+            quat_mul_into(out, self.q_tilt, quat)
+        elif a > 0.0:
+            s = math.sin(0.5 * a)
+            q = np.array([math.cos(0.5 * a), -self.d[1] * s, self.d[0] * s, 0.0])
+            quat_mul_into(out, q, quat)
+        else:
+            out[:] = quat
+
+    def step(self, pc: Percept) -> bool:
+        """Advance the phase from the measured TCP; True when it should hold x-y (align)."""
+        z, t = float(pc.p[2]), pc.t_node
+        if self.phase == SEARCH:
+            if t - self.t0 < TILT_SETTLE:  # still tilting: no resting height yet
+                self.z_top = z
+            self.z_top = max(self.z_top, z)
+            if self.z_top - z >= self.cfg.drop_depth:
+                self.phase, self.t0 = LATERAL, t
+                lead = float(np.dot(pc.p_d[:2] - pc.p[:2], self.d))  # the spring's pull on
+                self.origin[:] = pc.p[:2] + max(0.0, lead) * self.d  # the part, kept
+        if self.phase == LATERAL:
+            travel = float(np.dot(pc.p[:2] - self.origin, self.d))
+            lead = self.cfg.lateral_speed * (t - self.t0) - travel
+            stalled = lead > self.cfg.stall_lag
+            spent = travel >= self.cfg.lateral_reach or t - self.t0 > self.cfg.lateral_time
+            if self.z_top - z < 0.5 * self.cfg.drop_depth:  # back up: the rim rode out over
+                self.phase, self.t0 = SEARCH, t  # the edge (a shallow drop), search on
+            elif stalled or spent:
+                self.phase, self.t0 = ALIGN, t
+        elif self.phase == ALIGN:
+            since = t - self.t0 - self.cfg.align_time
+            if since <= 0.0:
+                self.z_aligned = z
+            elif since > RETRY and self.z_aligned - z < RETRY_SINK:
+                self.phase, self.t0 = SEARCH, t  # upright and not sinking: search on
+        return self.phase == ALIGN
+
+    def lateral(self, pc: Percept, twist: np.ndarray) -> None:
+        """In the lateral phase: the x-y set-point and velocity along ``d`` from the drop."""
+        pc.p_d[:2] = self.origin + self.cfg.lateral_speed * (pc.t_node - self.t0) * self.d
+        twist[:2] = self.cfg.lateral_speed * self.d

@@ -1,0 +1,116 @@
+"""The tilted search (``skills/tilt.py``): the phases on fed percepts, and a pass over a sharp
+hole that an upright peg misses."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from teachfit.core.errors import SkillError
+from teachfit.core.geometry import Pose, wxyz_to_rotation
+from teachfit.core.setpoints import SetpointTrajectory
+from teachfit.execution.follow import run_trajectory
+from teachfit.execution.search import task_follow_config
+from teachfit.robot.registry import make_robot
+from teachfit.skills.follow import FollowConfig, FollowSetpoints
+from teachfit.skills.percept import MPCommand, Percept
+from teachfit.skills.tilt import ALIGN, LATERAL, SEARCH, TiltConfig, TiltState, wedge_lag
+from teachfit.tasks import get_task
+
+
+def test_config_checks_and_default_direction_leans_toward_the_path():
+    with pytest.raises(SkillError, match="angle"):
+        TiltConfig(angle=0.0)
+    with pytest.raises(SkillError, match="stall_lag"):
+        TiltConfig(stall_lag=-1.0)
+    path = np.array([[0.0, 0.0, 0.0], [0.0, 0.02, 0.0], [0.0, 0.04, 0.0]])
+    assert np.allclose(TiltConfig().unit(path), (0.0, 1.0))
+    assert np.allclose(TiltConfig(direction=np.pi).unit(path), (-1.0, 0.0))
+    assert np.allclose(TiltConfig().unit(np.zeros((3, 3))), (1.0, 0.0))
+
+
+def test_wedge_lag_grows_with_friction_and_tilt():
+    lag = wedge_lag(0.25, 0.5, 6.0, 2500.0)
+    assert lag == pytest.approx(2 * 6.0 * (np.tan(0.25) + 0.5) / (1 - 0.5 * np.tan(0.25)) / 2500)
+    assert wedge_lag(0.25, 0.8, 6.0, 2500.0) > lag > wedge_lag(0.1, 0.5, 6.0, 2500.0)
+
+
+def _tick(run, pc, p, t):
+    pc.p[:] = p
+    pc.t_node = t
+    cmd = MPCommand()
+    run.command(pc, cmd)
+    return cmd
+
+
+def test_phases_tilt_drop_slide_to_the_wall_and_align():
+    t = np.array([0.0, 10.0])
+    pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])  # along +x: the rim leans +x
+    traj = SetpointTrajectory.from_path(t, pos)
+    tilt = TiltConfig(angle=0.2, drop_depth=5e-4, lateral_speed=0.005, stall_lag=0.002)
+    run = FollowSetpoints(traj, FollowConfig(tilt=tilt, hold_stiffness=200.0)).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    state = run.tilt
+    _tick(run, pc, (0.0, 0.0, 0.0008), 0.1)  # resting tilted: the TCP rose
+    rim = wxyz_to_rotation(pc.q_d).apply([1.0, 0.0, 0.0])
+    assert state.phase == SEARCH and rim[2] == pytest.approx(-np.sin(0.2))  # +x rim lowest
+    _tick(run, pc, (0.010, 0.0, 0.0002), 1.0)  # sank 0.6 mm: dropped, slide on along +x
+    assert state.phase == LATERAL
+    cmd = _tick(run, pc, (0.0102, 0.0, 0.0002), 1.1)
+    assert pc.p_d[0] > 0.0102 and cmd.twist[0] == pytest.approx(0.005) and cmd.twist[1] == 0
+    _tick(run, pc, (0.0102, 0.0, 0.0002), 1.6)  # blocked while the set-point ran 2.5 mm on
+    assert state.phase == ALIGN
+    cmd = _tick(run, pc, (0.0102, 0.0, 0.0), 1.85)  # half way up, held where it is
+    assert np.allclose(pc.p_d[:2], (0.0102, 0.0)) and np.all(cmd.twist[:2] == 0.0)
+    assert wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.1)
+    assert np.allclose(cmd.stiffness_full[:2, :2], 200.0 * np.eye(2))
+    _tick(run, pc, (0.0102, 0.0, 0.0), 2.2)
+    assert np.allclose(pc.q_d, (1.0, 0.0, 0.0, 0.0))  # upright
+    _tick(run, pc, (0.0102, 0.0, 0.0), 2.5)  # upright 0.4 s, not sinking: still waiting
+    assert state.phase == ALIGN
+    _tick(run, pc, (0.0102, 0.0, 0.0), 2.7)  # on the edge: missed, search on, tilted
+    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.2)
+    assert np.allclose(pc.p_d[:2], (0.0102, 0.0))  # from where the part stands ...
+    run.command(pc, MPCommand())  # ... back to the trajectory where it was left (t = 1 s)
+    assert run.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
+
+
+def test_no_drop_is_felt_while_the_part_still_tilts():
+    traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
+    run = FollowSetpoints(traj, FollowConfig(tilt=TiltConfig())).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    _tick(run, pc, (0.0, 0.0, 0.003), 0.05)  # bounced up while tilting
+    _tick(run, pc, (0.0, 0.0, 0.002), 0.25)
+    _tick(run, pc, (0.0, 0.0, 0.002), 0.35)  # settled 1 mm lower: not a drop
+    assert run.tilt.phase == SEARCH
+    _tick(run, pc, (0.0, 0.0, 0.0014), 0.5)
+    assert run.tilt.phase == LATERAL
+
+
+def test_state_reset_starts_a_new_search():
+    state = TiltState(TiltConfig(), np.zeros((2, 3)))
+    state.phase = ALIGN
+    state.reset(0.06)
+    assert state.phase == SEARCH and state.z_top == 0.06 and state.angle(5.0) == 0.15
+
+
+@pytest.fixture(scope="module")
+def sharp_pass():
+    task = get_task("peg2d", peg_diameter=0.008, clearance=2e-4, peg_chamfer=0.0, hole_chamfer=0.0)
+    robot = make_robot("floating", task, seed=0)
+    t = np.linspace(0.0, 2.0, 40)
+    xy = np.column_stack([-0.01 + 0.01 * t, np.full(t.size, 0.0015)])  # 1.5 mm off the axis
+    traj = SetpointTrajectory.from_path(t, np.column_stack([xy, np.full(t.size, 0.06)]))
+    return task, robot, traj, task.contact_pose(xy[0])
+
+
+def test_a_tilted_pass_drops_in_where_an_upright_one_slides_over(sharp_pass):
+    task, robot, traj, start = sharp_pass
+    cfg = dataclasses.replace(task_follow_config(task), settle_time=0.5)
+    assert cfg.tilt is not None and cfg.tilt.angle == task.search_tilt == 0.25
+    tilted = run_trajectory(robot, task, traj, start, cfg)
+    assert tilted.success and tilted.ground_truth_inserted
+    upright = run_trajectory(robot, task, traj, start, dataclasses.replace(cfg, tilt=None))
+    assert not upright.success and not upright.ground_truth_inserted
