@@ -233,21 +233,23 @@ def execute(
         """Command the set-point for the coming period and integrate it (task -> world)."""
         v, w = cmd.twist[:3], cmd.twist[3:]
         pos_w, quat_w = pc.to_world_pose(pc.p_d, pc.q_d)
+        ff = np.concatenate([rot @ cmd.wrench[:3], rot @ cmd.wrench[3:]])
         if cmd.full:
             np.dot(blk, cmd.stiffness_full, out=k_w)
             k_w[:] = k_w @ blk.T
-        else:
+            order = ImpedanceCommand(
+                pos=pos_w, quat=quat_w, lin_vel=rot @ v, ang_vel=rot @ w, wrench_ff=ff,
+                stiffness=k_w,
+            )  # fmt: skip
+        else:  # R diag(k) R^T per block: PSD by construction, the general checks skipped
             k = cmd.stiffness
             k_w[:] = 0.0
             k_w[:3, :3] = (rot * k[:3]) @ rot.T
             k_w[3:, 3:] = (rot * k[3:]) @ rot.T
-        ff = np.concatenate([rot @ cmd.wrench[:3], rot @ cmd.wrench[3:]])
-        robot.command(
-            ImpedanceCommand(
-                pos=pos_w, quat=quat_w, lin_vel=rot @ v, ang_vel=rot @ w, wrench_ff=ff,
-                stiffness=k_w,
+            order = ImpedanceCommand.from_diagonal_frame(
+                pos_w, quat_w, rot @ v, rot @ w, ff, k_w, k
             )
-        )  # fmt: skip
+        robot.command(order)
         sp_pos[:] = pos_w
         sp_quat[:] = quat_w
         sp_ff[:] = ff
