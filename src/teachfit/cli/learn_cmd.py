@@ -292,11 +292,20 @@ def bench_learning(
             "experiment succeed on each task, and the throughput (0: run the grid)",
         ),
     ] = 0,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            help="folder keeping every experiment's study (SQLite): the same command "
+            "resumes an interrupted grid from it",
+        ),
+    ] = Path("out/bench_learning/studies"),
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
     import os
 
     from teachfit.bench import learning as bl
+    from teachfit.bench.learning_random import cpu_seconds
     from teachfit.learning.objective import SkillObjective
 
     _worker_counts(scaling_workers)  # refused before any work, with --scaling or not
@@ -310,6 +319,13 @@ def bench_learning(
         return
     method_list = [m for m in methods.split(",") if m]
     total = len(task_list) * len(method_list) * experiments * trials
+    ran = [0]
+    cpu0 = cpu_seconds()
+
+    def tick(label: str) -> None:
+        ran[0] += 1
+        bar.update(job, advance=1, description=label)
+
     with progress_bar() as bar:
         job = bar.add_task("learning", total=total)
         res = bl.run_learning_bench(
@@ -322,15 +338,22 @@ def bench_learning(
             controller=controller,
             seed=seed,
             overrides=dict(_overrides(task_param)),
-            on_trial=lambda label, _r: bar.update(job, advance=1, description=label),
+            on_trial=lambda label, _r: tick(label),
             robot=robot,
             ray=ray,
+            studies=out,
         )
+    cpu = cpu_seconds() - cpu0
     extra = "".join(f" --task-param {p}" for p in task_param or [])
+    done = sum(len(e.costs) for e in res.experiments)
+    kept = f", {done - ran[0]} trials resumed from {out}" if done > ran[0] else ""
+    execs = ran[0] * starts
     text = (
         f"`teachfit bench learning --tasks {tasks} --methods {methods} --experiments "
         f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
-        f"{os.cpu_count()} cores, {res.wall_s:.0f} s in all)\n\n" + bl.to_markdown(res)
+        f"{os.cpu_count()} cores, {res.wall_s:.0f} s wall and {cpu:.0f} CPU-s in all, "
+        f"{execs} executions: {execs / cpu if cpu > 0 else math.nan:.2f} per CPU-s, "
+        f"learners included{kept})\n\n" + bl.to_markdown(res)
     )
     n_w = workers or os.cpu_count() or 1
     if target:
