@@ -4,13 +4,21 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import signal
 from pathlib import Path
 
 import numpy as np
+import pytest
 from media_checks import read_png
 from typer.testing import CliRunner
 
-from teachfit.bench.learning import ordering, run_learning_bench, to_markdown
+from teachfit.bench.learning import (
+    BenchInterrupted,
+    ordering,
+    run_learning_bench,
+    to_markdown,
+)
 from teachfit.cli import app
 from teachfit.learning.objective import SkillObjective
 from teachfit.viz.learning_figures import plot_best_execution, plot_learning_curves
@@ -86,13 +94,20 @@ def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
 
 def test_an_interrupted_grid_resumes_from_its_studies(tmp_path: Path) -> None:
     seen: list[str] = []
-    kw = {"workers": 0, "n_starts": 1, "on_trial": lambda label, _r: seen.append(label)}
-    part = run_learning_bench(["key"], ["cmaes"], 1, 2, studies=tmp_path, **kw)
-    whole = run_learning_bench(["key"], ["cmaes"], 1, 3, studies=tmp_path, **kw)
-    assert len(seen) == 2 + 1  # the second run kept the 2 stored trials and ran 1
-    assert len(list(tmp_path.glob("key-cmaes-s0-*.db"))) == 1
-    fresh = run_learning_bench(["key"], ["cmaes"], 1, 3, workers=0, n_starts=1)
-    assert whole.experiments[0].costs[:2] == part.experiments[0].costs
+
+    def interrupt(label: str, _r: object) -> None:
+        seen.append(label)
+        if len(seen) == 1:  # Ctrl-C during the first experiment, after its first trial
+            os.kill(os.getpid(), signal.SIGINT)
+
+    kw = {"workers": 0, "n_starts": 1, "studies": tmp_path}
+    with pytest.raises(BenchInterrupted, match="key/cmaes seed 0 interrupted; its 1 finished"):
+        run_learning_bench(["key"], ["cmaes"], 2, 2, on_trial=interrupt, **kw)
+    assert len(list(tmp_path.glob("*.db"))) == 1  # the grid stopped there
+    whole = run_learning_bench(["key"], ["cmaes"], 2, 2, on_trial=interrupt, **kw)
+    assert len(seen) == 1 + 1 + 2  # the stored trial was kept, not run again
+    assert len(list(tmp_path.glob("key-cmaes-s*.db"))) == 2
+    fresh = run_learning_bench(["key"], ["cmaes"], 1, 2, workers=0, n_starts=1)
     assert whole.experiments[0].costs == fresh.experiments[0].costs
 
 

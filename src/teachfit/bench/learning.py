@@ -32,6 +32,7 @@ from teachfit.learning.runner import run_study
 from teachfit.learning.study import METHODS, Study, TrialRecord
 
 __all__ = [
+    "BenchInterrupted",
     "CellStats",
     "Experiment",
     "LearningBench",
@@ -46,6 +47,10 @@ __all__ = [
     "study_path",
     "to_markdown",
 ]
+
+
+class BenchInterrupted(LearningError):
+    """An experiment of the bench was interrupted (SIGINT / SIGTERM) before its budget."""
 
 
 def method_options(method: str, trials: int) -> dict[str, object]:
@@ -222,7 +227,7 @@ def run_experiment(
         if ray is not None:
             from teachfit.learning.ray_runner import run_study_ray
 
-            run_study_ray(
+            report = run_study_ray(
                 study,
                 objective,
                 trials,
@@ -232,7 +237,7 @@ def run_experiment(
                 handle_signals=handle_signals,
             )
         else:
-            run_study(
+            report = run_study(
                 study,
                 objective,
                 trials,
@@ -242,6 +247,14 @@ def run_experiment(
             )
         wall = time.perf_counter() - t0
         study.close()
+        if report.interrupted:  # the rest of a grid must not run on (nor count it whole)
+            kept = (
+                f"its {study.n_finished} finished trials are in {storage}: the same command resumes"
+                if storage is not None
+                else "its trials are discarded (keep studies to resume)"
+            )
+            what = f"{objective.task}/{method} seed {objective.seed}"
+            raise BenchInterrupted(f"{what} interrupted; {kept}")
         return Experiment.from_records(
             objective.task, method, objective.seed, study.trials(), wall, objective.n_starts
         )

@@ -82,6 +82,9 @@ class RobotState:
         return np.concatenate([self.lin_vel, self.ang_vel])
 
 
+_FIELDS = ("pos", "quat", "lin_vel", "ang_vel", "wrench_ff", "stiffness")
+
+
 @dataclass(frozen=True)
 class ImpedanceCommand:
     """A Cartesian impedance set-point (world frame, at the TCP).
@@ -148,29 +151,27 @@ class ImpedanceCommand:
         symmetric and positive semi-definite whenever ``diagonal >= 0``, so the general
         checks (``allclose``, ``eigvalsh``: ~150 µs, per 10 ms command) are skipped.
 
-        The same arrays result (copies, the quaternion normalised the same way); anything
-        non-finite, a negative ``diagonal`` entry or a non-unit ``quat`` goes through
-        :meth:`__init__`, which raises the usual :class:`ControlError`.
+        The float arrays given become the command's, read-only and not copied: pass arrays
+        nothing else writes (fresh ones, or one read-only ``stiffness`` shared by several
+        commands). The values are those :meth:`__init__` stores (the quaternion normalised
+        the same way); anything non-finite, a negative ``diagonal`` entry or a non-unit
+        ``quat`` goes through :meth:`__init__`, which raises its usual :class:`ControlError`.
         """
         parts = (pos, quat, lin_vel, ang_vel, wrench_ff, stiffness)
+        # one finite sum for all (NaN and inf propagate); Python sums of ``tolist`` cost a
+        # quarter of numpy's reductions on arrays this small
+        total = sum(sum(a.ravel().tolist()) for a in parts)
+        norm = float(np.linalg.norm(quat))
         if not (
-            diagonal.min() >= 0.0
-            and all(math.isfinite(float(a.sum())) for a in parts)
-            and abs(float(np.linalg.norm(quat)) - 1.0) <= 1e-3
+            min(diagonal.tolist()) >= 0.0
+            and math.isfinite(total)
+            and abs(norm - 1.0) <= 1e-3
+            and all(a.dtype == np.float64 for a in parts)
         ):
             return cls(pos, quat, lin_vel, ang_vel, wrench_ff, stiffness)
         self = object.__new__(cls)
-        q = np.array(quat, dtype=float)
-        q = q / float(np.linalg.norm(q))
-        for name, value in (
-            ("pos", pos),
-            ("quat", q),
-            ("lin_vel", lin_vel),
-            ("ang_vel", ang_vel),
-            ("wrench_ff", wrench_ff),
-            ("stiffness", stiffness),
-        ):
-            arr = np.array(value, dtype=float)
+        values = (pos, quat / norm, lin_vel, ang_vel, wrench_ff, stiffness)
+        for name, arr in zip(_FIELDS, values, strict=True):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
         object.__setattr__(self, "damping", None)
