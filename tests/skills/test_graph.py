@@ -294,3 +294,13 @@ def test_with_context_replaces_values_only():
     with pytest.raises(SkillError, match="unknown context"):
         sk.with_context({"force": 3.0})
     assert dataclasses.replace(sk.params.context["depth"], value=0.02) == sk.params.context["depth"]
+
+
+def test_with_fixed_moves_a_learned_parameter_to_the_context():
+    sk = peg_in_hole.build("impedance").with_fixed({"tilt": 0.05})
+    assert "tilt" not in sk.space.names and sk.params.context["tilt"].value == 0.05
+    assert sk.resolve({})["tilt"] == 0.05  # "-tilt" in approach still resolves
+    with pytest.raises(SkillError, match="outside its domain"):
+        peg_in_hole.build("impedance").with_fixed({"tilt": 0.5})
+    with pytest.raises(SkillError, match="unknown learned"):
+        sk.with_fixed({"tilt": 0.05})  # already fixed

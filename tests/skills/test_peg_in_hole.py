@@ -1,7 +1,10 @@
-"""The peg-in-hole skill on the torque-controlled FR3 arm with its default parameters."""
+"""The peg-in-hole skill on the FR3 arm with its default parameters; the key's task context."""
+
+import numpy as np
 
 from teachfit.core.outcome import Outcome
 from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
+from teachfit.skills import peg_in_hole
 from teachfit.tasks import get_task
 
 
@@ -16,3 +19,14 @@ def test_default_skill_inserts_on_the_arm_after_a_real_lateral_move():
     assert run.outcome is Outcome.SUCCESS and out.successes == (True,)
     lateral = next(v for v in run.visits if v.node == "lateral")
     assert lateral.t_exit - lateral.t_enter > setup.skill.params.context["t_settle"].value
+
+
+def test_key_context_fixes_the_tilt_and_learns_the_rest():
+    # seed B (Sec. V) does not learn the key's initial alignment; the other tasks learn it
+    key = get_task("key")
+    ctx = peg_in_hole.hole_context(key, np.random.default_rng(0))
+    assert ctx.fixed == {"tilt": key.params.fixed_tilt}
+    assert ctx.values["drop_depth"] == key.skill_context["drop_depth"]
+    skill = peg_in_hole_setup(key, seed=0, n_starts=1).skill
+    assert "tilt" not in skill.space.names and skill.params.context["tilt"].value == 0.1
+    assert "tilt" in peg_in_hole_setup(get_task("peg"), seed=0, n_starts=1).skill.space.names

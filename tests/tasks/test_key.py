@@ -1,4 +1,4 @@
-"""The ``key`` task: a flat blade into a narrow chamfered slot."""
+"""The ``key`` task: a grooved blade into a narrow warded keyway."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.floating import FloatingToolRobot, build_scene
 from teachfit.tasks import Key, KeyParams, get_task
-from teachfit.tasks.scene.prisms import beyond_edge_block, rectangle
+from teachfit.tasks.scene.prism_hole import KeyScene
+from teachfit.tasks.scene.prisms import beyond_edge_block, chamfered_block, rectangle
 
 STIFF = [300, 300, 300, 50, 50, 50]
 
@@ -37,11 +38,39 @@ def push(robot: FloatingToolRobot, x: float, y: float, rz: float, steps: int = 8
     return robot.step(steps).pose
 
 
-def test_scene_is_four_chamfered_walls(task: Key) -> None:
+def test_scene_is_four_chamfered_walls_and_two_wards(task: Key) -> None:
     model = mujoco.MjModel.from_xml_string(build_scene(task))
     names = {model.geom(i).name for i in range(model.ngeom)}
     walls = {f"slot_wall_{s}" for s in ("east", "west", "north", "south")}
-    assert walls | {"fixture_base", "key_blade", "key_bow"} <= names
+    wards = {"slot_ward_ne", "slot_ward_sw", "key_blade_west", "key_blade_east"}
+    assert walls | wards | {"fixture_base", "key_bow"} <= names
+    plain = mujoco.MjModel.from_xml_string(build_scene(get_task("key", ward_depth=0.0)))
+    assert "key_blade" in {plain.geom(i).name for i in range(plain.ngeom)}
+
+
+def test_blade_profile_is_the_keyway_less_its_clearance(task: Key) -> None:
+    # Z-shaped profile: full thickness in the middle, a ward_depth groove on the north face
+    # east of it and on the south face west of it; each ward stands clearance / 2 off
+    p = task.params
+    west, east = (poly for _, poly in task.blade_pieces())
+    assert west[:, 1].max() == pytest.approx(p.blade_thickness / 2)
+    assert west[:, 1].min() == pytest.approx(-p.blade_thickness / 2 + p.ward_depth)
+    assert east[:, 0].max() == pytest.approx(p.blade_width / 2)
+    assert east[:, 1].max() == pytest.approx(p.blade_thickness / 2 - p.ward_depth)
+    ne = dict(KeyScene(task).hole_wards(0.0, 0.01))["slot_ward_ne"]
+    assert ne[:, 1].min() - east[:, 1].max() == pytest.approx(p.clearance / 2)
+    assert ne[:, 0].min() - west[:, 0].max() == pytest.approx(p.clearance / 2)
+
+
+def test_chamfered_block_lowers_two_edges() -> None:
+    # a 1 x 1 x 1 cube with 0.2 chamfers along two adjacent edges: two prisms of 0.02 and
+    # their 0.2^3 / 3 corner pyramid counted once
+    edges = [(np.array([0.0, 1.0]), -0.5), (np.array([1.0, 0.0]), -0.5)]
+    v = chamfered_block(rectangle(0.5, 0.5), edges, 0.0, 1.0, 0.2)
+    assert ConvexHull(v).volume == pytest.approx(1 - 2 * 0.02 + 0.2**3 / 3, rel=1e-9)
+    assert v[np.isclose(v[:, 0], -0.5), 2].max() == pytest.approx(0.8)
+    with pytest.raises(ValueError, match="empty"):
+        chamfered_block(rectangle(0.5, 0.5), edges, 0.0, 1.0, 2.0)
 
 
 def test_chamfered_walls_leave_the_slot_open() -> None:
@@ -67,9 +96,31 @@ def test_aligned_key_enters(robot, task, rz) -> None:
     assert task.ground_truth_inserted(pose)
 
 
-@pytest.mark.parametrize("offset", [(0.001, 0.0), (0.0, 0.001)])
-def test_chamfers_guide_a_1mm_offset_in(robot, task, offset) -> None:
+# the wards, not the 0.8 mm entry chamfer, set the lateral capture: within clearance / 2 plus
+# the blade's chamfer the chamfers guide the blade in; a plain slot takes 1 mm
+@pytest.mark.parametrize("offset", [(0.0003, 0.0), (-0.0003, 0.0), (0.0, 0.0005), (0.0, -0.0005)])
+def test_chamfers_guide_the_blade_in_within_the_capture(robot, task, offset) -> None:
     assert task.ground_truth_inserted(push(robot, *offset, 0.0))
+
+
+@pytest.mark.parametrize("offset", [(0.0007, 0.0), (-0.0007, 0.0), (0.0, 0.0008), (0.0, -0.0008)])
+def test_wards_block_a_blade_beyond_the_capture(robot, task, offset) -> None:
+    pose = push(robot, *offset, 0.0)
+    assert task.insertion_depth(pose) < task.params.slot_chamfer
+    assert not task.ground_truth_inserted(pose)
+
+
+def test_plain_slot_guides_a_1mm_offset_in() -> None:
+    plain = FloatingToolRobot(get_task("key", ward_depth=0.0))
+    assert plain.task.ground_truth_inserted(push(plain, 0.001, 0.0, 0.0))
+    assert plain.task.ground_truth_inserted(push(plain, 0.0, -0.001, 0.0))
+
+
+def test_key_fixes_the_tilt_and_drops_to_the_chamfer_bottom(task: Key) -> None:
+    p = task.params
+    assert task.skill_fixed == {"tilt": p.fixed_tilt}
+    lift = p.blade_width / 2 * np.sin(p.fixed_tilt)
+    assert task.skill_context["drop_depth"] == pytest.approx(p.slot_chamfer - lift)
 
 
 @pytest.mark.parametrize("offset", [(0.0025, 0.0), (0.0, 0.0025), (-0.002, 0.002)])
@@ -108,6 +159,9 @@ def test_ground_truth_inserted_with_symmetry(task: Key) -> None:
         ({"success_depth": 0.021}, "deeper than the slot"),
         ({"blade_length": 0.0205}, "bow stays above"),
         ({"bow_width": 0.005}, "bow"),
+        ({"ward_depth": 0.001}, "ward_depth"),
+        ({"blade_chamfer": 0.0008}, "grooved blade"),
+        ({"profile_middle": 0.0065}, "profile_middle"),
         ({"demo_offset": 0.018}, "off the lock face"),
         ({"friction": -0.1}, "friction"),
     ],

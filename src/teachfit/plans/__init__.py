@@ -2,7 +2,8 @@
 
 Parametric parts (:mod:`.parts`), mesh-mesh collision (:mod:`.collision`), synthetic
 demonstrations (:mod:`.synth`), key-pose ranking (:mod:`.keyposes`) and the planner loop
-(:mod:`.planner`). Poses are ``L2G``: the moving part ``L`` in the fixed part's frame ``G``.
+(:mod:`.planner`, with its values in :mod:`.plan_types` and the OMPL boundary in
+:mod:`.ompl_space`). Poses are ``L2G``: the moving part ``L`` in the fixed part's frame ``G``.
 """
 
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix

@@ -17,10 +17,11 @@ the process (worker processes included). With a budget in collision checks
 (``PlannerConfig.max_checks``) instead of seconds, a query's result is a function of its
 inputs and seed alone, whatever the machine's speed or load.
 
-Inside this module (the OMPL boundary) states are ``(7,)`` arrays ``[x, y, z, qw, qx, qy, qz]``:
-``L2G`` in m and a unit quaternion. Outside it, poses are :class:`~teachfit.core.geometry.Pose`:
-:attr:`PlanResult.poses` and :meth:`MotionPlanner.dense_poses`. Rotations go through the geometry
-kernel (scipy for batches, its MuJoCo-backed matrix routine in the collision checks).
+Inside this module and :mod:`.ompl_space` (the OMPL boundary) states are ``(7,)`` arrays
+``[x, y, z, qw, qx, qy, qz]``: ``L2G`` in m and a unit quaternion. Outside them, poses are
+:class:`~teachfit.core.geometry.Pose`: :attr:`PlanResult.poses` and
+:meth:`MotionPlanner.dense_poses`. Rotations go through the geometry kernel (scipy for batches,
+its MuJoCo-backed matrix routine in the collision checks).
 """
 
 from __future__ import annotations
@@ -28,12 +29,10 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import ompl.base as ob
 import ompl.geometric as og
-import ompl.util as ou
 from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import PlanningError
@@ -41,14 +40,15 @@ from teachfit.core.geometry import (
     Pose,
     array_to_poses,
     poses_to_array,
-    poses_to_matrices,
     quat_angle,
     rotation_to_wxyz,
     wxyz_to_rotation,
 )
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
 from teachfit.plans.keyposes import KeyPoses, rank_key_poses, straight_chain
+from teachfit.plans.ompl_space import PLANNERS, matrix_to_state, seed_ompl, slerp
 from teachfit.plans.parts import Assembly
+from teachfit.plans.plan_types import PlannerConfig, PlanResult
 
 __all__ = [
     "PLANNERS",
@@ -58,186 +58,6 @@ __all__ = [
     "matrix_to_state",
     "seed_ompl",
 ]
-
-ou.setLogLevel(ou.LogLevel.LOG_ERROR)
-
-PLANNERS: dict[str, Callable[[ob.SpaceInformation], ob.Planner]] = {
-    "RRTConnect": og.RRTConnect,
-    "RRT": og.RRT,
-    "RRTstar": og.RRTstar,
-    "KPIECE1": og.KPIECE1,
-    "BKPIECE1": og.BKPIECE1,
-    "LBKPIECE1": og.LBKPIECE1,
-    "PRM": og.PRM,
-}
-"""OMPL geometric planners selectable by name."""
-
-
-def seed_ompl(seed: int) -> None:
-    """Seed OMPL's global RNG: every OMPL sampler created afterwards draws from ``seed``.
-
-    OMPL derives the seed of each new random generator (a planner's sampler, a path simplifier)
-    from this global one; reseeding after the first draw in a process works (ompl 2.0) but logs
-    an error, which is silenced here. OMPL ignores a seed of 0, so ``seed`` maps to ``seed + 1``.
-
-    Raises
-    ------
-    PlanningError
-        ``seed`` is not an integer in ``[0, 2**32 - 2]``.
-    """
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
-        raise PlanningError(f"seed must be an integer, got {seed!r}")
-    if not 0 <= int(seed) <= 2**32 - 2:
-        raise PlanningError(f"seed must be in [0, 2**32 - 2], got {seed}")
-    level = ou.getLogLevel()
-    ou.setLogLevel(ou.LogLevel.LOG_NONE)
-    try:
-        ou.RNG.setSeed(int(seed) + 1)
-    finally:
-        ou.setLogLevel(level)
-
-
-def _slerp(qa: np.ndarray, qb: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """(N, 4) unit quaternions w-x-y-z from ``qa`` (s = 0) to ``qb`` (s = 1) along the shorter
-    arc, as OMPL's SO(3) interpolation. Written out (the textbook formula) because scipy's
-    ``Slerp`` costs ~0.5 ms to build per segment, and densifying runs per straight motion."""
-    qa = qa / np.linalg.norm(qa)
-    qb = qb / np.linalg.norm(qb)
-    dot = float(qa @ qb)
-    if dot < 0.0:
-        qb, dot = -qb, -dot
-    theta = np.arccos(min(dot, 1.0))
-    if theta < 1e-9:
-        return np.tile(qa, (len(s), 1))
-    wa, wb = np.sin((1.0 - s) * theta), np.sin(s * theta)
-    return (wa[:, None] * qa + wb[:, None] * qb) / np.sin(theta)
-
-
-def matrix_to_state(T: np.ndarray) -> np.ndarray:
-    """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform (scipy's quaternion sign)."""
-    T = np.asarray(T, dtype=float)
-    q = rotation_to_wxyz(Rotation.from_matrix(T[:3, :3]), canonical=False)
-    return np.concatenate([T[:3, 3], q])
-
-
-@dataclass(frozen=True)
-class PlannerConfig:
-    """Settings of :class:`MotionPlanner`.
-
-    Attributes
-    ----------
-    planner : str
-        OMPL planner, a key of :data:`PLANNERS` (paper: a RRT-Connect variant).
-    te : float or None
-        Time budget (s) of one attempt; when exceeded the next key pose is inserted. The paper
-        used 5 s with Panda3D's collision checks in Python; t_e is in effect a budget of
-        samples, ~200 of our checks by default (None): 0.002 s on parts made of boxes (~10 us
-        a check), 0.02 s on meshes (~0.1 ms): RRT-Connect's short detours; the key poses do
-        the rest.
-    max_checks : int or None
-        Budget of one attempt in collision checks instead of ``te`` seconds (``te`` is then
-        ignored): the result of a query no longer depends on the machine's speed or load.
-    resolution : float
-        Longest motion (m; rotations count as the motion of the part's farthest vertex) that
-        OMPL checks without an intermediate state.
-    verify_resolution : float
-        Same, for the final dense verification of the path.
-    shortcut : bool
-        Shortcut the path (OMPL's ``reduceVertices``).
-    smooth_steps : int
-        B-spline smoothing passes (OMPL's ``smoothBSpline``); 0 disables smoothing.
-    repair_samples : int
-        Samples per radius when looking for the collision-free pose nearest a key pose.
-    first_key_poses : int
-        Number of ranked key poses in the first attempt (paper: 0).
-    key_region : float or None
-        Candidate key poses are taken where the demonstrated part is closer than this (m) to
-        the fixed part (the paper's "important area"); 0 takes them anywhere, None uses the
-        assembly's ``key_region``.
-    """
-
-    planner: str = "RRTConnect"
-    te: float | None = None
-    resolution: float = 0.0005
-    verify_resolution: float = 0.0005
-    shortcut: bool = True
-    smooth_steps: int = 2
-    repair_samples: int = 64
-    first_key_poses: int = 0
-    key_region: float | None = None
-    max_checks: int | None = None
-
-    def __post_init__(self) -> None:
-        if self.planner not in PLANNERS:
-            raise PlanningError(f"unknown planner {self.planner!r}; known: {', '.join(PLANNERS)}")
-        te_ok = self.te is None or self.te > 0
-        if not te_ok or not self.resolution > 0 or not self.verify_resolution > 0:
-            raise PlanningError("te, resolution and verify_resolution must be > 0")
-        if self.max_checks is not None and self.max_checks < 1:
-            raise PlanningError(f"max_checks must be >= 1 or None, got {self.max_checks}")
-        if (
-            self.smooth_steps < 0
-            or self.repair_samples < 1
-            or self.first_key_poses < 0
-            or (self.key_region is not None and self.key_region < 0)
-        ):
-            raise PlanningError(
-                "smooth_steps, repair_samples, first_key_poses, key_region must be >= 0"
-            )
-
-
-@dataclass(frozen=True, eq=False)
-class PlanResult:
-    """Outcome of one planning query.
-
-    Attributes
-    ----------
-    success : bool
-        A path was found and passed dense verification.
-    path : (N, 7) float
-        The OMPL states ``[x, y, z, qw, qx, qy, qz]`` of ``L2G`` from start to goal (empty on
-        failure); outside the planner use :attr:`poses`.
-    time_s : float
-        Planning time (s): ranking the key poses and the attempts, up to a collision-free path
-        (what the paper's Table I reports).
-    total_s : float
-        Wall time of the whole query including shortcutting, smoothing and verification (s).
-    attempts : int
-        Attempts made (each with one more key pose than the previous).
-    used_key_poses, candidates, replaced_key_poses : int
-        Key poses in the successful attempt, candidates available, key poses that were in
-        collision and were replaced.
-    collision_checks : int
-        Collision checks made.
-    planner : str
-        OMPL planner used.
-    message : str
-        Why it failed, or ``"ok"``.
-    key_poses : KeyPoses or None
-        The ranked candidates (None without demonstration).
-    """
-
-    success: bool
-    path: np.ndarray
-    time_s: float
-    total_s: float
-    attempts: int
-    used_key_poses: int
-    candidates: int
-    replaced_key_poses: int
-    collision_checks: int
-    planner: str
-    message: str
-    key_poses: KeyPoses | None = None
-
-    @property
-    def poses(self) -> tuple[Pose, ...]:
-        """The path as poses ``L2G`` (m, w-x-y-z) from start to goal (empty on failure)."""
-        return array_to_poses(self.path)
-
-    def L2G(self) -> np.ndarray:
-        """(N, 4, 4) path as homogeneous transforms."""
-        return poses_to_matrices(self.poses)
 
 
 class MotionPlanner:
@@ -625,7 +445,7 @@ class MotionPlanner:
         for a, b in zip(path[:-1], path[1:], strict=True):
             n = max(int(np.ceil(self._distance(a, b[None])[0] / res)), 1)
             s = np.linspace(0.0, 1.0, n + 1)[1:]
-            q = _slerp(a[3:], b[3:], s)
+            q = slerp(a[3:], b[3:], s)
             out.append(np.concatenate([a[:3] + s[:, None] * (b[:3] - a[:3]), q], axis=1))
         return np.concatenate(out)
 

@@ -16,7 +16,7 @@ domain, or a primitive whose resolved values are invalid (e.g. a negative speed)
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from teachfit.core.errors import SkillError
 from teachfit.core.params import ParamSpace
@@ -166,19 +166,12 @@ class Skill:
 
     def with_context(self, values: Mapping[str, float]) -> Skill:
         """The same skill with context parameter values replaced (e.g. from a task)."""
-        return Skill(
-            self.name,
-            self.nodes,
-            self.transitions,
-            self.start,
-            self.params.with_context(values),
-            self.success,
-            self.error,
-            self.pre,
-            self.recovery,
-            self.doc,
-            self.frame,
-        )
+        return replace(self, params=self.params.with_context(values))
+
+    def with_fixed(self, values: Mapping[str, float]) -> Skill:
+        """The same skill with some learned parameters fixed (moved to the context) at
+        ``values``: a task that does not learn them (see :meth:`SkillParams.with_fixed`)."""
+        return replace(self, params=self.params.with_fixed(values))
 
     # ------------------------------------------------------------------------- compiling
     def resolve(self, learned: Mapping[str, float] | None = None) -> dict[str, float]:

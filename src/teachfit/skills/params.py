@@ -119,6 +119,19 @@ class SkillParams:
         }
         return SkillParams(ctx, self.learned)
 
+    def with_fixed(self, values: Mapping[str, float]) -> SkillParams:
+        """A copy in which the learned parameters named in ``values`` are context parameters
+        with those values (each inside its domain): a task that fixes them, as seed B fixes
+        the key's initial tilt (Sec. V). Unknown names and values outside a domain are
+        errors."""
+        checked = self.check_learned(values)
+        ctx = dict(self.context)
+        for n in values:
+            p = self.learned[n]
+            ctx[n] = ContextParam(checked[n], p.unit, f"{p.doc} (fixed by the task, not learned)")
+        lrn = {n: p for n, p in self.learned.items() if n not in values}
+        return SkillParams(ctx, lrn)
+
     def check_learned(
         self, values: Mapping[str, float], users: Mapping[str, Iterable[str]] | None = None
     ) -> dict[str, float]:

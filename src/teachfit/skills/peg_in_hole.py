@@ -32,7 +32,7 @@ its square).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -217,12 +217,14 @@ def build(controller: str = "adaptive") -> Skill:
 # ------------------------------------------------------------------------------ context
 @dataclass(frozen=True)
 class HoleContext:
-    """What the task context gives the skill: the estimated hole frame, the true goal and
-    context parameter values."""
+    """What the task context gives the skill: the estimated hole frame, the true goal,
+    context parameter values and learned parameters the task fixes (``fixed``: name -> value,
+    e.g. the key's initial tilt, which seed B does not learn)."""
 
     hole2world_est: Pose
     goal2world: Pose
     values: dict[str, float]
+    fixed: dict[str, float] = field(default_factory=dict)
 
 
 #: error of the hole-pose estimate when a task has no ``estimated_hole`` of its own
@@ -251,7 +253,8 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
 
 def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     """Context for ``task``: estimated hole pose, goal depth, approach height above the
-    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping."""
+    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping and
+    the learned parameters its optional ``skill_fixed`` mapping fixes."""
     hole = task.hole2world
     est = estimate_hole(task, rng)
     above = float(task.surface_z - hole.pos[2])  # surface above the hole entry (valleys)
@@ -267,7 +270,8 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     }
     values.update(dict(getattr(task, "skill_context", {}) or {}))
     goal = hole.compose(Pose(np.array([0.0, 0.0, -float(task.success_depth)])))
-    return HoleContext(est, goal, values)
+    fixed = {k: float(v) for k, v in (getattr(task, "skill_fixed", {}) or {}).items()}
+    return HoleContext(est, goal, values, fixed)
 
 
 def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:

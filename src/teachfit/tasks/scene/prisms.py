@@ -1,4 +1,4 @@
-"""Convex prisms for polygonal holes and parts (triangle puzzle, key slot).
+"""Convex prisms for polygonal holes and parts (triangle puzzle, key slot and wards).
 
 MuJoCo collides a mesh as its convex hull, so a plate with a convex polygonal hole is built
 from one piece per hole edge: the part of the plate's square outline *beyond* that edge's line,
@@ -129,3 +129,47 @@ def chamfered_prism(poly: np.ndarray, length: float, chamfer: float = 0.0) -> np
         layers.append((poly, 0.0))
     verts = [np.column_stack([pts, np.full(len(pts), z)]) for pts, z in layers]
     return np.unique(np.round(np.concatenate(verts), 12), axis=0)
+
+
+def chamfered_block(
+    outline: np.ndarray,
+    edges: list[tuple[np.ndarray, float]],
+    z_bottom: float,
+    z_top: float,
+    chamfer: float,
+) -> np.ndarray:
+    """Vertices of the prism over ``outline`` with a 45-degree chamfer along several edges.
+
+    Each edge ``(normal, offset)`` is a side of ``outline`` with its outward-into-material
+    unit normal (the solid is ``normal . p >= offset`` there, as for
+    :func:`beyond_edge_block`); its top is lowered to ``z_top - chamfer`` along that edge. The
+    solid is the intersection of half-spaces (the outline's sides, bottom, top and one chamfer
+    plane per edge), so it is convex; its vertices come from scipy's
+    ``HalfspaceIntersection`` (Qhull), with the Chebyshev centre as the interior point.
+    """
+    from scipy.optimize import linprog
+    from scipy.spatial import HalfspaceIntersection
+
+    poly = np.asarray(outline, dtype=float)
+    rows = []  # A x + b <= 0, x = (px, py, z)
+    for i in range(len(poly)):
+        a, b = poly[i], poly[(i + 1) % len(poly)]
+        t = (b - a) / np.linalg.norm(b - a)
+        n = np.array([t[1], -t[0]])  # outward for a counter-clockwise outline
+        rows.append([n[0], n[1], 0.0, -float(a @ n)])
+    rows += [[0.0, 0.0, -1.0, z_bottom], [0.0, 0.0, 1.0, -z_top]]
+    for normal, offset in edges:  # z <= z_top - chamfer + n . p - offset
+        nx, ny = np.asarray(normal, dtype=float)
+        rows.append([-nx, -ny, 1.0, -(z_top - chamfer) + offset])
+    h = np.asarray(rows)
+    norms = np.linalg.norm(h[:, :3], axis=1)
+    lp = linprog(
+        np.r_[0.0, 0.0, 0.0, -1.0],
+        A_ub=np.column_stack([h[:, :3], norms]),
+        b_ub=-h[:, 3],
+        bounds=[(None, None)] * 3 + [(0.0, None)],
+    )
+    if not lp.success or lp.x[3] <= 0:
+        raise ValueError("the chamfered block is empty (chamfer too large for its outline)")
+    verts = HalfspaceIntersection(h, lp.x[:3]).intersections
+    return np.unique(np.round(verts, 12), axis=0)
