@@ -305,6 +305,7 @@ def bench_learning(
     import os
 
     from teachfit.bench import learning as bl
+    from teachfit.bench import learning_scaling as ls
     from teachfit.bench.learning_random import cpu_seconds
     from teachfit.learning.objective import SkillObjective
 
@@ -372,7 +373,7 @@ def bench_learning(
         )
     if speedup_trials > 0 and n_w > 1:
         with console.status(f"speed-up: {speedup_trials} trials with 1 and {n_w} workers"):
-            t1, tn, ratio = bl.speedup(
+            t1, tn, ratio = ls.speedup(
                 trials=speedup_trials, workers=n_w, seed=seed, n_starts=starts
             )
         text += (
@@ -406,12 +407,12 @@ def _bench_scaling(
     """``bench learning --scaling``: trials/s with 1, 2, 4, ... workers, in one run."""
     import os
 
-    from teachfit.bench import learning as bl
+    from teachfit.bench import learning_scaling as ls
 
     counts = _worker_counts(workers)
     task = tasks.split(",")[0]
     with console.status(f"scaling: {task}, {trials} trial(s) per worker, {counts} workers"):
-        rows = bl.scaling(
+        rows = ls.scaling(
             counts, task=task, trials_per_worker=trials, n_starts=starts, seed=seed, ray=ray
         )
     where = f"Ray at {ray}" if ray else "a local process pool per count (start-up included)"
@@ -419,7 +420,7 @@ def _bench_scaling(
         f"`teachfit bench learning --scaling --tasks {task} --scaling-workers {workers} "
         f"--scaling-trials {trials} --starts {starts}{f' --ray {ray}' if ray else ''}`: "
         f"Latin hypercube trials on {where}; this machine has {os.cpu_count()} cores, "
-        f"1-min load average {os.getloadavg()[0]:.1f}\n\n" + bl.scaling_markdown(rows)
+        f"1-min load average {os.getloadavg()[0]:.1f}\n\n" + ls.scaling_markdown(rows)
     )
     print_markdown(text)
     if markdown is not None:
