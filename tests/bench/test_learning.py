@@ -106,6 +106,7 @@ def test_an_interrupted_grid_resumes_from_its_studies(tmp_path: Path) -> None:
     assert len(list(tmp_path.glob("*.db"))) == 1  # the grid stopped there
     whole = run_learning_bench(["key"], ["cmaes"], 2, 2, on_trial=interrupt, **kw)
     assert len(seen) == 1 + 1 + 2  # the stored trial was kept, not run again
+    assert [e.restored for e in whole.experiments] == [1, 0]
     assert len(list(tmp_path.glob("key-cmaes-s*.db"))) == 2
     fresh = run_learning_bench(["key"], ["cmaes"], 1, 2, workers=0, n_starts=1)
     assert whole.experiments[0].costs == fresh.experiments[0].costs

@@ -73,6 +73,8 @@ class Experiment:
     best_params: dict[str, float]
     wall_s: float
     n_starts: int = 1
+    #: trials read back from a stored study (not run, nor timed, in this call)
+    restored: int = 0
 
     @staticmethod
     def from_records(
@@ -82,6 +84,7 @@ class Experiment:
         recs: Sequence[TrialRecord],
         wall_s: float,
         n_starts: int = 1,
+        restored: int = 0,
     ) -> Experiment:
         if not recs:
             raise LearningError(f"{task}/{method} seed {seed}: no trial finished")
@@ -98,6 +101,7 @@ class Experiment:
             dict(best.params),
             wall_s,
             n_starts,
+            restored,
         )
 
     @property
@@ -149,7 +153,7 @@ class CellStats:
         best = np.array([e.costs[e.best_index] for e in exps])
         ok = [e for e in exps if e.first_feasible is not None]
         ins = [e.costs[e.best_index] for e in ok]
-        n_trials = sum(len(e.costs) for e in exps)
+        n_trials = sum(len(e.costs) - e.restored for e in exps)  # the ones timed here
         wall = float(np.mean([e.wall_s for e in exps]))
         ci = band([[b] for b in best])  # t interval of the mean best cost over experiments
         return CellStats(
@@ -252,7 +256,13 @@ def run_experiment(
             what = f"{objective.task}/{method} seed {objective.seed}"
             raise BenchInterrupted(f"{what} interrupted; {kept}")
         return Experiment.from_records(
-            objective.task, method, objective.seed, study.trials(), wall, objective.n_starts
+            objective.task,
+            method,
+            objective.seed,
+            study.trials(),
+            wall,
+            objective.n_starts,
+            study.n_restored,
         )
 
 
