@@ -2,14 +2,23 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import os
+import signal
 from pathlib import Path
 
 import numpy as np
+import pytest
 from media_checks import read_png
 from typer.testing import CliRunner
 
-from teachfit.bench.learning import run_learning_bench, to_markdown
+from teachfit.bench.learning import (
+    BenchInterrupted,
+    ordering,
+    run_learning_bench,
+    to_markdown,
+)
 from teachfit.cli import app
 from teachfit.learning.objective import SkillObjective
 from teachfit.viz.learning_figures import plot_best_execution, plot_learning_curves
@@ -54,15 +63,53 @@ def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
         # wall figures are printed by the benchmark; here only their arithmetic is checked
         assert math.isclose(cell.wall_s, float(np.mean([e.wall_s for e in exps])))
         assert math.isclose(cell.trials_per_s, 12 / sum(e.wall_s for e in exps))
+        # the mean best cost's 95 % t interval over the 2 experiments, and every execution
+        half = 12.706 * cell.best_cost_sd / math.sqrt(2)
+        assert math.isclose(cell.best_cost_high - cell.best_cost_mean, half, rel_tol=1e-3)
+        assert cell.executions == 12
+        ok = sum(round(r) for e in exps for r in e.success_rate)
+        assert cell.executions_ok == ok
     text = to_markdown(bench)
     rows = [ln for ln in text.splitlines() if ln.startswith("| key |")]
     assert [r.split(" | ")[1] for r in rows] == ["cmaes", "lhs"]
     for row, cell in zip(rows, bench.cells, strict=True):
         assert f"| {100 * cell.best_success:.0f} % |" in row
+        assert f"{cell.best_cost_mean:.3f} [{cell.best_cost_low:.3f}, " in row
+        assert f"| {cell.n - cell.never_feasible}/2 | {cell.executions_ok}/12 = " in row
+    assert "- ordering on key (mean best cost, s): **" in text
+    # ordering: "<" only between intervals that do not overlap
+    a, b = bench.cells
+    apart = [
+        dataclasses.replace(a, best_cost_mean=1.0, best_cost_low=0.9, best_cost_high=1.1),
+        dataclasses.replace(b, best_cost_mean=2.0, best_cost_low=1.5, best_cost_high=2.5),
+    ]
+    assert ordering(apart) == {"key": "cmaes < lhs"}
+    close = [dataclasses.replace(apart[0], best_cost_high=1.6), apart[1]]
+    assert ordering(close[::-1]) == {"key": "cmaes ≈ lhs"}
     path = plot_learning_curves(
         {(c.task, c.method): c.curve for c in bench.cells}, tmp_path / "fig6.png"
     )
     read_png(path, min_px=300)
+
+
+def test_an_interrupted_grid_resumes_from_its_studies(tmp_path: Path) -> None:
+    seen: list[str] = []
+
+    def interrupt(label: str, _r: object) -> None:
+        seen.append(label)
+        if len(seen) == 1:  # Ctrl-C during the first experiment, after its first trial
+            os.kill(os.getpid(), signal.SIGINT)
+
+    kw = {"workers": 0, "n_starts": 1, "studies": tmp_path}
+    with pytest.raises(BenchInterrupted, match="key/cmaes seed 0 interrupted; its 1 finished"):
+        run_learning_bench(["key"], ["cmaes"], 2, 2, on_trial=interrupt, **kw)
+    assert len(list(tmp_path.glob("*.db"))) == 1  # the grid stopped there
+    whole = run_learning_bench(["key"], ["cmaes"], 2, 2, on_trial=interrupt, **kw)
+    assert len(seen) == 1 + 1 + 2  # the stored trial was kept, not run again
+    assert [e.restored for e in whole.experiments] == [1, 0]
+    assert len(list(tmp_path.glob("key-cmaes-s*.db"))) == 2
+    fresh = run_learning_bench(["key"], ["cmaes"], 1, 2, workers=0, n_starts=1)
+    assert whole.experiments[0].costs == fresh.experiments[0].costs
 
 
 def _bench(*args: str) -> object:
@@ -74,6 +121,7 @@ def test_bench_learning_cli_and_best_execution_figure(tmp_path: Path) -> None:
     res = _bench(
         *("--methods", "lhs", "--experiments", "2", "--trials", "3", "--starts", "1"),
         *("--workers", "0", "--speedup-trials", "0", "--plot", str(fig), "--markdown", str(md)),
+        *("--out", str(tmp_path / "studies")),
     )
     assert res.exit_code == 0, res.output
     # the table written is the library's for the same settings, but for the wall-time columns
@@ -82,6 +130,7 @@ def test_bench_learning_cli_and_best_execution_figure(tmp_path: Path) -> None:
     want = next(ln for ln in expected.splitlines() if ln.startswith("| key | lhs |"))
     assert row.split(" | ")[:7] == want.split(" | ")[:7]
     read_png(fig, min_px=300)
+    assert "per CPU-s" in res.output and len(list((tmp_path / "studies").glob("*.db"))) == 2
     res = _bench("--methods", "sgd", "--experiments", "1", "--trials", "2")
     assert res.exit_code == 2 and "unknown method(s) ['sgd']" in res.output
     obj = SkillObjective("key", n_starts=1)

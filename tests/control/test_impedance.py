@@ -3,6 +3,7 @@ import pytest
 
 from teachfit.control.impedance import (
     CartesianImpedance,
+    DampingMemo,
     ImpedanceLimits,
     aligned_stiffness,
     critical_damping,
@@ -28,6 +29,22 @@ def test_critical_damping_matches_scalar_formula():
     m = np.array([1.0, 1.0, 4.0, 0.01, 0.01, 0.04])
     d = critical_damping(k, m, 1.0)
     assert np.allclose(np.diag(d), 2 * np.sqrt(np.diag(k) * m))
+
+
+def test_remembered_damping_is_the_computed_one():
+    """DampingMemo returns critical_damping's bits, recomputed when the gains change."""
+    rng = np.random.default_rng(2)
+    m = np.array([1.0, 1.0, 1.0, 0.004, 0.004, 0.004])
+    memo = DampingMemo(m)
+    for _ in range(20):
+        a = rng.normal(size=(6, 6))
+        k = a @ a.T * 100.0
+        for ratio in (1.0, 0.7):
+            want = critical_damping(k, m, ratio)
+            assert np.array_equal(memo(k, ratio), want)
+            assert np.array_equal(memo(k.copy(), ratio), want)  # same values: remembered
+    diag = np.diag([100.0, 200.0, 300.0, 1.0, 2.0, 3.0])
+    assert np.array_equal(memo(diag, 1.0), critical_damping(diag, m, 1.0))
 
 
 def test_wrench_limits_hold():

@@ -132,3 +132,29 @@ def test_peg_in_hole_context_from_task(task):
     assert 0 < np.hypot(*off[:2]) < 0.004  # a realistic, sub-4-mm taught error
     starts = peg_in_hole.default_starts(task, 4, rng)
     assert len(starts) == 4 and all(s.pos[2] > task.surface_z + 0.02 for s in starts)
+
+
+def test_the_fast_command_path_leaves_an_execution_unchanged(task, monkeypatch):
+    """A task frame yawed off the world: the engine's task-frame stiffness is a full (6, 6)
+    matrix; its unchecked command and the remembered damping give the very same execution
+    as the checked constructor and a fresh ``critical_damping`` every command."""
+    from teachfit.control import impedance
+    from teachfit.core.state import ImpedanceCommand
+
+    setup = peg_in_hole_setup(task, seed=1, controller="adaptive")
+    est = setup.task.hole2world.compose(Pose.from_xyz_rz(8e-4, -6e-4, 0.0, 0.4))
+    setup = dataclasses.replace(setup, task2world=est)
+    trial = SkillTrial(setup, controller="adaptive", seed=1)
+    fast = trial(starts=setup.starts[:1]).traces[0]
+    monkeypatch.setattr(
+        ImpedanceCommand, "from_diagonal_frame", lambda *a: ImpedanceCommand(*a[:6])
+    )
+    monkeypatch.setattr(
+        impedance.DampingMemo,
+        "__call__",
+        lambda self, k, r: impedance.critical_damping(k, self.mass, r),
+    )
+    ref = SkillTrial(setup, controller="adaptive", seed=1)(starts=setup.starts[:1]).traces[0]
+    assert fast.outcome == ref.outcome and fast.steps == ref.steps > 100
+    for name in ("pos", "quat", "wrench", "setpoint_pos"):
+        assert np.array_equal(getattr(fast.log, name), getattr(ref.log, name)), name

@@ -57,11 +57,27 @@ def test_each_learner_improves_within_a_small_budget(method: str) -> None:
         assert best < 0.03
 
 
-def test_gp_bayesian_optimisation_is_the_default_and_learns() -> None:
+def test_gp_bayesian_optimisation_is_the_default_and_learns(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    torch = pytest.importorskip("torch")
     learner = make_learner("bo", SPACE, seed=1, options={"n_startup": 4})
-    assert type(learner._study.sampler).__name__ == "GPSampler"
-    costs = drive(learner, 12)  # 8 GP-guided trials after 4 random ones
+    sampler = learner._study.sampler
+    assert type(sampler).__name__ == "GPSampler"
+    threads, fit = [], sampler.sample_relative
+    monkeypatch.setattr(
+        sampler, "sample_relative", lambda *a: threads.append(torch.get_num_threads()) or fit(*a)
+    )
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        costs = drive(learner, 12)  # 8 GP-guided trials after 4 random ones
+        after = torch.get_num_threads()
+    finally:
+        torch.set_num_threads(before)
     assert min(costs[4:]) < 0.02 < min(costs[:4])
+    # the GP works on one thread (its tensors are small), and the caller keeps its count
+    assert threads == [1] * 12 and after == 2
 
 
 @pytest.mark.parametrize("method", ["cmaes", "pso", "lhs"])

@@ -220,3 +220,35 @@ def test_a_study_file_that_is_no_database_is_one_clear_error(tmp_path: Path) -> 
         stored_tags(cut)
     with pytest.raises(LearningError, match="is a folder"):
         storage_url(tmp_path)
+
+
+def test_an_sqlite_study_reads_only_new_trials_and_all_after_a_foreign_one(
+    tmp_path: Path,
+) -> None:
+    """Two openers of one SQLite study: each sync sees what the other stored (read above the
+    last trial id seen), and a trial some other writer left unfinished makes it read all."""
+    import optuna
+
+    url = f"sqlite:///{tmp_path / 's.db'}"
+    a, b = open_shared(url, "lhs"), open_shared(url, "lhs")
+
+    def store(study: Study) -> None:
+        cand = study.ask(8)
+        assert cand is not None
+        study.tell(cand, TrialResult(*cost(study.params_of(cand))))
+
+    for n in (1, 2, 3):
+        store(a)
+        b.sync()
+        assert b.n_finished == n and len(b.trials()) == n
+    assert b._read_above is not None  # incremental
+    raw = optuna.load_study(study_name="teachfit", storage=url)
+    raw.ask()  # a RUNNING trial: it may finish later under a lower id than new ones
+    store(a)
+    b.sync()
+    assert b._read_above is None and b.n_finished == 4  # fell back to full reads
+    store(a)
+    b.sync()
+    assert b.n_finished == 5 and [t.key for t in b.trials()] == [t.key for t in a.trials()]
+    a.close()
+    b.close()

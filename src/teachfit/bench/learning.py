@@ -12,6 +12,8 @@ on the real robot), and wall time and trials/s on this machine.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 import os
 import tempfile
@@ -22,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from teachfit.bench.learning_table import ordering, to_markdown
 from teachfit.core.params import LearningError
 from teachfit.learning.curves import Band, band, best_so_far, first_feasible
 from teachfit.learning.objective import SkillObjective
@@ -29,18 +32,21 @@ from teachfit.learning.runner import run_study
 from teachfit.learning.study import METHODS, Study, TrialRecord
 
 __all__ = [
+    "BenchInterrupted",
     "CellStats",
     "Experiment",
     "LearningBench",
     "method_options",
+    "ordering",
     "run_experiment",
     "run_learning_bench",
-    "ScalingRow",
-    "scaling",
-    "scaling_markdown",
-    "speedup",
+    "study_path",
     "to_markdown",
 ]
+
+
+class BenchInterrupted(LearningError):
+    """An experiment of the bench was interrupted (SIGINT / SIGTERM) before its budget."""
 
 
 def method_options(method: str, trials: int) -> dict[str, object]:
@@ -66,10 +72,19 @@ class Experiment:
     success_rate: tuple[float, ...]
     best_params: dict[str, float]
     wall_s: float
+    n_starts: int = 1
+    #: trials read back from a stored study (not run, nor timed, in this call)
+    restored: int = 0
 
     @staticmethod
     def from_records(
-        task: str, method: str, seed: int, recs: Sequence[TrialRecord], wall_s: float
+        task: str,
+        method: str,
+        seed: int,
+        recs: Sequence[TrialRecord],
+        wall_s: float,
+        n_starts: int = 1,
+        restored: int = 0,
     ) -> Experiment:
         if not recs:
             raise LearningError(f"{task}/{method} seed {seed}: no trial finished")
@@ -85,6 +100,8 @@ class Experiment:
             tuple(r.info.get("success_rate", 0.0) for r in recs),
             dict(best.params),
             wall_s,
+            n_starts,
+            restored,
         )
 
     @property
@@ -96,6 +113,11 @@ class Experiment:
     @property
     def first_feasible(self) -> int | None:
         return first_feasible(self.feasible)
+
+    @property
+    def executions_ok(self) -> int:
+        """Executions that succeeded, over all trials."""
+        return sum(round(r * self.n_starts) for r in self.success_rate)
 
     def sim_min_until(self, trial: int | None) -> float:
         """Simulated robot minutes of trials 1..``trial`` (NaN for ``None``)."""
@@ -111,6 +133,8 @@ class CellStats:
     n: int
     best_cost_mean: float
     best_cost_sd: float
+    best_cost_low: float
+    best_cost_high: float
     best_success: float
     first_feasible_mean: float
     never_feasible: int
@@ -121,20 +145,25 @@ class CellStats:
     wall_s: float
     trials_per_s: float
     curve: Band = field(repr=False)
+    executions_ok: int = 0
+    executions: int = 0
 
     @staticmethod
     def of(exps: Sequence[Experiment]) -> CellStats:
         best = np.array([e.costs[e.best_index] for e in exps])
         ok = [e for e in exps if e.first_feasible is not None]
         ins = [e.costs[e.best_index] for e in ok]
-        n_trials = sum(len(e.costs) for e in exps)
+        n_trials = sum(len(e.costs) - e.restored for e in exps)  # the ones timed here
         wall = float(np.mean([e.wall_s for e in exps]))
+        ci = band([[b] for b in best])  # t interval of the mean best cost over experiments
         return CellStats(
             exps[0].task,
             exps[0].method,
             len(exps),
             float(best.mean()),
             float(best.std(ddof=1)) if len(exps) > 1 else 0.0,
+            float(ci.low[0]),
+            float(ci.high[0]),
             float(np.mean([e.success_rate[e.best_index] for e in exps])),
             float(np.mean([e.first_feasible for e in ok])) if ok else math.nan,
             len(exps) - len(ok),
@@ -145,6 +174,8 @@ class CellStats:
             wall,
             n_trials / (wall * len(exps)) if wall > 0 else math.nan,
             band([best_so_far(e.costs) for e in exps]),
+            sum(e.executions_ok for e in exps),
+            sum(len(e.costs) * e.n_starts for e in exps),
         )
 
 
@@ -172,8 +203,9 @@ def run_experiment(
     ray: str | None = None,
 ) -> Experiment:
     """One learning run of ``trials`` trials; the study goes to ``storage`` (default: a
-    temporary SQLite file, removed afterwards). ``ray``: run the trials on Ray (``"local"``
-    or the address of a running cluster), ``workers`` of them at once."""
+    temporary SQLite file, removed afterwards), and a study stored there before is resumed
+    (its finished trials kept, only the rest run). ``ray``: run the trials on Ray
+    (``"local"`` or the address of a running cluster), ``workers`` of them at once."""
     if method not in METHODS:
         raise LearningError(f"unknown method {method!r}; known: {list(METHODS)}")
     with tempfile.TemporaryDirectory(prefix="teachfit-bench-", dir=_ram_dir()) as tmp:
@@ -187,7 +219,7 @@ def run_experiment(
             seed=objective.seed,
             options=method_options(method, trials),
             penalty=objective.penalty,
-            resume=False,
+            resume=storage is not None,
             context=objective.context(),
             name=f"{objective.task}-{method}-{objective.seed}",
         )
@@ -195,7 +227,7 @@ def run_experiment(
         if ray is not None:
             from teachfit.learning.ray_runner import run_study_ray
 
-            run_study_ray(
+            report = run_study_ray(
                 study,
                 objective,
                 trials,
@@ -205,7 +237,7 @@ def run_experiment(
                 handle_signals=handle_signals,
             )
         else:
-            run_study(
+            report = run_study(
                 study,
                 objective,
                 trials,
@@ -215,7 +247,33 @@ def run_experiment(
             )
         wall = time.perf_counter() - t0
         study.close()
-        return Experiment.from_records(objective.task, method, objective.seed, study.trials(), wall)
+        if report.interrupted:  # the rest of a grid must not run on (nor count it whole)
+            kept = (
+                f"its {study.n_finished} finished trials are in {storage}: the same command resumes"
+                if storage is not None
+                else "its trials are discarded (keep studies to resume)"
+            )
+            what = f"{objective.task}/{method} seed {objective.seed}"
+            raise BenchInterrupted(f"{what} interrupted; {kept}")
+        return Experiment.from_records(
+            objective.task,
+            method,
+            objective.seed,
+            study.trials(),
+            wall,
+            objective.n_starts,
+            study.n_restored,
+        )
+
+
+def study_path(folder: str | Path, objective: SkillObjective, method: str, trials: int) -> Path:
+    """Where :func:`run_learning_bench` keeps one experiment's study in ``folder``: named by
+    task, method and seed, plus a digest of everything else the study is tagged with (skill,
+    controller, robot, starts, task overrides, the method's options), so that other settings
+    never meet a stored study of different ones and the same settings resume it."""
+    tags = [objective.skill, objective.context(), method_options(method, trials)]
+    digest = hashlib.sha1(json.dumps(tags, sort_keys=True).encode()).hexdigest()[:10]
+    return Path(folder) / f"{objective.task}-{method}-s{objective.seed}-{digest}.db"
 
 
 def _ram_dir() -> str | None:
@@ -243,9 +301,12 @@ def run_learning_bench(
     on_trial: Callable[[str, TrialRecord], None] | None = None,
     robot: str = "floating",
     ray: str | None = None,
+    studies: str | Path | None = None,
 ) -> LearningBench:
     """Every task x method x experiment; ``on_trial(label, record)`` reports progress;
-    ``ray``: trials on Ray (see :func:`run_experiment`)."""
+    ``ray``: trials on Ray (see :func:`run_experiment`). ``studies``: a folder keeping each
+    experiment's study (:func:`study_path`), so that an interrupted grid resumes where it
+    stopped (``None``: throw-away studies)."""
     if experiments < 1 or trials < 1:
         raise LearningError(f"experiments and trials must be >= 1, got {experiments}, {trials}")
     bad = [m for m in methods if m not in METHODS]
@@ -268,8 +329,11 @@ def run_learning_bench(
                 )
                 label = f"{task}/{method} #{e + 1}"
                 cb = None if on_trial is None else (lambda r, lb=label: on_trial(lb, r))
+                db = None if studies is None else study_path(studies, obj, method, trials)
                 mine.append(
-                    run_experiment(obj, method, trials, workers=workers, on_trial=cb, ray=ray)
+                    run_experiment(
+                        obj, method, trials, workers=workers, on_trial=cb, ray=ray, storage=db
+                    )
                 )
             cells.append(CellStats.of(mine))
             exps.extend(mine)
@@ -283,124 +347,3 @@ def _cores() -> int:
     import os
 
     return os.cpu_count() or 1
-
-
-def speedup(
-    task: str = "puzzle",
-    method: str = "cmaes",
-    trials: int = 24,
-    workers: int = 2,
-    n_starts: int = 4,
-    seed: int = 0,
-    repeats: int = 2,
-) -> tuple[float, float, float]:
-    """Wall time (s) of the same study with 1 and with ``workers`` workers, and the ratio.
-
-    The runs alternate (1, N, 1, N, ...) ``repeats`` times and each count keeps its fastest
-    run: on a machine shared with other work the minimum is the least disturbed estimate.
-    """
-    obj = SkillObjective(task, seed=seed, n_starts=n_starts)
-    t1 = tn = math.inf
-    for _ in range(max(1, repeats)):
-        t1 = min(t1, run_experiment(obj, method, trials, workers=1).wall_s)
-        tn = min(tn, run_experiment(obj, method, trials, workers=workers).wall_s)
-    return t1, tn, t1 / tn
-
-
-@dataclass(frozen=True)
-class ScalingRow:
-    """One worker count of :func:`scaling`: ``trials`` trials in ``wall_s`` seconds."""
-
-    workers: int
-    trials: int
-    wall_s: float
-
-    @property
-    def trials_per_s(self) -> float:
-        return self.trials / self.wall_s if self.wall_s > 0 else math.nan
-
-
-def scaling(
-    workers: Sequence[int] = (1, 2, 4),
-    *,
-    task: str = "puzzle",
-    trials_per_worker: int = 6,
-    n_starts: int = 1,
-    seed: int = 0,
-    ray: str | None = None,
-) -> list[ScalingRow]:
-    """Trials/s of a learning study with each worker count, measured in one run.
-
-    Each count runs ``trials_per_worker * workers`` trials of a Latin hypercube study (no
-    generation barrier: this measures the runner, not a learner's parallelism). With ``ray``
-    the counts share one Ray connection, and a warm-up study on ``max(workers)`` workers
-    first starts the Ray workers and builds their MuJoCo scenes, so the figures are trials
-    alone. Without it each count starts a fresh local process pool (start-up included).
-    """
-    counts = sorted({int(w) for w in workers})
-    if not counts or counts[0] < 1 or trials_per_worker < 1:
-        raise LearningError(f"need worker counts >= 1 and trials >= 1, got {workers}")
-    obj = SkillObjective(task, seed=seed, n_starts=n_starts)
-    started = False
-    if ray is not None:
-        from teachfit.learning.ray_runner import _init, import_ray
-
-        started = _init(import_ray(), ray, counts[-1])
-    try:
-        if ray is not None:
-            run_experiment(obj, "lhs", counts[-1], workers=counts[-1], ray=ray)  # warm-up
-        rows = []
-        for w in counts:
-            n = trials_per_worker * w
-            exp = run_experiment(obj, "lhs", n, workers=w, ray=ray)
-            rows.append(ScalingRow(w, len(exp.costs), exp.wall_s))
-        return rows
-    finally:
-        if started:
-            import_ray().shutdown()
-
-
-def scaling_markdown(rows: Sequence[ScalingRow]) -> str:
-    """The scaling as a markdown table: speed-up over the fewest workers, and per worker."""
-    base = rows[0]
-    head = (
-        "| workers | trials | wall (s) | trials/s | speed-up | per worker (x linear) |\n"
-        "|---|---|---|---|---|---|\n"
-    )
-    lines = []
-    for r in rows:
-        up = r.trials_per_s / base.trials_per_s
-        per = up * base.workers / r.workers
-        lines.append(
-            f"| {r.workers} | {r.trials} | {r.wall_s:.1f} | {r.trials_per_s:.2f} | "
-            f"x{up:.2f} | {per:.2f} |"
-        )
-    return head + "\n".join(lines) + "\n"
-
-
-def _pm(mean: float, sd: float) -> str:
-    return f"{mean:.3f} ± {sd:.3f}"
-
-
-def _f(x: float, fmt: str = ".2f") -> str:
-    return "–" if math.isnan(x) else format(x, fmt)
-
-
-def to_markdown(bench: LearningBench) -> str:
-    """The grid as a markdown table (one row per task x method)."""
-    head = (
-        "| task | method | best cost (s) | success of best | first feasible (trial) | "
-        "insertion time (s) | robot time to feasible / best / all (min) | wall (s) | "
-        "trials/s |\n|---|---|---|---|---|---|---|---|---|\n"
-    )
-    rows = []
-    for c in bench.cells:
-        never = f" ({c.never_feasible} never)" if c.never_feasible else ""
-        rows.append(
-            f"| {c.task} | {c.method} | {_pm(c.best_cost_mean, c.best_cost_sd)} | "
-            f"{100 * c.best_success:.0f} % | {_f(c.first_feasible_mean, '.1f')}{never} | "
-            f"{_f(c.insertion_time, '.3f')} | {_f(c.sim_feasible_min)} / "
-            f"{_f(c.sim_best_min)} / {_f(c.sim_total_min)} | {c.wall_s:.1f} | "
-            f"{c.trials_per_s:.2f} |"
-        )
-    return head + "\n".join(rows) + "\n"

@@ -26,7 +26,14 @@ from teachfit.learning.objective import SkillObjective
 from teachfit.learning.study import TrialRecord
 from teachfit.metrics.stats import wilson_interval
 
-__all__ = ["GRID", "RandomRate", "grid_projection", "random_rate", "random_rate_markdown"]
+__all__ = [
+    "GRID",
+    "RandomRate",
+    "cpu_seconds",
+    "grid_projection",
+    "random_rate",
+    "random_rate_markdown",
+]
 
 #: the issue's full Fig. 6 grid: tasks x methods x experiments x trials x starts
 GRID = (3, 4, 5, 130, 4)
@@ -55,7 +62,7 @@ class RandomRate:
         return self.executions / self.cpu_s if self.cpu_s > 0 else math.nan
 
 
-def _cpu_s() -> float:
+def cpu_seconds() -> float:
     """CPU seconds (user + system) of this process and its finished children."""
     own = resource.getrusage(resource.RUSAGE_SELF)
     kids = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -79,7 +86,7 @@ def random_rate(
         raise LearningError(f"trials and experiments must be >= 1, got {trials}, {experiments}")
     ov = tuple(sorted((overrides or {}).items()))
     ok = execs = feasible = n = 0
-    cpu0, wall0 = _cpu_s(), time.perf_counter()
+    cpu0, wall0 = cpu_seconds(), time.perf_counter()
     for e in range(experiments):
         obj = SkillObjective(task, seed=seed + e, n_starts=n_starts, task_overrides=ov)
         exp = run_experiment(obj, "lhs", trials, workers=workers, on_trial=on_trial)
@@ -90,7 +97,7 @@ def random_rate(
         n += len(exp.costs)
     lo, hi = wilson_interval(ok, execs)
     return RandomRate(
-        task, ok, execs, feasible, n, lo, hi, _cpu_s() - cpu0, time.perf_counter() - wall0
+        task, ok, execs, feasible, n, lo, hi, cpu_seconds() - cpu0, time.perf_counter() - wall0
     )
 
 

@@ -292,11 +292,21 @@ def bench_learning(
             "experiment succeed on each task, and the throughput (0: run the grid)",
         ),
     ] = 0,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "--out",
+            help="folder keeping every experiment's study (SQLite): the same command "
+            "resumes an interrupted grid from it",
+        ),
+    ] = Path("out/bench_learning/studies"),
 ) -> None:
     """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
     import os
 
     from teachfit.bench import learning as bl
+    from teachfit.bench import learning_scaling as ls
+    from teachfit.bench.learning_random import cpu_seconds
     from teachfit.learning.objective import SkillObjective
 
     _worker_counts(scaling_workers)  # refused before any work, with --scaling or not
@@ -310,6 +320,13 @@ def bench_learning(
         return
     method_list = [m for m in methods.split(",") if m]
     total = len(task_list) * len(method_list) * experiments * trials
+    ran = [0]
+    cpu0 = cpu_seconds()
+
+    def tick(label: str) -> None:
+        ran[0] += 1
+        bar.update(job, advance=1, description=label)
+
     with progress_bar() as bar:
         job = bar.add_task("learning", total=total)
         res = bl.run_learning_bench(
@@ -322,20 +339,33 @@ def bench_learning(
             controller=controller,
             seed=seed,
             overrides=dict(_overrides(task_param)),
-            on_trial=lambda label, _r: bar.update(job, advance=1, description=label),
+            on_trial=lambda label, _r: tick(label),
             robot=robot,
             ray=ray,
+            studies=out,
         )
+    cpu = cpu_seconds() - cpu0
     extra = "".join(f" --task-param {p}" for p in task_param or [])
+    done = sum(len(e.costs) for e in res.experiments)
+    kept = (
+        f", {done - ran[0]} trials resumed from {out}: wall and trials/s count the others"
+        if done > ran[0]
+        else ""
+    )
+    execs = ran[0] * starts
     text = (
         f"`teachfit bench learning --tasks {tasks} --methods {methods} --experiments "
         f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
-        f"{os.cpu_count()} cores, {res.wall_s:.0f} s in all)\n\n" + bl.to_markdown(res)
+        f"{os.cpu_count()} cores, {res.wall_s:.0f} s wall and {cpu:.0f} CPU-s in all, "
+        f"{execs} executions: {execs / cpu if cpu > 0 else math.nan:.2f} per CPU-s, "
+        f"learners included{kept})\n\n" + bl.to_markdown(res)
     )
     n_w = workers or os.cpu_count() or 1
     if target:
         done = [e for e in res.experiments if e.task == "puzzle" and e.method == "cmaes"]
-        if done and trials == 130 and starts == 4:
+        if done and trials == 130 and starts == 4 and done[0].restored:
+            wall = math.nan  # resumed from --out: its wall time is not the whole run's
+        elif done and trials == 130 and starts == 4:
             wall = done[0].wall_s
         else:
             with console.status("130-trial x 4-start CMA-ES on puzzle"):
@@ -346,10 +376,12 @@ def bench_learning(
         text += (
             f"\nCMA-ES, 130 trials x 4 starts on puzzle: {wall:.1f} s wall "
             f"({130 / wall:.2f} trials/s, {n_w} workers) -- {verdict} the 5-minute target\n"
+            if math.isfinite(wall)
+            else "\nCMA-ES puzzle 5-minute target: not timed (its experiment was resumed)\n"
         )
     if speedup_trials > 0 and n_w > 1:
         with console.status(f"speed-up: {speedup_trials} trials with 1 and {n_w} workers"):
-            t1, tn, ratio = bl.speedup(
+            t1, tn, ratio = ls.speedup(
                 trials=speedup_trials, workers=n_w, seed=seed, n_starts=starts
             )
         text += (
@@ -383,12 +415,12 @@ def _bench_scaling(
     """``bench learning --scaling``: trials/s with 1, 2, 4, ... workers, in one run."""
     import os
 
-    from teachfit.bench import learning as bl
+    from teachfit.bench import learning_scaling as ls
 
     counts = _worker_counts(workers)
     task = tasks.split(",")[0]
     with console.status(f"scaling: {task}, {trials} trial(s) per worker, {counts} workers"):
-        rows = bl.scaling(
+        rows = ls.scaling(
             counts, task=task, trials_per_worker=trials, n_starts=starts, seed=seed, ray=ray
         )
     where = f"Ray at {ray}" if ray else "a local process pool per count (start-up included)"
@@ -396,7 +428,7 @@ def _bench_scaling(
         f"`teachfit bench learning --scaling --tasks {task} --scaling-workers {workers} "
         f"--scaling-trials {trials} --starts {starts}{f' --ray {ray}' if ray else ''}`: "
         f"Latin hypercube trials on {where}; this machine has {os.cpu_count()} cores, "
-        f"1-min load average {os.getloadavg()[0]:.1f}\n\n" + bl.scaling_markdown(rows)
+        f"1-min load average {os.getloadavg()[0]:.1f}\n\n" + ls.scaling_markdown(rows)
     )
     print_markdown(text)
     if markdown is not None:

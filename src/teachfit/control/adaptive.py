@@ -36,10 +36,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from teachfit.control.impedance import (
+    DampingMemo,
     SetpointError,
     clip_wrench,
     clipped_twist,
-    critical_damping,
 )
 from teachfit.core.control import (
     AdaptiveLimits,
@@ -123,6 +123,7 @@ class AdaptiveImpedance:
         self._sqrt_k0 = np.zeros(6)
         self._k_room = np.zeros(6)
         self._d0 = np.zeros((6, 6))
+        self._damping = DampingMemo(m)
         self._xi = 1.0
         self._error = SetpointError()
         self._fd = np.zeros(6)
@@ -179,7 +180,7 @@ class AdaptiveImpedance:
         np.minimum(self._k_adapt, self._k_room, out=self._k_adapt)
         self._xi = cmd.damping_ratio if self.damping_ratio is None else self.damping_ratio
         if cmd.damping is None:
-            self._d0[:] = critical_damping(self._k0, self.mass, cmd.damping_ratio)
+            self._d0[:] = self._damping(self._k0, cmd.damping_ratio)
         else:
             self._d0[:] = cmd.damping
         self._error.set(cmd, clipped_twist(cmd, ilim), t)

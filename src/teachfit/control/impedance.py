@@ -47,6 +47,24 @@ def critical_damping(stiffness: np.ndarray, mass: np.ndarray, ratio: float) -> n
     return 2.0 * ratio * root * np.outer(sm, sm)
 
 
+class DampingMemo:
+    """:func:`critical_damping` for a fixed apparent ``mass`` (6,), remembered for the last
+    stiffness and ratio: a skill sends the same gains for many 10 ms commands in a row, and
+    the (6, 6) case costs an ``eigh`` each time. Same bits as calling the function."""
+
+    def __init__(self, mass: np.ndarray) -> None:
+        self.mass = mass
+        self._key = b""
+        self._d = np.zeros((6, 6))
+
+    def __call__(self, stiffness: np.ndarray, ratio: float) -> np.ndarray:
+        key = stiffness.tobytes() + np.float64(ratio).tobytes()
+        if key != self._key:
+            self._d = critical_damping(stiffness, self.mass, ratio)
+            self._key = key
+        return self._d
+
+
 def aligned_stiffness(
     direction: np.ndarray,
     along: float,
@@ -169,6 +187,7 @@ class CartesianImpedance:
         # buffers allocated once; the per-tick path below allocates as little as possible
         self._k = np.zeros((6, 6))
         self._d = np.zeros((6, 6))
+        self._damping = DampingMemo(m)
         self._ff = np.zeros(6)
         self._error = SetpointError()
         self._has_cmd = False
@@ -183,7 +202,7 @@ class CartesianImpedance:
         lim = self.limits
         self._k[:] = cmd.stiffness
         if cmd.damping is None:
-            self._d[:] = critical_damping(self._k, self.mass, cmd.damping_ratio)
+            self._d[:] = self._damping(self._k, cmd.damping_ratio)
         else:
             self._d[:] = cmd.damping
         self._error.set(cmd, clipped_twist(cmd, lim), t)

@@ -197,6 +197,7 @@ def execute(
     cmd = MPCommand()
     rot = pc.rot
     k_w = np.zeros((6, 6))
+    k_frame: list = [b"", k_w]  # (bytes of the task-frame k, its world-frame (6, 6), read-only)
     blk = np.zeros((6, 6))
     blk[:3, :3] = rot
     blk[3:, 3:] = rot
@@ -233,21 +234,28 @@ def execute(
         """Command the set-point for the coming period and integrate it (task -> world)."""
         v, w = cmd.twist[:3], cmd.twist[3:]
         pos_w, quat_w = pc.to_world_pose(pc.p_d, pc.q_d)
+        ff = np.concatenate([rot @ cmd.wrench[:3], rot @ cmd.wrench[3:]])
         if cmd.full:
             np.dot(blk, cmd.stiffness_full, out=k_w)
             k_w[:] = k_w @ blk.T
-        else:
-            k = cmd.stiffness
-            k_w[:] = 0.0
-            k_w[:3, :3] = (rot * k[:3]) @ rot.T
-            k_w[3:, 3:] = (rot * k[3:]) @ rot.T
-        ff = np.concatenate([rot @ cmd.wrench[:3], rot @ cmd.wrench[3:]])
-        robot.command(
-            ImpedanceCommand(
+            order = ImpedanceCommand(
                 pos=pos_w, quat=quat_w, lin_vel=rot @ v, ang_vel=rot @ w, wrench_ff=ff,
                 stiffness=k_w,
+            )  # fmt: skip
+        else:  # R diag(k) R^T per block: PSD by construction, the general checks skipped;
+            # built once per distinct k (a primitive holds its gains for many commands)
+            k = cmd.stiffness
+            key = k.tobytes()
+            if key != k_frame[0]:
+                k_new = np.zeros((6, 6))
+                k_new[:3, :3] = (rot * k[:3]) @ rot.T
+                k_new[3:, 3:] = (rot * k[3:]) @ rot.T
+                k_new.setflags(write=False)
+                k_frame[:] = key, k_new
+            order = ImpedanceCommand.from_diagonal_frame(
+                pos_w, quat_w, rot @ v, rot @ w, ff, k_frame[1], k
             )
-        )  # fmt: skip
+        robot.command(order)
         sp_pos[:] = pos_w
         sp_quat[:] = quat_w
         sp_ff[:] = ff
@@ -266,7 +274,7 @@ def execute(
         t = st.t - t0
         pc.update(st, t)
         pc.t_node = t - t_enter
-        if not (np.all(np.isfinite(pc.p)) and np.all(np.isfinite(pc.f))):
+        if not math.isfinite(sum(pc.p.tolist()) + sum(pc.f.tolist())):  # NaN/inf propagate
             raise SimulationDiverged(f"non-finite state at t={t:.3f} s")
         pc.detected = bool(detect(st.pose)) if detect is not None else False
         path += float(np.linalg.norm(pc.pos - last_pos))

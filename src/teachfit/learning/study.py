@@ -233,6 +233,9 @@ class Study:
         self._dists = {
             n: FloatDistribution(d.low, d.high, log=d.log) for n, d in space.domains.items()
         }
+        #: SQLite: id of the last trial read (-1: none yet); None: read all every time
+        self._read_above: int | None = -1 if self.url.startswith("sqlite") else None
+        self._read: list[optuna.trial.FrozenTrial] = []
         finished = self._finished_trials()
         stored = self._optuna.user_attrs
         if not finished:
@@ -268,9 +271,23 @@ class Study:
         # read the database itself, not Optuna's cache of it: the cache skips trials that
         # other processes commit out of id order (concurrent writers of a database server)
         sid = self._optuna._study_id
-        done = (optuna.trial.TrialState.COMPLETE,)
-        trials = _retry(lambda: self._rdb.get_all_trials(sid, deepcopy=False, states=done))
-        return sorted(trials, key=lambda t: (t.number, t._trial_id))
+        complete = optuna.trial.TrialState.COMPLETE
+        if self._read_above is None:
+            trials = _retry(
+                lambda: self._rdb.get_all_trials(sid, deepcopy=False, states=(complete,))
+            )
+            return sorted(trials, key=lambda t: (t.number, t._trial_id))
+        # SQLite serialises its writers (BEGIN IMMEDIATE) and trials are stored finished, so
+        # trial ids become visible in order: read only those above the last one seen. (A full
+        # read costs ~1 ms per stored trial, once a second: ~15 % of a learning run's CPU.)
+        new = _retry(lambda: self._rdb._get_trials(sid, None, set(), self._read_above))
+        if any(t.state != complete for t in new):  # written by something else: read it all
+            self._read_above, self._read = None, []
+            return self._finished_trials()
+        if new:
+            self._read_above = max(t._trial_id for t in new)
+            self._read = sorted([*self._read, *new], key=lambda t: (t.number, t._trial_id))
+        return list(self._read)
 
     # ------------------------------------------------------------------------- trials
     @property

@@ -171,6 +171,7 @@ class FloatingToolRobot:
         self._angvel_local = self.data.qvel[b + 3 : b + 6]
         self._angvel = np.zeros(3)
         self._tare = np.zeros(6)
+        self._bias = np.asarray(self.params.ft_bias, dtype=float)
         self._warnings = 0
         self._warning_numbers = self.data.warning.number
         self._cmd: ImpedanceCommand | None = None
@@ -320,7 +321,7 @@ class FloatingToolRobot:
     def measured_wrench(self) -> np.ndarray:
         """What the wrist F/T sensor reports: its filtered output, tared and biased (N, N·m,
         world, at the TCP); the gauge noise is inside the filter."""
-        return self._raw_wrench() - self._tare + np.asarray(self.params.ft_bias)
+        return self._raw_wrench() - self._tare + self._bias
 
     def true_contact_wrench(self) -> np.ndarray:
         """Tared wrench without the bias (for tests and diagnostics; the filtered gauge noise
@@ -329,7 +330,7 @@ class FloatingToolRobot:
 
     # -------------------------------------------------------------------- divergence
     def _warning_count(self) -> int:
-        return int(self._warning_numbers.sum())  # a view: no Python loop per tick
+        return sum(self._warning_numbers.tolist())  # a view; a list sum beats numpy's here
 
     def _law_output_fault(self, *inputs: np.ndarray) -> None:
         """A non-finite wrench: the law's fault (a :class:`ControlError`) when what it was
@@ -353,6 +354,6 @@ class FloatingToolRobot:
                 f"MuJoCo warning(s) {kinds} at t={self.data.time:.3f} s: simulation invalid"
             )
             raise self._fault
-        if not math.isfinite(float(self.data.qpos.sum()) + float(self.data.qvel.sum())):
+        if not math.isfinite(sum(self.data.qpos.tolist()) + sum(self.data.qvel.tolist())):
             self._fault = SimulationDiverged(f"NaN/inf in the state at t={self.data.time:.3f} s")
             raise self._fault

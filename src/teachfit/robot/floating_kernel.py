@@ -42,11 +42,18 @@ XI, CLIP_F, CLIP_T = k.N_SCALARS, k.N_SCALARS + 1, k.N_SCALARS + 2
 N_SCALARS = k.N_SCALARS + 3
 
 
+#: indices of the routines :func:`run` calls (with :func:`~teachfit.robot.fr3.kernel.fixed_law`):
+#: mju_subQuat, mju_rotVecQuat, mju_quatIntegrate, mj_step, mj_applyFT
+USED = frozenset({6, 7, 8, 12, APPLY_FT})
+
+
 @cache
 def routines() -> tuple:
-    """The FR3 kernel's routines plus ``mj_applyFT`` (index :data:`APPLY_FT`)."""
+    """The FR3 kernel's routines plus ``mj_applyFT`` (index :data:`APPLY_FT`); the ones
+    :func:`run` never calls are ``0``: numba types every ctypes routine of the tuple in Python
+    on each call (~1.6 µs each, per 10 ms command), an integer costs nothing."""
     apply_ft = k._fn("mj_applyFT", _P, _P, _P, _P, _P, ctypes.c_int, _P)
-    return (*k.routines(), apply_ft)
+    return tuple(f if i in USED else 0 for i, f in enumerate((*k.routines(), apply_ft)))
 
 
 @numba.njit(cache=True)

@@ -1,0 +1,89 @@
+"""Seed B's Fig. 6 grid as text: the per-cell table and the methods' ordering per task.
+
+Per task x method (over its experiments, seeds ``seed + e``): the mean best cost with its 95 %
+t interval (s), the best parameters' success rate, how many experiments found a feasible trial
+and the first one (trial number, mean over those that did), the executions of all trials that
+succeeded with their Wilson 95 % interval, insertion time, robot time and wall time. The
+ordering ranks a task's methods by mean best cost; ``<`` separates two neighbours whose
+intervals do not overlap, ``≈`` two whose intervals overlap (not told apart by these
+experiments). Experiment ``e`` of every method uses the same set-up (hole estimate, starts,
+sensor noise), so the comparison is paired; the intervals shown are the unpaired ones, the
+conservative reading.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from teachfit.metrics.stats import wilson_interval
+
+if TYPE_CHECKING:
+    from teachfit.bench.learning import CellStats, LearningBench
+
+__all__ = ["ordering", "ordering_markdown", "to_markdown"]
+
+
+def _f(x: float, fmt: str = ".2f") -> str:
+    return "–" if math.isnan(x) else format(x, fmt)
+
+
+def _ci(c: CellStats) -> str:
+    if c.n < 2:
+        return f"{c.best_cost_mean:.3f}"
+    return f"{c.best_cost_mean:.3f} [{c.best_cost_low:.3f}, {c.best_cost_high:.3f}]"
+
+
+def _executions(c: CellStats) -> str:
+    if c.executions == 0:
+        return "–"
+    lo, hi = wilson_interval(c.executions_ok, c.executions)
+    rate = 100 * c.executions_ok / c.executions
+    return f"{c.executions_ok}/{c.executions} = {rate:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]"
+
+
+def to_markdown(bench: LearningBench) -> str:
+    """The grid as a markdown table (one row per task x method), then the ordering."""
+    head = (
+        "| task | method | best cost (s) [95 % CI] | success of best | first feasible "
+        "(trial) | solved | executions that succeeded [95 % Wilson] | insertion time (s) | "
+        "robot time to feasible / best / all (min) | wall (s) | trials/s |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|\n"
+    )
+    rows = []
+    for c in bench.cells:
+        never = f" ({c.never_feasible} never)" if c.never_feasible else ""
+        rows.append(
+            f"| {c.task} | {c.method} | {_ci(c)} | "
+            f"{100 * c.best_success:.0f} % | {_f(c.first_feasible_mean, '.1f')}{never} | "
+            f"{c.n - c.never_feasible}/{c.n} | {_executions(c)} | "
+            f"{_f(c.insertion_time, '.3f')} | {_f(c.sim_feasible_min)} / "
+            f"{_f(c.sim_best_min)} / {_f(c.sim_total_min)} | {c.wall_s:.1f} | "
+            f"{c.trials_per_s:.2f} |"
+        )
+    return head + "\n".join(rows) + "\n\n" + ordering_markdown(bench.cells)
+
+
+def ordering(cells: Sequence[CellStats]) -> dict[str, str]:
+    """Per task, its methods from the lowest mean best cost up, joined by ``<`` (the two
+    95 % intervals do not overlap) or ``≈`` (they do)."""
+    out: dict[str, str] = {}
+    for task in dict.fromkeys(c.task for c in cells):
+        mine = sorted((c for c in cells if c.task == task), key=lambda c: c.best_cost_mean)
+        text = mine[0].method
+        for a, b in zip(mine, mine[1:], strict=False):
+            apart = a.n > 1 and b.n > 1 and a.best_cost_high < b.best_cost_low
+            text += (" < " if apart else " ≈ ") + b.method
+        out[task] = text
+    return out
+
+
+def ordering_markdown(cells: Sequence[CellStats]) -> str:
+    """:func:`ordering` as lines ``task: a < b ≈ c ...`` with each method's interval."""
+    lines = []
+    for task, text in ordering(cells).items():
+        mine = sorted((c for c in cells if c.task == task), key=lambda c: c.best_cost_mean)
+        detail = ", ".join(f"{c.method} {_ci(c)}" for c in mine)
+        lines.append(f"- ordering on {task} (mean best cost, s): **{text}** ({detail})")
+    return "\n".join(lines) + "\n"
