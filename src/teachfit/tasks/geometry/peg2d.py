@@ -23,6 +23,7 @@ from teachfit.tasks.scene.round_hole import Peg2DScene
 #: at the default friction, which its default sweep suits (see Peg2D.teacher_hints)
 DEFAULT_PITCH, DEFAULT_HALFWIDTH, DEFAULT_FRICTION = 0.0025, 0.015, 0.3
 TEACHER_STIFFNESS, TEACHER_SPEED, TEACHER_LOAD = 600.0, 0.012, 7.0
+GRAVITY = 9.81  # m/s^2
 
 
 @dataclass(frozen=True)
@@ -128,6 +129,12 @@ class Peg2D(Task):
         default cell's follower unchanged). Too soft a follower on a
         high-friction top cuts a tour's turns by the lag and misses holes the plan crosses."""
         return max(1.0, self.params.friction / DEFAULT_FRICTION)
+
+    def sliding_friction(self, push: float) -> float:
+        """Friction force (N) on the peg sliding on the top pressed with ``push`` (N): the
+        friction coefficient times the push plus the peg's weight (2.1 N at the default 0.3
+        and a 6 N push)."""
+        return self.params.friction * (push + GRAVITY * self.scene.peg_mass)
 
     def teacher_hints(self) -> dict[str, float]:
         """The blind teacher's sweep scaled to this cell (m, s; TeacherStyle fields).
