@@ -260,7 +260,8 @@ def _variants(
 
     def finished(r: VariantResult) -> None:  # printed and saved as each variant ends
         done.append(r)
-        console.print(f"{task} {r.variant.label}: " + ", ".join(_variant_cells(r)[-3:]))
+        cells = _variant_cells(r)[-3:] if r.rows else [f"{r.kept}/{r.tried}", r.why]
+        console.print(f"{task} {r.variant.label}: demos {', '.join(cells)}")
         atomic_write_text(out.with_suffix(".json"), sv.results_json(done), "results")
         save_figure(success_by_parameter(sv.figure_data(done), title, sv.GOALS[task]), out)
 
