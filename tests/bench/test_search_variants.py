@@ -1,5 +1,7 @@
-from teachfit.bench.search_variants import figure_data, goal_misses, run_variant
-from teachfit.tasks.variants import Variant
+import json
+
+from teachfit.bench.search_variants import figure_data, goal_misses, results_json, run_variant
+from teachfit.tasks.variants import Variant, variant
 from teachfit.viz.variant_figures import success_by_parameter
 
 
@@ -22,8 +24,11 @@ def test_one_variant_runs_tshix_and_ergodic_on_the_same_starts(tmp_path):
 
 
 def test_without_ergodic_only_the_tshix_row_is_run():
-    v = Variant("peg2d", (("peg_diameter_mm", 20.0), ("friction", 0.3)), ())
+    v = variant("peg2d", peg_diameter_mm=20.0, clearance_mm=0.5, friction=0.3, chamfers=1.0)
     ticks = []
     res = run_variant(v, 0, 1, 8, 0, lambda: ticks.append(1), ergodic=False)  # a short tour
     assert [r.method for r in res.rows] == ["tshix"] and len(ticks) == 1
     assert res.rows[0].ours.trials == 1
+    doc = json.loads(results_json([res]))  # what the CLI saves after each variant
+    assert doc[0]["variant"] == "d20 c0.5 mu0.3 chamfered" and doc[0]["demos_kept"] == 1
+    assert doc[0]["rates"]["tshix"]["trials"] == 1 and "ergodic" not in doc[0]["rates"]

@@ -123,3 +123,21 @@ def test_sharp_edged_holes_are_searched_tilted_chamfered_ones_upright():
         if tilt is not None:
             hole = task.params.peg_diameter + task.params.clearance
             assert tilt.lateral_reach == pytest.approx(hole)
+
+
+def test_feedforward_never_below_the_sliding_friction_while_moving():
+    from teachfit.execution.search import along_motion, friction_floor
+    from teachfit.skills.follow import FollowConfig
+
+    t = np.array([0.0, 1.0, 2.0, 3.0])
+    states = np.array([[0.0, 0.0], [0.01, 0.0], [0.01, 0.01], [0.01, 0.01]])  # +x, +y, rest
+    gmr = np.array([[0.5, 3.0], [4.0, 0.0], [0.0, 0.2], [1.0, 1.0]])
+    out = along_motion(gmr, t, states, ("x", "y"), floor=2.0)
+    assert out[0] == pytest.approx([2.0, 0.0])  # 0.5 N along +x: raised to the floor
+    assert out[1][0] == pytest.approx(out[1][1])  # the turn's direction is the diagonal
+    assert np.linalg.norm(out[1]) == pytest.approx(max(2.0, 4.0 / np.sqrt(2)))
+    assert np.allclose(out[3], 0.0)  # at rest: nothing
+    assert np.allclose(along_motion(gmr, t, states, ("x", "y"))[0], [0.5, 0.0])
+    push = FollowConfig().push_force
+    assert friction_floor(get_task("peg2d"), FollowConfig()) == pytest.approx(0.3 * (push + 0.981))
+    assert friction_floor(get_task("socket3d"), FollowConfig()) == 0.0  # no hint: no floor

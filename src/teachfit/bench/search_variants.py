@@ -10,7 +10,8 @@ starts. A variant whose teacher recorded nothing gets no rows but its discard re
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import json
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,16 +107,21 @@ def run_variants(
     workers: int | None = None,
     progress: Progress = None,
     ergodic: bool = True,
+    on_variant: Callable[[VariantResult], None] | None = None,
 ) -> list[VariantResult]:
-    """:func:`run_variant` on ``n_variants`` grid points of ``task`` drawn with ``seed``."""
+    """:func:`run_variant` on ``n_variants`` grid points of ``task`` drawn with ``seed``;
+    ``on_variant`` gets each variant's result as soon as it is done (to print and save it:
+    a long run stopped early keeps the variants it finished)."""
     if task not in PROTOCOLS:
         raise TeachfitError(f"no variant benchmark for {task!r}; choose from {sorted(PROTOCOLS)}")
     if n_starts < 1:
         raise TeachfitError(f"number of starts must be >= 1, got {n_starts}")
-    return [
-        run_variant(v, seed, n_starts, n_points, workers, progress, ergodic)
-        for v in sample_variants(task, n_variants, seed)
-    ]
+    out = []
+    for v in sample_variants(task, n_variants, seed):
+        out.append(run_variant(v, seed, n_starts, n_points, workers, progress, ergodic))
+        if on_variant is not None:
+            on_variant(out[-1])
+    return out
 
 
 def goal_misses(results: Sequence[VariantResult]) -> list[VariantResult]:
@@ -138,3 +144,24 @@ def figure_data(results: Sequence[VariantResult]) -> list[dict[str, object]]:
         }
         out.append({"values": dict(r.variant.values), "rates": rates})
     return out
+
+
+def results_json(results: Sequence[VariantResult]) -> str:
+    """The results as a JSON document: per variant its label, axis values, demonstrations
+    kept/tried, the teacher's failure (``why``) and per method ``successes``, ``trials`` and
+    the Wilson 95 % interval ``low``, ``high``."""
+    doc = [
+        {
+            "variant": r.variant.label,
+            "values": dict(r.variant.values),
+            "demos_kept": r.kept,
+            "demos_tried": r.tried,
+            "why": r.why,
+            "rates": {
+                m: dict(zip(("successes", "trials", "low", "high"), v, strict=True))
+                for m, v in fig["rates"].items()  # type: ignore[attr-defined]
+            },
+        }
+        for r, fig in zip(results, figure_data(results), strict=True)
+    ]
+    return json.dumps(doc, indent=1)

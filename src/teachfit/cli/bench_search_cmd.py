@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
@@ -13,7 +13,11 @@ from teachfit.cli import options as o
 from teachfit.cli.common import RobotOpt, append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_table
+from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import TeachfitError
+
+if TYPE_CHECKING:
+    from teachfit.bench.search_variants import VariantResult
 
 TABLES = ("1", "2", "ablation", "3", "all")
 _COLS = ("method", "ours [95 % CI]", "paper [95 % CI]", "median time", "plan", "length", "E")
@@ -216,6 +220,17 @@ def _task_table(
     _emit(title, rows, markdown)
 
 
+def _variant_cells(r: VariantResult) -> list[str]:
+    """A variant's row: its axis values, demonstrations kept/tried, TSHIX, ergodic."""
+    cells = [f"{v:g}" for _, v in r.variant.values] + [f"{r.kept}/{r.tried}"]
+    by = {row.method: row.ours for row in r.rows}
+    for m in ("tshix", "ergodic"):
+        s = by.get(m)
+        why = r.why[:60] or "not run"
+        cells.append(why if s is None else _rate(s.successes, s.trials, s.low, s.high))
+    return cells
+
+
 def _variants(
     task: str,
     n: int,
@@ -235,27 +250,29 @@ def _variants(
 
     if figure.suffix.lower().lstrip(".") not in Figure().canvas.get_supported_filetypes():
         raise TeachfitError(f"cannot write figure {figure}: unknown image format; use .png")
-    with progress_bar() as bar:
-        what = "TSHIX and ergodic" if ergodic else "TSHIX"
-        job = bar.add_task(f"{task} variants: {what}", total=(1 + ergodic) * n * starts)
-        results = sv.run_variants(
-            task, n, seed, starts, points, workers, lambda: bar.advance(job), ergodic
-        )
     protocol, default_points, demos = sv.PROTOCOLS[task]
     title = (
         f"{task} variants ({protocol} protocol, {demos} teacher demo(s), {starts} starts, "
         f"{points or default_points} points, seed {seed})"
     )
+    out = figure.with_name(f"{figure.stem}_{task}{figure.suffix}")
+    done: list[VariantResult] = []
+
+    def finished(r: VariantResult) -> None:  # printed and saved as each variant ends
+        done.append(r)
+        cells = _variant_cells(r)[-3:] if r.rows else [f"{r.kept}/{r.tried}", r.why]
+        console.print(f"{task} {r.variant.label}: demos {', '.join(cells)}")
+        atomic_write_text(out.with_suffix(".json"), sv.results_json(done), "results")
+        save_figure(success_by_parameter(sv.figure_data(done), title, sv.GOALS[task]), out)
+
+    with progress_bar() as bar:
+        what = "TSHIX and ergodic" if ergodic else "TSHIX"
+        job = bar.add_task(f"{task} variants: {what}", total=(1 + ergodic) * n * starts)
+        results = sv.run_variants(
+            task, n, seed, starts, points, workers, lambda: bar.advance(job), ergodic, finished
+        )
     cols = (*(k for k, _ in results[0].variant.values), "demos kept/tried", "TSHIX", "ergodic")
-    lines = []
-    for r in results:
-        cells = [f"{v:g}" for _, v in r.variant.values] + [f"{r.kept}/{r.tried}"]
-        by = {row.method: row.ours for row in r.rows}
-        for m in ("tshix", "ergodic"):
-            s = by.get(m)
-            why = r.why[:60] or "not run"
-            cells.append(why if s is None else _rate(s.successes, s.trials, s.low, s.high))
-        lines.append(cells)
+    lines = [_variant_cells(r) for r in results]
     table = Table(title=title)
     for col in cols:
         table.add_column(col, justify="right")
@@ -268,9 +285,7 @@ def _variants(
         f"goal TSHIX >= {100 * goal:.0f} % on every variant: "
         + ("met" if not misses else f"missed on {', '.join(r.variant.label for r in misses)}")
     )
-    out = figure.with_name(f"{figure.stem}_{task}{figure.suffix}")
-    fig = success_by_parameter(sv.figure_data(results), title, goal)
-    console.print(f"figure -> {save_figure(fig, out)}")
+    console.print(f"figure -> {out}, results -> {out.with_suffix('.json')}")
     if markdown is not None:
         md = [f"\n**{title}**\n", "| " + " | ".join(cols) + " |", "|" + " --- |" * len(cols)]
         md += ["| " + " | ".join(c) + " |" for c in lines]

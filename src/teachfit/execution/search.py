@@ -37,13 +37,15 @@ def search_setpoints(
     task: Task,
     start: Pose,
     model: SearchModel | None = None,
+    *,
+    friction_floor: float = 0.0,
 ) -> SetpointTrajectory:
     """World set-points for a search trajectory started at ``start``.
 
     With ``model``, the feed-forward wrench is the GMR conditional mean of the action given the
     planned step (seed A, Sec. III-C), mapped onto the searched wrench components; its x-y
-    force is projected onto the step's x-y direction and clipped at zero
-    (:func:`along_motion`).
+    force is projected onto the step's x-y direction, never below ``friction_floor`` (N)
+    while moving (:func:`along_motion`).
     """
     states = np.asarray(traj.states, dtype=float)
     dims = tuple(traj.dims)
@@ -60,23 +62,34 @@ def search_setpoints(
     quat = quat_from_rz(np.broadcast_to(rz, (n,))) if "rz" in dims else np.tile(start.quat, (n, 1))
     ff = np.zeros((n, 6))
     if model is not None and model.dynamics is not None:
-        actions = along_motion(model.feedforward_along(traj.t, states), traj.t, states, dims)
+        gmr = model.feedforward_along(traj.t, states)
+        actions = along_motion(gmr, traj.t, states, dims, floor=friction_floor)
         for j, d in enumerate(dims):
             ff[:, _WRENCH_INDEX[d]] = actions[:, j]
     return SetpointTrajectory(traj.t, pos, quat, ff, name=traj.method)
 
 
 def along_motion(
-    actions: np.ndarray, t: np.ndarray, states: np.ndarray, dims: tuple[str, ...]
+    actions: np.ndarray,
+    t: np.ndarray,
+    states: np.ndarray,
+    dims: tuple[str, ...],
+    floor: float = 0.0,
 ) -> np.ndarray:
     """The feed-forward ``actions`` (T, D; N, N·m) with their x-y force replaced by its part
-    along the planned x-y motion of ``states`` at ``t``, never backwards (none at rest).
+    along the planned x-y motion of ``states`` at ``t``, never backwards and, while moving,
+    never below ``floor`` (N; none at rest).
 
     Why: the force that keeps a sliding part on its path pushes along the motion (it meets
     friction); a component across it only drags the part off the path. A one-component GMR
     is a linear map of the step, and on a stick-slip demonstration (friction 0.8, Ø 8 mm
     peg2d) it learned ``(4.2, 0.4) N`` for a step along +y: the part then slid along +x,
     4 mm off a tour that crossed the hole. On the default cell the across part is <= 0.2 N.
+    ``floor`` (the sliding friction, :func:`friction_floor`): with less, the spring pulls the
+    rest and the part trails its set-point; at a turn of the tour that lag becomes an offset
+    across the motion, where the follower is soft, and the part cuts the corner (Ø 12 mm,
+    0.2 mm, μ 0.5: tours 0.8-1.2 mm from the axis passed by at 1.6-1.9 mm, outside the
+    1.6 mm where the chamfers catch it).
     """
     lin = [j for j, d in enumerate(dims) if d in ("x", "y")]
     if len(lin) != 2:
@@ -86,6 +99,7 @@ def along_motion(
     speed = np.linalg.norm(vel, axis=1)
     u = np.divide(vel, speed[:, None], out=np.zeros_like(vel), where=speed[:, None] > 1e-9)
     push = np.clip(np.sum(out[:, lin] * u, axis=1), 0.0, None)
+    push = np.where(speed > 1e-9, np.maximum(push, floor), 0.0)
     out[:, lin] = push[:, None] * u
     return out
 
@@ -221,6 +235,14 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
     )
 
 
+def friction_floor(task: Task, config: FollowConfig) -> float:
+    """The least feed-forward force (N) along the motion for ``task`` followed with
+    ``config``: the sliding friction of the part pressed with the follower's push, where the
+    task says what it is (``peg2d``'s :meth:`sliding_friction`), else 0."""
+    friction = getattr(task, "sliding_friction", None)
+    return 0.0 if friction is None else float(friction(config.push_force))
+
+
 def run_search(
     robot: Robot,
     task: Task,
@@ -231,10 +253,14 @@ def run_search(
     feedforward: bool = True,
     config: FollowConfig | None = None,
 ) -> SearchRun:
-    """Execute one search trajectory from ``start`` through the engine."""
-    setpoints = search_setpoints(traj, task, start, model if feedforward else None)
+    """Execute one search trajectory from ``start`` through the engine (``config``: the
+    task's, :func:`task_follow_config`; the feed-forward at least :func:`friction_floor`)."""
     if config is None:
         config = task_follow_config(task)
+    floor = friction_floor(task, config)
+    setpoints = search_setpoints(
+        traj, task, start, model if feedforward else None, friction_floor=floor
+    )
     return SearchRun(run_trajectory(robot, task, setpoints, start, config), traj, setpoints)
 
 
