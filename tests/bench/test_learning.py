@@ -11,11 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 from media_checks import read_png
+from scipy import stats
 from typer.testing import CliRunner
 
 from teachfit.bench.learning import (
+    PAPER_ORDERING,
     BenchInterrupted,
     ordering,
+    paired_markdown,
     run_learning_bench,
     to_markdown,
 )
@@ -77,6 +80,15 @@ def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
         assert f"{cell.best_cost_mean:.3f} [{cell.best_cost_low:.3f}, " in row
         assert f"| {cell.n - cell.never_feasible}/2 | {cell.executions_ok}/12 = " in row
     assert "- ordering on key (mean best cost, s): **" in text
+    # paired: the difference of the two methods' best costs on each common set-up (seed)
+    lo, hi = sorted(bench.cells, key=lambda c: c.best_cost_mean)
+    by = {(e.method, e.seed): e.costs[e.best_index] for e in bench.experiments}
+    d = [by[(hi.method, s)] - by[(lo.method, s)] for s in (5, 6)]
+    half = float(stats.t.ppf(0.975, 1)) * float(np.std(d, ddof=1)) / math.sqrt(2)
+    paired = paired_markdown(bench)
+    assert paired in text and paired.startswith(f"- paired on key: {hi.method} - {lo.method} = ")
+    assert f"= {np.mean(d):+.3f} [{np.mean(d) - half:+.3f}, " in paired
+    assert "over 2 set-ups" in paired and f"Paper: {PAPER_ORDERING['key']}" in paired
     # ordering: "<" only between intervals that do not overlap
     a, b = bench.cells
     apart = [

@@ -24,7 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
-from teachfit.bench.learning_table import ordering, to_markdown
+from teachfit.bench.learning_table import (
+    PAPER_ORDERING,
+    ordering,
+    paired_markdown,
+    to_markdown,
+)
 from teachfit.core.params import LearningError
 from teachfit.learning.curves import Band, band, best_so_far, first_feasible
 from teachfit.learning.objective import SkillObjective
@@ -32,12 +37,14 @@ from teachfit.learning.runner import run_study
 from teachfit.learning.study import METHODS, Study, TrialRecord
 
 __all__ = [
+    "PAPER_ORDERING",
     "BenchInterrupted",
     "CellStats",
     "Experiment",
     "LearningBench",
     "method_options",
     "ordering",
+    "paired_markdown",
     "run_experiment",
     "run_learning_bench",
     "study_path",
