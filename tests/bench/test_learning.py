@@ -21,6 +21,7 @@ from teachfit.bench.learning import (
     paired_markdown,
     run_learning_bench,
     to_markdown,
+    unsolved_setups,
 )
 from teachfit.cli import app
 from teachfit.learning.objective import SkillObjective
@@ -89,6 +90,15 @@ def test_bench_statistics_agree_with_the_experiments(tmp_path: Path) -> None:
     assert paired in text and paired.startswith(f"- paired on key: {hi.method} - {lo.method} = ")
     assert f"= {np.mean(d):+.3f} [{np.mean(d) - half:+.3f}, " in paired
     assert "over 2 set-ups" in paired and f"Paper: {PAPER_ORDERING['key']}" in paired
+    # a set-up no method solved is named; one that a single method solved is not
+    never = [dataclasses.replace(e, feasible=(False,) * 6) for e in bench.experiments]
+    assert unsolved_setups(dataclasses.replace(bench, experiments=tuple(never)), "key") == [5, 6]
+    one = [never[0], *never[1:]]
+    one[0] = dataclasses.replace(never[0], feasible=(True,) + (False,) * 5)
+    solved = [e.seed for e in one if e.first_feasible is not None]
+    fixed = dataclasses.replace(bench, experiments=tuple(one))
+    assert unsolved_setups(fixed, "key") == [s for s in (5, 6) if s not in solved]
+    assert "no method succeeded once" in paired_markdown(fixed)
     # ordering: "<" only between intervals that do not overlap
     a, b = bench.cells
     apart = [

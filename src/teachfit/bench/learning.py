@@ -29,6 +29,7 @@ from teachfit.bench.learning_table import (
     ordering,
     paired_markdown,
     to_markdown,
+    unsolved_setups,
 )
 from teachfit.core.params import LearningError
 from teachfit.learning.curves import Band, band, best_so_far, first_feasible
@@ -49,6 +50,7 @@ __all__ = [
     "run_learning_bench",
     "study_path",
     "to_markdown",
+    "unsolved_setups",
 ]
 
 

@@ -30,7 +30,14 @@ from teachfit.metrics.stats import wilson_interval
 if TYPE_CHECKING:
     from teachfit.bench.learning import CellStats, LearningBench
 
-__all__ = ["PAPER_ORDERING", "ordering", "ordering_markdown", "paired_markdown", "to_markdown"]
+__all__ = [
+    "PAPER_ORDERING",
+    "ordering",
+    "ordering_markdown",
+    "paired_markdown",
+    "to_markdown",
+    "unsolved_setups",
+]
 
 #: Seed B's reading of Fig. 6 (Sec. VI), by task: "all four algorithms are suited to a certain
 #: degree" for puzzle and key, BO finds worse solutions with a larger interval and stops early;
@@ -137,4 +144,24 @@ def paired_markdown(bench: LearningBench) -> str:
             )
         paper = PAPER_ORDERING.get(task, "not in the paper")
         lines.append(f"- paired on {task}: " + "; ".join(parts) + f". Paper: {paper}")
+        unsolved = unsolved_setups(bench, task)
+        if unsolved:
+            lines.append(
+                f"- set-up(s) {', '.join(map(str, unsolved))} of {task}: no method succeeded "
+                "once (only failure costs there: the set-up, e.g. its taught hole estimate, "
+                "is out of the skill's reach, and widens every unpaired interval)"
+            )
     return "\n".join(lines) + "\n"
+
+
+def unsolved_setups(bench: LearningBench, task: str) -> list[int]:
+    """Seeds (set-ups) of ``task`` on which every method's experiment ran and none had a
+    feasible trial (no execution succeeded)."""
+    methods = {c.method for c in bench.cells if c.task == task}
+    by_seed: dict[int, list[bool]] = {}
+    for e in bench.experiments:
+        if e.task == task:
+            by_seed.setdefault(e.seed, []).append(e.first_feasible is not None)
+    return sorted(
+        s for s, found in by_seed.items() if len(found) == len(methods) and not any(found)
+    )
