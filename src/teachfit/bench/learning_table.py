@@ -96,12 +96,17 @@ def to_markdown(bench: LearningBench) -> str:
     )
 
 
+def _ranked(cells: Sequence[CellStats], task: str) -> list[CellStats]:
+    """``task``'s cells from the lowest mean best cost up."""
+    return sorted((c for c in cells if c.task == task), key=lambda c: c.best_cost_mean)
+
+
 def ordering(cells: Sequence[CellStats]) -> dict[str, str]:
     """Per task, its methods from the lowest mean best cost up, joined by ``<`` (the two
     95 % intervals do not overlap) or ``≈`` (they do)."""
     out: dict[str, str] = {}
     for task in dict.fromkeys(c.task for c in cells):
-        mine = sorted((c for c in cells if c.task == task), key=lambda c: c.best_cost_mean)
+        mine = _ranked(cells, task)
         text = mine[0].method
         for a, b in zip(mine, mine[1:], strict=False):
             apart = a.n > 1 and b.n > 1 and a.best_cost_high < b.best_cost_low
@@ -114,7 +119,7 @@ def ordering_markdown(cells: Sequence[CellStats]) -> str:
     """:func:`ordering` as lines ``task: a < b ≈ c ...`` with each method's interval."""
     lines = []
     for task, text in ordering(cells).items():
-        mine = sorted((c for c in cells if c.task == task), key=lambda c: c.best_cost_mean)
+        mine = _ranked(cells, task)
         detail = ", ".join(f"{c.method} {_ci(c)}" for c in mine)
         lines.append(f"- ordering on {task} (mean best cost, s): **{text}** ({detail})")
     return "\n".join(lines) + "\n"
@@ -126,7 +131,7 @@ def paired_markdown(bench: LearningBench) -> str:
     best = {(e.task, e.method, e.seed): e.costs[e.best_index] for e in bench.experiments}
     lines = []
     for task in dict.fromkeys(c.task for c in bench.cells):
-        mine = sorted((c for c in bench.cells if c.task == task), key=lambda c: c.best_cost_mean)
+        mine = _ranked(bench.cells, task)
         parts = []
         for a, b in zip(mine, mine[1:], strict=False):
             seeds = sorted(
