@@ -76,6 +76,35 @@ def test_phases_tilt_drop_slide_to_the_wall_and_align():
     assert run.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
 
 
+def test_after_a_missed_align_it_retries_at_the_other_tilt_and_feels_a_drop_at_once():
+    traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
+    tilt = TiltConfig(angle=0.25, retry_angle=0.14, drop_depth=5e-4, stall_lag=0.002)
+    run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    state = run.tilt
+    for t, z in ((0.5, 0.003), (0.6, 0.0024), (1.2, 0.0024), (1.5, 0.0), (2.4, 0.0)):
+        _tick(run, pc, (0.0, 0.0, z), t)  # rest, drop, blocked, align, upright on the edge
+    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.14)
+    _tick(run, pc, (0.0, 0.0, -6e-4), 2.5)  # still tilting, but below the edge it stood on
+    assert state.phase == LATERAL
+    for t in (3.1, 3.4, 4.2):  # blocked, align, upright and not sinking: missed again
+        _tick(run, pc, (0.0, 0.0, -6e-4), t)
+    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.25)
+    state.reset(0.0)  # a new search starts at the first tilt
+    assert state.full == 0.25 and state.z_floor == -np.inf
+
+
+def test_peg2d_jam_free_tilt_is_where_the_high_rim_clears_the_near_edge():
+    task = get_task("peg2d", peg_diameter=0.03, clearance=3e-4, peg_chamfer=0.0, hole_chamfer=0.0)
+    r, big_r = 0.015, 0.01515
+    assert task.jam_free_tilt == pytest.approx(np.arccos(r / big_r))  # 0.14 rad
+    config = task_follow_config(task).tilt
+    assert config.angle == 0.25 and config.retry_angle == pytest.approx(task.jam_free_tilt)
+    wide = get_task("peg2d", peg_diameter=0.008, clearance=5e-4, peg_chamfer=0.0, hole_chamfer=0.0)
+    assert task_follow_config(wide).tilt.retry_angle is None  # acos(4 / 4.25) > 0.25 rad
+
+
 def test_no_drop_is_felt_while_the_part_still_tilts():
     traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
     run = FollowSetpoints(traj, FollowConfig(tilt=TiltConfig())).compile({})

@@ -222,13 +222,16 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
     """The tilted search where the task asks for one (``search_tilt`` > 0, rad; see
     :mod:`teachfit.skills.tilt`): the drop felt at half the upright hold depth (a tilted peg
     rests steadily on a flat top; its drop is ~ tan(tilt) x how far the rim is past the edge),
-    the low rim slid up to a hole diameter after it."""
+    the low rim slid up to a hole diameter after it; after a missed align it tries once at the
+    task's ``jam_free_tilt`` where that is smaller, then at ``search_tilt`` again, and so on."""
     angle = float(getattr(task, "search_tilt", 0.0))
     if angle <= 0.0:
         return None
     p = task.params
+    jam_free = getattr(task, "jam_free_tilt", None)
     return TiltConfig(
         angle=angle,
+        retry_angle=None if jam_free is None or jam_free >= angle else float(jam_free),
         drop_depth=0.5 * float(task.search_hold_depth),
         lateral_reach=p.peg_diameter + p.clearance,
         stall_lag=wedge_lag(angle, p.friction, load, stiffness),

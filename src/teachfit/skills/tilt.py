@@ -11,7 +11,9 @@ position within about a hole radius of the point one peg radius behind the hole 
 
 1. *search*: the follower's set-points, the orientation tilted; the reference height is the
    highest the TCP has been since the tilt settled (the tilted part rests one
-   ``r sin(angle)`` above the surface);
+   ``r sin(angle)`` above the surface); while it settles after a missed align, never below
+   the height the part stood upright at on the edge (tilted again right over the hole, it
+   drops in before it settles);
 2. *lateral*: once the TCP sank ``drop_depth`` below it, the x-y set-point moves from the
    TCP along ``d`` at ``lateral_speed``: the low rim slides across the hole until its far
    wall stops it (the set-point then leads the TCP by ``stall_lag``), or the TCP has gone
@@ -23,6 +25,17 @@ position within about a hole radius of the point one peg radius behind the hole 
    sinking ``RETRY`` s later, it missed (it stands on the edge): the search goes on, tilted,
    from where the trajectory was left (:class:`~teachfit.skills.follow.FollowSetpoints`
    pauses the trajectory's clock outside the search phase and blends back to it).
+
+Jams. A wide part that dropped in deep at a large tilt can jam while it turns upright: its
+high rim comes down on the top beside the near edge while its side still rests on the far
+edge, and from there pushing only wedges it or walks it back out (Ø 30 mm, 0.3 mm clearance,
+μ 0.8 at 0.25 rad: the same drop, turn and miss for two minutes). Turning a part of radius
+``r`` upright about the far edge of a hole of radius ``R``, the high rim clears the near
+edge for any depth once the tilt is at most ``acos(r / R)`` (0.14 rad there). A small tilt
+costs elsewhere (the part tends to end upright beside the axis: Ø 30 mm, 0.2 mm, μ 0.5 at
+0.115 rad succeeds 11/20 against 20/20 at 0.25 rad), so the search keeps ``angle`` and after
+each missed align alternates with ``retry_angle`` (None: ``angle`` always), as a hand that
+felt a jam tries again more upright.
 """
 
 from __future__ import annotations
@@ -59,10 +72,15 @@ class TiltConfig:
     lateral_speed: float = 0.005
     stall_lag: float = 0.003
     align_time: float = 0.5
+    retry_angle: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.angle) and 0.0 < self.angle < 0.6):
             raise SkillError(f"tilt: angle must be in (0, 0.6) rad, got {self.angle}")
+        if self.retry_angle is not None and not (
+            math.isfinite(self.retry_angle) and 0.0 < self.retry_angle < 0.6
+        ):
+            raise SkillError(f"tilt: retry_angle must be in (0, 0.6) rad, got {self.retry_angle}")
         if self.direction is not None and not math.isfinite(self.direction):
             raise SkillError(f"tilt: direction must be finite, got {self.direction}")
         for name in ("drop_depth", "lateral_reach", "lateral_speed", "stall_lag", "align_time"):
@@ -109,24 +127,30 @@ class TiltState:
 
     def __init__(self, cfg: TiltConfig, path: np.ndarray) -> None:
         self.cfg, self.d = cfg, cfg.unit(path)
-        s = math.sin(0.5 * cfg.angle)  # about z x d = (-d_y, d_x, 0): lowers the +d rim
-        self.q_tilt = np.array([math.cos(0.5 * cfg.angle), -self.d[1] * s, self.d[0] * s, 0.0])
         self.reset(0.0)
+
+    def _tilt_to(self, angle: float) -> None:
+        """Search at ``angle`` (rad) from now on."""
+        s = math.sin(0.5 * angle)  # about z x d = (-d_y, d_x, 0): lowers the +d rim
+        self.full = angle
+        self.q_tilt = np.array([math.cos(0.5 * angle), -self.d[1] * s, self.d[0] * s, 0.0])
 
     def reset(self, z: float) -> None:
         self.phase, self.z_top, self.t0, self.z_aligned = SEARCH, z, 0.0, z
         self.origin = np.zeros(2)
+        self.z_floor = -math.inf  # m, where a missed align stood upright (on the edge)
+        self._tilt_to(self.cfg.angle)
 
     def angle(self, t: float) -> float:
         """The tilt (rad) at node time ``t``: full until aligning, then down to 0."""
         if self.phase != ALIGN:
-            return self.cfg.angle
-        return self.cfg.angle * max(0.0, 1.0 - (t - self.t0) / self.cfg.align_time)
+            return self.full
+        return self.full * max(0.0, 1.0 - (t - self.t0) / self.cfg.align_time)
 
     def orient(self, out: np.ndarray, quat: np.ndarray, t: float) -> None:
         """``out`` = ``quat`` tilted by the phase's angle about z x d (world-side product)."""
         a = self.angle(t)
-        if a >= self.cfg.angle:
+        if a >= self.full:
             quat_mul_into(out, self.q_tilt, quat)
         elif a > 0.0:
             s = math.sin(0.5 * a)
@@ -139,8 +163,8 @@ class TiltState:
         """Advance the phase from the measured TCP; True when it should hold x-y (align)."""
         z, t = float(pc.p[2]), pc.t_node
         if self.phase == SEARCH:
-            if t - self.t0 < TILT_SETTLE:  # still tilting: no resting height yet
-                self.z_top = z
+            if t - self.t0 < TILT_SETTLE:  # still tilting: no resting height yet, but
+                self.z_top = max(z, self.z_floor)  # below the edge it stood on: a drop
             self.z_top = max(self.z_top, z)
             if self.z_top - z >= self.cfg.drop_depth:
                 self.phase, self.t0 = LATERAL, t
@@ -160,7 +184,11 @@ class TiltState:
             if since <= 0.0:
                 self.z_aligned = z
             elif since > RETRY and self.z_aligned - z < RETRY_SINK:
-                self.phase, self.t0 = SEARCH, t  # upright and not sinking: search on
+                self.phase, self.t0 = SEARCH, t  # upright and not sinking: search on,
+                self.z_floor = z
+                other = self.cfg.retry_angle  # the other tilt next time
+                if other is not None:
+                    self._tilt_to(other if self.full == self.cfg.angle else self.cfg.angle)
         return self.phase == ALIGN
 
     def lateral(self, pc: Percept, twist: np.ndarray) -> None:

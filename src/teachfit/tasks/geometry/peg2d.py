@@ -10,6 +10,7 @@ the search is in x-y.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -140,6 +141,15 @@ class Peg2D(Task):
         """Tilt (rad) of a searching peg: :data:`SEARCH_TILT` where the upright capture
         half-width is under the tilted one, :data:`TILTED_CAPTURE` (sharp edges), else 0."""
         return SEARCH_TILT if self.capture_halfwidth < TILTED_CAPTURE else 0.0
+
+    @property
+    def jam_free_tilt(self) -> float:
+        """The largest tilt (rad) at which a peg turning upright about the hole's far edge
+        clears the near edge with its high rim at any depth: ``acos(r / R)`` for peg radius
+        ``r`` and hole radius ``R = r + clearance / 2`` (Ø 30 mm, 0.3 mm: 0.14 rad;
+        :mod:`teachfit.skills.tilt`, jams)."""
+        r = 0.5 * self.params.peg_diameter
+        return math.acos(r / (r + 0.5 * self.params.clearance))
 
     def sliding_friction(self, push: float) -> float:
         """Friction force (N) on the peg sliding on the top pressed with ``push`` (N): the
