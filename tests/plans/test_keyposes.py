@@ -33,6 +33,19 @@ def test_steepest_pitch_is_ranked_first():
         assert np.allclose(pose.pos, pos[i]) and abs(abs(pose.quat @ q[i]) - 1) < 1e-12
 
 
+def test_included_samples_are_candidates_and_the_rest_stay_evenly_spaced():
+    t, pos, q = _pitch_demo(np.linspace(0.0, 1.0, 101))
+    plain = rank_key_poses(t, pos, q, 5, param="pitch").indices
+    keys = rank_key_poses(t, pos, q, 5, param="pitch", include=np.array([7, 93]))
+    assert len(keys.indices) == 5 and {7, 93} <= set(keys.indices.tolist())
+    others = sorted(set(keys.indices.tolist()) - {7, 93})
+    assert others != plain.tolist()[:3] and np.all(np.diff(others) > 20)  # 3 spread evenly
+    with pytest.raises(PlanningError, match="include"):
+        rank_key_poses(t, pos, q, 2, param="pitch", include=np.array([3, 5, 9]))
+    with pytest.raises(PlanningError, match="include"):
+        rank_key_poses(t, pos, q, 5, param="pitch", include=np.array([0]))
+
+
 def test_auto_picks_the_most_changing_parameter():
     keys = rank_key_poses(*_pitch_demo(np.linspace(0.0, 1.0, 101)), 5, param="auto")
     assert keys.param == "pitch"

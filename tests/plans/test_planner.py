@@ -62,16 +62,17 @@ def test_l_groove_with_demonstration_succeeds(lgroove):
 
 def test_same_seed_same_path_whatever_ran_before(lgroove):
     asm, planner = lgroove
-    demo = synth_demo(asm, 1)  # a demonstration whose plan needs OMPL's sampler (not only
-    # straight motions between key poses), so that the seed shows in the path
+    demo = synth_demo(asm, 1)
     first, other, again = (planner.plan(demo, seed=s) for s in (0, 1, 0))
     assert first.success and other.success and again.success
     # exactly the same path and the same work, though another query ran in between
     assert np.array_equal(first.path, again.path)
     assert first.collision_checks == again.collision_checks
     assert first.attempts == again.attempts
-    # the seed reaches OMPL's sampler: another seed plans another path
-    assert first.path.shape != other.path.shape or not np.array_equal(first.path, other.path)
+    # the seed reaches OMPL's sampler (the guided plans above are straight motions, which
+    # draw nothing): without a demonstration the same seed does the same work, another not
+    plain = [planner.plan(None, seed=s).collision_checks for s in (0, 1, 0)]
+    assert plain[0] == plain[2] != plain[1]
 
 
 def test_a_worker_process_plans_the_same_path(lgroove):
@@ -163,7 +164,7 @@ def test_planner_selection_and_bad_config():
 
 def test_l_groove_uses_no_more_key_poses_than_the_paper(lgroove):
     asm, planner = lgroove
-    for seed in (2, 5):
+    for seed in (2, 5, 38):  # 38: its evenly spaced candidates need 4 (the demonstration 2)
         result = planner.plan(synth_demo(asm, seed), seed=seed)
         assert result.success, result.message
         lo, hi = asm.paper.used

@@ -56,6 +56,7 @@ def select_candidates(
     *,
     char_length: float = 0.1,
     eligible: np.ndarray | None = None,
+    include: np.ndarray | None = None,
 ) -> np.ndarray:
     """Indices (n,) of candidate key poses, evenly spaced along the demonstration's pose path.
 
@@ -70,6 +71,9 @@ def select_candidates(
         Samples a key pose may be taken from (the paper's "important area", where the parts
         are close); the path length is measured over them only. All samples when None or
         when fewer than ``n`` are eligible.
+    include : (m,) int, optional
+        Samples that are candidates whatever the spacing (``m <= n``, not the first or last
+        sample): the other ``n - m`` are spaced evenly as above.
 
     Returns
     -------
@@ -77,6 +81,9 @@ def select_candidates(
     """
     if n < 1:
         raise PlanningError(f"need at least one candidate key pose, got n={n}")
+    forced = np.unique(np.asarray([] if include is None else include, dtype=int))
+    if len(forced) > n or (len(forced) and (forced[0] < 1 or forced[-1] > len(pos) - 2)):
+        raise PlanningError(f"include: at most {n} inner sample indices, got {forced.tolist()}")
     step = np.diff(pose_parameters(pos, quat), axis=0)
     step[:, 3:] *= char_length  # 1 rad of rotation moves the part's far end by char_length
     length = np.concatenate([[0.0], np.linalg.norm(step, axis=1)])
@@ -88,10 +95,11 @@ def select_candidates(
     if len(s) < 3 or s[-1] <= 0:
         raise PlanningError("demonstration does not move: no key poses to take from it")
     lo, hi = s[mask].min(), s[mask].max()
-    targets = lo + (hi - lo) * (np.arange(n) + 0.5) / n
+    spaced = n - len(forced)
+    targets = lo + (hi - lo) * (np.arange(spaced) + 0.5) / max(spaced, 1)
     where = np.flatnonzero(mask)
     idx = where[np.clip(np.searchsorted(s[where], targets), 0, len(where) - 1)]
-    return np.unique(idx)
+    return np.unique(np.concatenate([idx, forced]))
 
 
 @dataclass(frozen=True, eq=False)
@@ -155,6 +163,7 @@ def rank_key_poses(
     degree: int = 7,
     char_length: float = 0.1,
     eligible: np.ndarray | None = None,
+    include: np.ndarray | None = None,
 ) -> KeyPoses:
     """Select candidate key poses of a demonstration and rank them.
 
@@ -173,6 +182,8 @@ def rank_key_poses(
         Characteristic length (m) of the moving part.
     eligible : (T,) bool, optional
         Samples candidates may be taken from, see :func:`select_candidates`.
+    include : (m,) int, optional
+        Samples that are candidates in any case, see :func:`select_candidates`.
 
     Raises
     ------
@@ -195,7 +206,9 @@ def rank_key_poses(
     if param not in PARAMS:
         raise PlanningError(f"unknown pose parameter {param!r}; use one of {PARAMS} or 'auto'")
     column = values6[:, PARAMS.index(param)]
-    idx = select_candidates(pos, quat, n_candidates, char_length=char_length, eligible=eligible)
+    idx = select_candidates(
+        pos, quat, n_candidates, char_length=char_length, eligible=eligible, include=include
+    )
     # numpy's Polynomial.fit maps time onto [-1, 1] internally, which keeps the fit well
     # conditioned for any demonstration length.
     poly = np.polynomial.Polynomial.fit(t, column, deg=int(min(degree, len(t) - 1)))

@@ -6,7 +6,12 @@ RRT-Connect (OMPL, SE(3), validity by coal in Python: box or mesh checks, see
 key pose and plan segment by segment. A key pose in collision is first replaced by the nearest
 collision-free pose sampled around it. The ranking puts first the chain of key poses joined by
 free straight motions (:func:`~teachfit.plans.keyposes.straight_chain`; its motion checks are
-reused by the attempts), then the rest by the paper's derivative. Each segment tries the
+reused by the attempts), then the rest by the paper's derivative. Where that chain needs more
+than two key poses, the same greedy walk runs over the demonstration itself (about
+:data:`CHAIN_NODES` of its poses, evenly in time) and, if it needs fewer, its poses
+become candidates in place of evenly spaced ones (the count stays the task's): six evenly
+spaced candidates can miss the poses that a short chain needs (L-groove seed 38: 4 key
+poses through them, 2 through the demonstration). Each segment tries the
 straight motion, then, between neighbouring key poses, the demonstrated motion, then
 RRT-Connect; solved segments are reused by later attempts. The final path is shortcut and
 smoothed (OMPL's PathSimplifier) and verified densely with our own interpolation.
@@ -58,6 +63,11 @@ __all__ = [
     "matrix_to_state",
     "seed_ompl",
 ]
+
+#: demonstrated poses (about; evenly in time) the greedy straight chain looks at when the
+#: candidates' own chain needs more than two (every 5th of the L-groove's 164), ~12 ms of
+#: motion checks (CPU, busy machine) where it runs
+CHAIN_NODES = 30
 
 
 class MotionPlanner:
@@ -267,9 +277,14 @@ class MotionPlanner:
         repaired: dict[int, np.ndarray | None] = {}
         straight: dict[tuple[int, int], bool] = {}
         if demo is not None:
-            keys = self._rank(demo)
+            keys, eligible = self._rank(demo)
             repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
-            keys, straight = self._chain_first(keys, repaired)
+            keys, straight, n_chain = self._chain_first(keys, repaired)
+            shorter = self._demo_chain(demo, n_chain) if n_chain > 2 else None
+            if shorter is not None:
+                keys, _ = self._rank(demo, include=shorter, eligible=eligible)
+                repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+                keys, straight = self._chain_through(keys, shorter)
         n_cand = 0 if keys is None else len(keys.indices)
         via = self._demonstrated(demo, keys)
         solved: dict[tuple[int, int], np.ndarray] = {}
@@ -344,7 +359,15 @@ class MotionPlanner:
             key_poses=keys,
         )
 
-    def _rank(self, demo: object) -> KeyPoses:
+    def _rank(
+        self,
+        demo: object,
+        include: np.ndarray | None = None,
+        eligible: np.ndarray | None = None,
+    ) -> tuple[KeyPoses, np.ndarray | None]:
+        """The demonstration's ranked candidates (``include``: samples that are candidates in
+        any case) and the mask of samples near contact they were taken from (``eligible``:
+        that mask from an earlier call, not computed again)."""
         task = getattr(demo, "task", None)
         if task != self.asm.task:
             raise PlanningError(
@@ -355,14 +378,14 @@ class MotionPlanner:
             raise PlanningError(f"demonstration has {t.size} pose(s); need at least 2")
         pos = np.asarray(demo.pos, dtype=float)  # type: ignore[attr-defined]
         quat = np.asarray(demo.quat, dtype=float)  # type: ignore[attr-defined]
-        eligible = None
-        if self.key_region > 0 and pos.shape == (len(t), 3) and quat.shape == (len(t), 4):
+        shapes_ok = pos.shape == (len(t), 3) and quat.shape == (len(t), 4)
+        if eligible is None and self.key_region > 0 and shapes_ok:
             # every third sample, each standing for its neighbours (a 30 Hz demonstration moves
             # ~1 mm a sample): the region is a coarse mask, and this is a third of the checks
             step = 3
             near = [self._near.collides_xyzq(*pos[i], *quat[i]) for i in range(0, len(t), step)]
             eligible = np.repeat(np.array(near, dtype=bool), step)[: len(t)]
-        return rank_key_poses(
+        keys = rank_key_poses(
             t,
             pos,
             quat,
@@ -370,7 +393,9 @@ class MotionPlanner:
             param=self.asm.key_param,
             char_length=self.radius,
             eligible=eligible,
+            include=include,
         )
+        return keys, eligible
 
     def _demonstrated(
         self, demo: object | None, keys: KeyPoses | None
@@ -395,12 +420,57 @@ class MotionPlanner:
 
         return via
 
+    def _demo_chain(self, demo: object, than: int) -> np.ndarray | None:
+        """Sample indices of the demonstration's own greedy straight chain
+        (:func:`straight_chain` over :data:`CHAIN_NODES` of its poses, from the start to the goal
+        or approach pose) if it needs fewer than ``than`` poses, all collision-free and at most
+        the task's candidate count; else None."""
+        states = np.concatenate(
+            [np.asarray(demo.pos, dtype=float), np.asarray(demo.quat, dtype=float)], axis=1
+        )  # type: ignore[attr-defined]
+        step = max(1, len(states) // CHAIN_NODES)
+        idx = np.arange(step, len(states) - 1, step)
+        end = self.goal if self.approach is None else self.approach
+        nodes = {-1: self.start, len(idx): end} | {i: states[j] for i, j in enumerate(idx)}
+        free: dict[int, bool] = {}
+
+        def ok(i: int) -> bool:
+            if i not in free:
+                free[i] = not self._collides(nodes[i])
+            return free[i]
+
+        def connects(a: int, b: int) -> bool:
+            if not (ok(a) and ok(b)):
+                return False
+            return bool(self.si.checkMotion(self._to_ompl(nodes[a]), self._to_ompl(nodes[b])))
+
+        chain = straight_chain(len(idx), connects)
+        if len(chain) >= than or len(chain) > self.asm.n_candidates or not all(map(ok, chain)):
+            return None
+        return idx[chain]
+
+    def _chain_through(
+        self, keys: KeyPoses, samples: np.ndarray
+    ) -> tuple[KeyPoses, dict[tuple[int, int], bool]]:
+        """``keys`` reordered with the candidates at the demonstration's ``samples`` first (a
+        chain :meth:`_demo_chain` found joined by free straight motions, collision-free, so
+        not repaired), then the rest by the derivative rule; and those motions, by pair of
+        the attempts' node ids, as :meth:`_chain_first` gives them."""
+        n = len(keys.indices)
+        end = n if self.approach is None else n + 1
+        chain = [int(np.searchsorted(keys.indices, j)) for j in samples]
+        nodes = [-1, *chain, end]
+        straight = {(a, b): True for a, b in zip(nodes[:-1], nodes[1:], strict=True)}
+        rest = [int(i) for i in keys.order if int(i) not in chain]
+        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int)), straight
+
     def _chain_first(
         self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]
-    ) -> tuple[KeyPoses, dict[tuple[int, int], bool]]:
+    ) -> tuple[KeyPoses, dict[tuple[int, int], bool], int]:
         """``keys`` reordered: the straight chain (:func:`straight_chain`) first, then the rest
-        by the derivative rule; and the straight motions tested meanwhile (OMPL's motion check,
-        the attempts' own), by pair of the attempts' node ids, for the attempts to reuse."""
+        by the derivative rule; the straight motions tested meanwhile (OMPL's motion check,
+        the attempts' own), by pair of the attempts' node ids, for the attempts to reuse; and
+        the chain's length."""
         n = len(keys.indices)
         end = n if self.approach is None else n + 1  # the attempts' id of the chain's last node
         nodes = {-1: self.start, n: self.goal if self.approach is None else self.approach}
@@ -416,7 +486,8 @@ class MotionPlanner:
 
         chain = straight_chain(n, connects)
         rest = [int(i) for i in keys.order if int(i) not in chain]
-        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int)), straight
+        keys = dataclasses.replace(keys, order=np.array(chain + rest, dtype=int))
+        return keys, straight, len(chain)
 
     def _finish(self, path: np.ndarray) -> np.ndarray | None:
         """Shortcut and smooth ``path`` with OMPL, then verify densely; None if unverifiable."""
