@@ -189,6 +189,10 @@ class MotionPlanner:
                 return ok[int(np.argmin(self._distance(state, ok)))]
         return None
 
+    def _repair_all(self, keys: KeyPoses, rng: np.random.Generator) -> dict[int, np.ndarray | None]:
+        """:meth:`repair` of every candidate, by its position in ``keys``."""
+        return {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+
     # -- segments -----------------------------------------------------------------------------
     def _plan_segment(
         self,
@@ -278,12 +282,12 @@ class MotionPlanner:
         straight: dict[tuple[int, int], bool] = {}
         if demo is not None:
             keys, eligible = self._rank(demo)
-            repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+            repaired = self._repair_all(keys, rng)
             keys, straight, n_chain = self._chain_first(keys, repaired)
             shorter = self._demo_chain(demo, n_chain) if n_chain > 2 else None
             if shorter is not None:
                 keys, _ = self._rank(demo, include=shorter, eligible=eligible)
-                repaired = {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+                repaired = self._repair_all(keys, rng)
                 keys, straight = self._chain_through(keys, shorter)
         n_cand = 0 if keys is None else len(keys.indices)
         via = self._demonstrated(demo, keys)
@@ -406,9 +410,7 @@ class MotionPlanner:
         approach of a mesh task, or without a demonstration."""
         if demo is None or keys is None:
             return lambda a, b: None
-        demo_states = np.concatenate(
-            [np.asarray(demo.pos, dtype=float), np.asarray(demo.quat, dtype=float)], axis=1
-        )  # type: ignore[attr-defined]
+        demo_states = _demo_states(demo)
         n, last = len(keys.indices), len(demo_states) - 1
 
         def via(a: int, b: int) -> np.ndarray | None:
@@ -423,16 +425,16 @@ class MotionPlanner:
     def _demo_chain(self, demo: object, than: int) -> np.ndarray | None:
         """Sample indices of the demonstration's own greedy straight chain
         (:func:`straight_chain` over :data:`CHAIN_NODES` of its poses, from the start to the goal
-        or approach pose) if it needs fewer than ``than`` poses, all collision-free and at most
-        the task's candidate count; else None."""
-        states = np.concatenate(
-            [np.asarray(demo.pos, dtype=float), np.asarray(demo.quat, dtype=float)], axis=1
-        )  # type: ignore[attr-defined]
+        or approach pose) if it needs fewer than ``than`` poses, at most the task's candidate
+        count, every link a free straight motion (the walk steps on to the next pose where
+        none connects); else None."""
+        states = _demo_states(demo)
         step = max(1, len(states) // CHAIN_NODES)
         idx = np.arange(step, len(states) - 1, step)
         end = self.goal if self.approach is None else self.approach
         nodes = {-1: self.start, len(idx): end} | {i: states[j] for i, j in enumerate(idx)}
         free: dict[int, bool] = {}
+        linked: set[tuple[int, int]] = set()
 
         def ok(i: int) -> bool:
             if i not in free:
@@ -440,12 +442,20 @@ class MotionPlanner:
             return free[i]
 
         def connects(a: int, b: int) -> bool:
-            if not (ok(a) and ok(b)):
-                return False
-            return bool(self.si.checkMotion(self._to_ompl(nodes[a]), self._to_ompl(nodes[b])))
+            if (
+                ok(a)
+                and ok(b)
+                and self.si.checkMotion(self._to_ompl(nodes[a]), self._to_ompl(nodes[b]))
+            ):
+                linked.add((a, b))
+                return True
+            return False
 
         chain = straight_chain(len(idx), connects)
-        if len(chain) >= than or len(chain) > self.asm.n_candidates or not all(map(ok, chain)):
+        hops = [-1, *chain, len(idx)]
+        if len(chain) >= than or len(chain) > self.asm.n_candidates:
+            return None
+        if any(hop not in linked for hop in zip(hops[:-1], hops[1:], strict=True)):
             return None
         return idx[chain]
 
@@ -461,8 +471,7 @@ class MotionPlanner:
         chain = [int(np.searchsorted(keys.indices, j)) for j in samples]
         nodes = [-1, *chain, end]
         straight = {(a, b): True for a, b in zip(nodes[:-1], nodes[1:], strict=True)}
-        rest = [int(i) for i in keys.order if int(i) not in chain]
-        return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int)), straight
+        return _chain_ahead(keys, chain), straight
 
     def _chain_first(
         self, keys: KeyPoses, repaired: dict[int, np.ndarray | None]
@@ -485,9 +494,7 @@ class MotionPlanner:
             return ok
 
         chain = straight_chain(n, connects)
-        rest = [int(i) for i in keys.order if int(i) not in chain]
-        keys = dataclasses.replace(keys, order=np.array(chain + rest, dtype=int))
-        return keys, straight, len(chain)
+        return _chain_ahead(keys, chain), straight, len(chain)
 
     def _finish(self, path: np.ndarray) -> np.ndarray | None:
         """Shortcut and smooth ``path`` with OMPL, then verify densely; None if unverifiable."""
@@ -536,3 +543,16 @@ class MotionPlanner:
         if np.any(dense[:, :3] < lo - 1e-9) or np.any(dense[:, :3] > hi + 1e-9):
             return False
         return not any(self._collides(s) for s in dense)
+
+
+def _demo_states(demo: object) -> np.ndarray:
+    """(T, 7) states ``[x, y, z, qw, qx, qy, qz]`` of a demonstration's ``L2G``."""
+    pos = np.asarray(demo.pos, dtype=float)  # type: ignore[attr-defined]
+    return np.concatenate([pos, np.asarray(demo.quat, dtype=float)], axis=1)  # type: ignore[attr-defined]
+
+
+def _chain_ahead(keys: KeyPoses, chain: list[int]) -> KeyPoses:
+    """``keys`` with the candidates ``chain`` (positions, in order) ranked first, then the rest
+    in their order."""
+    rest = [int(i) for i in keys.order if int(i) not in chain]
+    return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int))

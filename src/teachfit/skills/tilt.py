@@ -131,9 +131,13 @@ class TiltState:
 
     def _tilt_to(self, angle: float) -> None:
         """Search at ``angle`` (rad) from now on."""
-        s = math.sin(0.5 * angle)  # about z x d = (-d_y, d_x, 0): lowers the +d rim
         self.full = angle
-        self.q_tilt = np.array([math.cos(0.5 * angle), -self.d[1] * s, self.d[0] * s, 0.0])
+        self.q_tilt = self._about_axis(angle)
+
+    def _about_axis(self, angle: float) -> np.ndarray:
+        """The rotation by ``angle`` (rad) about z x d = (-d_y, d_x, 0): lowers the +d rim."""
+        s = math.sin(0.5 * angle)
+        return np.array([math.cos(0.5 * angle), -self.d[1] * s, self.d[0] * s, 0.0])
 
     def reset(self, z: float) -> None:
         self.phase, self.z_top, self.t0, self.z_aligned = SEARCH, z, 0.0, z
@@ -153,9 +157,7 @@ class TiltState:
         if a >= self.full:
             quat_mul_into(out, self.q_tilt, quat)
         elif a > 0.0:
-            s = math.sin(0.5 * a)
-            q = np.array([math.cos(0.5 * a), -self.d[1] * s, self.d[0] * s, 0.0])
-            quat_mul_into(out, q, quat)
+            quat_mul_into(out, self._about_axis(a), quat)
         else:
             out[:] = quat
 
