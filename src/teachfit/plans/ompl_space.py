@@ -74,7 +74,9 @@ def slerp(qa: np.ndarray, qb: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 
 def matrix_to_state(T: np.ndarray) -> np.ndarray:
-    """(7,) state ``[x, y, z, qw, qx, qy, qz]`` of a (4, 4) transform (scipy's quaternion sign)."""
+    """(..., 7) states ``[x, y, z, qw, qx, qy, qz]`` of (..., 4, 4) transforms (scipy's
+    quaternion sign). A stack converts in one call: scipy's per-call overhead (~0.3 ms) is most
+    of the cost of one conversion."""
     T = np.asarray(T, dtype=float)
-    q = rotation_to_wxyz(Rotation.from_matrix(T[:3, :3]), canonical=False)
-    return np.concatenate([T[:3, 3], q])
+    q = rotation_to_wxyz(Rotation.from_matrix(T[..., :3, :3]), canonical=False)
+    return np.concatenate([T[..., :3, 3], q], axis=-1)

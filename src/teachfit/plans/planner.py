@@ -144,7 +144,7 @@ class MotionPlanner:
 
     # -- states -------------------------------------------------------------------------------
     def _collides(self, s: np.ndarray) -> bool:
-        return self.checker.collides_xyzq(*(float(v) for v in s))
+        return self.checker.collides_xyzq(*np.asarray(s, dtype=float).tolist())
 
     def _to_ompl(self, s: np.ndarray) -> ob.State:
         state = self.space.allocState()
@@ -191,7 +191,8 @@ class MotionPlanner:
 
     def _repair_all(self, keys: KeyPoses, rng: np.random.Generator) -> dict[int, np.ndarray | None]:
         """:meth:`repair` of every candidate, by its position in ``keys``."""
-        return {i: self.repair(matrix_to_state(T), rng) for i, T in enumerate(keys.L2G)}
+        states = matrix_to_state(keys.L2G)
+        return {i: self.repair(s, rng) for i, s in enumerate(states)}
 
     # -- segments -----------------------------------------------------------------------------
     def _plan_segment(
@@ -327,11 +328,11 @@ class MotionPlanner:
                 path = np.concatenate([pieces[0]] + [p[1:] for p in pieces[1:]])
                 t_plan = time.perf_counter() - t0
                 path = self._finish(path)
+                demo_states = matrix_to_state(keys.L2G) if chosen else None
                 n_replaced = sum(
                     1
                     for i in chosen
-                    if repaired[i] is None
-                    or not np.array_equal(repaired[i], matrix_to_state(keys.L2G[i]))
+                    if repaired[i] is None or not np.array_equal(repaired[i], demo_states[i])  # type: ignore[index]
                 )
                 return PlanResult(
                     success=path is not None,
