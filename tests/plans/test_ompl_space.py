@@ -20,6 +20,17 @@ def test_matrix_to_state_round_trip():
     np.testing.assert_allclose(back, T[:3, :3], atol=1e-12)
 
 
+def test_a_stack_of_transforms_converts_as_each_one_does():
+    rots = Rotation.random(5, random_state=3).as_matrix()
+    T = np.tile(np.eye(4), (5, 1, 1))
+    T[:, :3, :3] = rots
+    T[:, :3, 3] = np.arange(15.0).reshape(5, 3) * 1e-3
+    stack = matrix_to_state(T)
+    assert stack.shape == (5, 7)
+    for i in range(5):  # the planner's states must not depend on how they were converted
+        assert np.array_equal(stack[i], matrix_to_state(T[i]))
+
+
 def test_slerp_ends_midpoint_and_shorter_arc():
     qa = np.array([1.0, 0.0, 0.0, 0.0])
     qb = np.array([np.cos(0.5), 0.0, 0.0, np.sin(0.5)])  # 1 rad about z
