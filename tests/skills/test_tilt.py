@@ -14,7 +14,17 @@ from teachfit.execution.search import task_follow_config
 from teachfit.robot.registry import make_robot
 from teachfit.skills.follow import FollowConfig, FollowSetpoints
 from teachfit.skills.percept import MPCommand, Percept
-from teachfit.skills.tilt import ALIGN, LATERAL, SEARCH, TiltConfig, TiltState, wedge_lag
+from teachfit.skills.tilt import (
+    ALIGN,
+    LATERAL,
+    LIFT,
+    LIFT_SPEED,
+    SEARCH,
+    TiltConfig,
+    TiltState,
+    tilted_drop,
+    wedge_lag,
+)
 from teachfit.tasks import get_task
 
 
@@ -95,6 +105,54 @@ def test_after_a_missed_align_it_retries_at_the_other_tilt_and_feels_a_drop_at_o
     assert state.full == 0.25 and state.z_floor == -np.inf
 
 
+def test_tilted_drop_is_the_deeper_of_rim_on_top_and_both_rims_inside():
+    d, c, a = 0.03, 5e-4, 0.25
+    assert tilted_drop(a, d, c) == pytest.approx(d * np.sin(a))  # 7.4 mm: high rim on top
+    narrow = tilted_drop(0.1, d, c)  # nearly upright: the whole tip gets in, leaning on
+    assert narrow == pytest.approx((d + c - d * np.cos(0.1)) / np.tan(0.1))
+    assert narrow > d * np.sin(0.1)
+    with pytest.raises(SkillError, match="off_depth"):
+        TiltConfig(drop_depth=5e-4, off_depth=4e-4)
+
+
+def test_a_drop_deeper_than_a_hole_gives_lifts_back_over_the_top_and_goes_on_upright():
+    t = np.array([0.0, 10.0])
+    pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])  # along +x: the rim leans +x
+    traj = SetpointTrajectory.from_path(t, pos)
+    tilt = TiltConfig(angle=0.2, drop_depth=5e-4, stall_lag=0.01, off_depth=0.008)
+    run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    state = run.tilt
+    _tick(run, pc, (0.0, 0.0, 0.003), 0.5)  # resting tilted
+    _tick(run, pc, (0.005, 0.0, 0.0024), 1.0)  # the low rim went over the top's edge
+    assert state.phase == LATERAL
+    _tick(run, pc, (0.007, 0.0, -0.002), 1.4)  # pivoting on it, sinking: a hole gives that
+    assert state.phase == LATERAL
+    cmd = _tick(run, pc, (0.018, 0.0, -0.0055), 1.8)  # 8.5 mm: deeper than any hole gives
+    assert state.phase == LIFT
+    assert cmd.wrench[2] == 0.0 and cmd.twist[2] == LIFT_SPEED  # no push: up, in place
+    assert np.allclose(pc.p_d[:2], (0.018, 0.0))
+    _tick(run, pc, (0.018, 0.0, -0.03), 2.8)  # hanging below the set-point
+    assert state.phase == LIFT and pc.p_d[2] == pytest.approx(-0.0055 + LIFT_SPEED)
+    _tick(run, pc, (0.018, 0.0, 0.0042), 3.0)  # 1.2 mm above the top: over to the trajectory
+    z_held = pc.p_d[2]
+    cmd = _tick(run, pc, (0.0179, 0.0, 0.0042), 3.02)  # where it was left at 1 s: x = 10 mm
+    assert 0.01 < pc.p_d[0] < 0.018 and cmd.twist[0] == -LIFT_SPEED and pc.p_d[2] == z_held
+    _tick(run, pc, (0.011, 0.0, 0.0042), 3.2)
+    assert state.phase == LIFT and pc.p_d[0] == pytest.approx(0.01)  # there, TCP not yet
+    _tick(run, pc, (0.0105, 0.0, 0.0042), 3.3)
+    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == 0.0
+    assert run.paused == pytest.approx(3.3 - 1.0)
+    _tick(run, pc, (0.012, 0.0, 0.0), 3.5)  # upright on the top, lower: not a drop
+    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == 0.0
+    _tick(run, pc, (0.031, 0.0, 0.0), 4.0)  # a reach from the edge: tilted again
+    assert wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.2)
+    _tick(run, pc, (0.031, 0.0, 0.002), 4.5)  # settled tilted, then a hole's drop
+    _tick(run, pc, (0.031, 0.0, 0.0014), 4.6)
+    assert state.phase == LATERAL
+
+
 def test_peg2d_jam_free_tilt_is_where_the_high_rim_clears_the_near_edge():
     task = get_task("peg2d", peg_diameter=0.03, clearance=3e-4, peg_chamfer=0.0, hole_chamfer=0.0)
     r, big_r = 0.015, 0.01515
@@ -103,6 +161,7 @@ def test_peg2d_jam_free_tilt_is_where_the_high_rim_clears_the_near_edge():
     assert config.angle == 0.25 and config.retry_angle == pytest.approx(task.jam_free_tilt)
     wide = get_task("peg2d", peg_diameter=0.008, clearance=5e-4, peg_chamfer=0.0, hole_chamfer=0.0)
     assert task_follow_config(wide).tilt.retry_angle is None  # acos(4 / 4.25) > 0.25 rad
+    assert config.off_depth == pytest.approx(tilted_drop(0.25, 0.03, 3e-4) + 0.002)
 
 
 def test_no_drop_is_felt_while_the_part_still_tilts():

@@ -22,7 +22,7 @@ from teachfit.execution.follow import run_trajectory
 from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.skills.follow import FollowConfig
-from teachfit.skills.tilt import TiltConfig, wedge_lag
+from teachfit.skills.tilt import TiltConfig, tilted_drop, wedge_lag
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
@@ -30,6 +30,9 @@ from teachfit.trajectories.ergodic_opt import optimise_ergodic
 
 METHODS = ("tshix", "ergodic", "ergodic-opt", "spiral", "random-walk")
 _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rz": 5}
+#: m past the deepest a tilted part sinks into the hole that means it left the top instead
+#: (the tilt gives under the contact torque; the set-point leads the sinking part)
+OFF_MARGIN = 0.002
 
 
 def search_setpoints(
@@ -223,7 +226,10 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
     :mod:`teachfit.skills.tilt`): the drop felt at half the upright hold depth (a tilted peg
     rests steadily on a flat top; its drop is ~ tan(tilt) x how far the rim is past the edge),
     the low rim slid up to a hole diameter after it; after a missed align it tries once at the
-    task's ``jam_free_tilt`` where that is smaller, then at ``search_tilt`` again, and so on."""
+    task's ``jam_free_tilt`` where that is smaller, then at ``search_tilt`` again, and so on;
+    a drop deeper than the tilted part can sink into the hole (:func:`tilted_drop` at the
+    larger tilt, plus the hole's chamfer and ``OFF_MARGIN``) left the top over its outer
+    edge: lifted back onto it."""
     angle = float(getattr(task, "search_tilt", 0.0))
     if angle <= 0.0:
         return None
@@ -235,6 +241,7 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
         drop_depth=0.5 * float(task.search_hold_depth),
         lateral_reach=p.peg_diameter + p.clearance,
         stall_lag=wedge_lag(angle, p.friction, load, stiffness),
+        off_depth=tilted_drop(angle, p.peg_diameter, p.clearance) + p.hole_chamfer + OFF_MARGIN,
     )
 
 

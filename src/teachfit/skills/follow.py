@@ -33,7 +33,7 @@ from teachfit.skills.graph import Node, Skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
-from teachfit.skills.tilt import LATERAL, SEARCH, TiltConfig, TiltState
+from teachfit.skills.tilt import LATERAL, LIFT, SEARCH, TiltConfig, TiltState
 
 
 @dataclass(frozen=True)
@@ -219,6 +219,13 @@ class _FollowRun(PrimitiveRun):
             self.direction[:] = tilt.d
             tilt.lateral(pc, out.twist)
             out.wrench[:2] = 0.0
+        elif tilt.phase == LIFT:  # off the top: up, back over it, no push
+            t_left = pc.t_node - self.paused  # the trajectory's clock stood still since
+            target = self.traj.sample(t_left)[0][:2] + self.offset[:2]  # the drop
+            tilt.lift(pc, out.twist[:3], target)
+            if math.hypot(out.twist[0], out.twist[1]) > 1e-9:
+                self.direction[:] = out.twist[:2]
+            out.wrench[:] = 0.0
         elif self.hold is not None:
             pc.p_d[:2] = self.hold
             out.twist[:2] = 0.0

@@ -24,7 +24,18 @@ position within about a hole radius of the point one peg radius behind the hole 
    rests on the far wall, the part swings over the hole and slides in. Upright and not
    sinking ``RETRY`` s later, it missed (it stands on the edge): the search goes on, tilted,
    from where the trajectory was left (:class:`~teachfit.skills.follow.FollowSetpoints`
-   pauses the trajectory's clock outside the search phase and blends back to it).
+   pauses the trajectory's clock outside the search phase and blends back to it);
+4. *lift*: a drop in the lateral phase deeper than ``off_depth`` (a tilted part enters a
+   hole far less deep than the hole is) was the part leaving the top over its outer edge,
+   the low rim first (Ø 30 mm, 0.5 mm, μ 0.5: a 58 mm "drop" 46 mm from the hole on a Ø 120
+   mm top: the low rim went over the edge, the part pivoted on it and slid down the block's
+   side for the whole reach, and then stood on the floor beside the block, pushed there,
+   until the time ran out). Without the push, the set-point rises until the TCP is
+   ``LIFT_CLEAR`` / 2 above the top's height, then moves at ``LIFT_SPEED`` back over the top
+   to where the trajectory was left, and the search goes on from there upright (upright,
+   a part whose axis is over the top stays on it) until the TCP is ``lateral_reach`` from
+   where the drop was felt; then tilted again (tilted there again, the low rim went over the
+   same edge again: the same fall, lift and return, over and over).
 
 Jams. A wide part that dropped in deep at a large tilt can jam while it turns upright: its
 high rim comes down on the top beside the near edge while its side still rests on the far
@@ -57,8 +68,13 @@ TILT_SETTLE = 0.3
 #: a part upright for ``RETRY`` s (s) that sank less than ``RETRY_SINK`` (m) since is on the
 #: edge, not in the hole: the search goes on (an inserting part slides in within 0.3 s)
 RETRY, RETRY_SINK = 0.5, 0.001
+#: height (m) above the top's resting height that a part which left the top is lifted
+#: to, at least half of it, before it moves back over the top (its low rim clears the edge)
+LIFT_CLEAR = 0.002
+#: speed (m/s) of the lift's set-point, going up and then back over the top
+LIFT_SPEED = 0.05
 #: phases of a tilted search
-SEARCH, LATERAL, ALIGN = 0, 1, 2
+SEARCH, LATERAL, ALIGN, LIFT = 0, 1, 2, 3
 
 
 @dataclass(frozen=True)
@@ -73,6 +89,7 @@ class TiltConfig:
     stall_lag: float = 0.003
     align_time: float = 0.5
     retry_angle: float | None = None
+    off_depth: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.angle) and 0.0 < self.angle < 0.6):
@@ -81,6 +98,12 @@ class TiltConfig:
             math.isfinite(self.retry_angle) and 0.0 < self.retry_angle < 0.6
         ):
             raise SkillError(f"tilt: retry_angle must be in (0, 0.6) rad, got {self.retry_angle}")
+        if self.off_depth is not None and not (
+            math.isfinite(self.off_depth) and self.off_depth > self.drop_depth
+        ):
+            raise SkillError(
+                f"tilt: off_depth must exceed drop_depth ({self.drop_depth}), got {self.off_depth}"
+            )
         if self.direction is not None and not math.isfinite(self.direction):
             raise SkillError(f"tilt: direction must be finite, got {self.direction}")
         for name in ("drop_depth", "lateral_reach", "lateral_speed", "stall_lag", "align_time"):
@@ -109,6 +132,19 @@ class TiltConfig:
         v = pts.mean(axis=0) - pts[0]
         n = float(np.hypot(v[0], v[1]))
         return v / n if n > 1e-9 else np.array([1.0, 0.0])
+
+
+def tilted_drop(angle: float, diameter: float, clearance: float) -> float:
+    """The deepest (m) the low rim of a cylinder of ``diameter`` (m) tilted by ``angle``
+    (rad) gets below a flat top into a sharp-edged round hole ``clearance`` (m, diametral)
+    wider: with its high rim still on the top, ``D sin(angle)``; with both rims inside, as
+    deep as the low side of its body, leaning on over the far wall, lets it:
+    ``(D + c - D cos(angle)) / tan(angle)``; the larger of the two (the lowest point of the
+    tilted part drops as far as the TCP does)."""
+    d, c, tan = diameter, clearance, math.tan(angle)
+    on_top = min(d * math.sin(angle), (d + c) / tan)
+    inside = (d + c - d * math.cos(angle)) / tan
+    return max(on_top, inside)
 
 
 def wedge_lag(angle: float, friction: float, load: float, stiffness: float) -> float:
@@ -142,11 +178,17 @@ class TiltState:
     def reset(self, z: float) -> None:
         self.phase, self.z_top, self.t0, self.z_aligned = SEARCH, z, 0.0, z
         self.origin = np.zeros(2)
+        self.lifted = self.arrived = False  # lifting: up high enough; set-point back over
+        self.z_fall, self.z_lift, self.t_lifted = z, z, 0.0  # m, m, s: the lift's course
+        self.xy_fall, self.xy_lifted, self.back = np.zeros(2), np.zeros(2), np.zeros(2)
+        self.edge: np.ndarray | None = None  # m, x-y of a drop that was the top's edge
         self.z_floor = -math.inf  # m, where a missed align stood upright (on the edge)
         self._tilt_to(self.cfg.angle)
 
     def angle(self, t: float) -> float:
         """The tilt (rad) at node time ``t``: full until aligning, then down to 0."""
+        if self.phase == SEARCH and self.edge is not None:
+            return 0.0
         if self.phase != ALIGN:
             return self.full
         return self.full * max(0.0, 1.0 - (t - self.t0) / self.cfg.align_time)
@@ -164,7 +206,11 @@ class TiltState:
     def step(self, pc: Percept) -> bool:
         """Advance the phase from the measured TCP; True when it should hold x-y (align)."""
         z, t = float(pc.p[2]), pc.t_node
-        if self.phase == SEARCH:
+        if self.phase == SEARCH and self.edge is not None:  # upright beside the edge
+            self.z_top = z
+            if float(np.hypot(*(pc.p[:2] - self.edge))) > self.cfg.lateral_reach:
+                self.edge, self.t0 = None, t  # away from it: tilt again
+        elif self.phase == SEARCH:
             if t - self.t0 < TILT_SETTLE:  # still tilting: no resting height yet, but
                 self.z_top = max(z, self.z_floor)  # below the edge it stood on: a drop
             self.z_top = max(self.z_top, z)
@@ -177,7 +223,11 @@ class TiltState:
             lead = self.cfg.lateral_speed * (t - self.t0) - travel
             stalled = lead > self.cfg.stall_lag
             spent = travel >= self.cfg.lateral_reach or t - self.t0 > self.cfg.lateral_time
-            if self.z_top - z < 0.5 * self.cfg.drop_depth:  # back up: the rim rode out over
+            off = self.cfg.off_depth
+            if off is not None and self.z_top - z > off:  # deeper than any hole: off the top
+                self.phase, self.t0, self.lifted, self.arrived = LIFT, t, False, False
+                self.z_fall, self.xy_fall[:] = z, pc.p[:2]
+            elif self.z_top - z < 0.5 * self.cfg.drop_depth:  # back up: the rim rode out over
                 self.phase, self.t0 = SEARCH, t  # the edge (a shallow drop), search on
             elif stalled or spent:
                 self.phase, self.t0 = ALIGN, t
@@ -191,7 +241,39 @@ class TiltState:
                 other = self.cfg.retry_angle  # the other tilt next time
                 if other is not None:
                     self._tilt_to(other if self.full == self.cfg.angle else self.cfg.angle)
+        elif self.phase == LIFT:
+            if not self.lifted and z >= self.z_top + 0.5 * LIFT_CLEAR:  # high enough:
+                self.lifted, self.t_lifted = True, t  # over the top from here
+                self.xy_lifted[:] = pc.p[:2]
+            near = float(np.hypot(*(pc.p[:2] - self.back))) < LIFT_CLEAR
+            if self.arrived and near:
+                self.phase, self.t0 = SEARCH, t  # back over the top: search on from here,
+                self.edge = self.origin.copy()  # upright until away from the edge
         return self.phase == ALIGN
+
+    def lift(self, pc: Percept, twist: np.ndarray, target: np.ndarray) -> None:
+        """In the lift phase: the set-point rises from the TCP at ``LIFT_SPEED`` until the TCP
+        is ``LIFT_CLEAR`` / 2 above the top's height (the part's unsupported weight pulls it
+        below the set-point, by an amount that depends on the part and the stiffness, so the
+        set-point goes up until the TCP is there, and stays); then x-y moves at
+        ``LIFT_SPEED`` to ``target`` (2,; m: the trajectory's x-y where it was left).
+        ``twist`` (3,): the set-point's velocity."""
+        self.back[:] = target
+        twist[:] = 0.0
+        if not self.lifted:
+            self.z_lift = self.z_fall + LIFT_SPEED * (pc.t_node - self.t0)
+            pc.p_d[:2], pc.p_d[2], twist[2] = self.xy_fall, self.z_lift, LIFT_SPEED
+            return
+        pc.p_d[2] = self.z_lift
+        gap = target - self.xy_lifted
+        dist = float(np.hypot(gap[0], gap[1]))
+        s = LIFT_SPEED * (pc.t_node - self.t_lifted)
+        self.arrived = s >= dist
+        if self.arrived:
+            pc.p_d[:2] = target
+        else:
+            pc.p_d[:2] = self.xy_lifted + gap * (s / dist)
+            twist[:2] = LIFT_SPEED * gap / dist
 
     def lateral(self, pc: Percept, twist: np.ndarray) -> None:
         """In the lateral phase: the x-y set-point and velocity along ``d`` from the drop."""
