@@ -188,9 +188,8 @@ class FrankaRobot:
         tick.bias = bias / self.params.bias_ticks
         tick.q_rest = self._loop.q.copy()
         law = make_law(self.controller_spec, self._mass, self.control_period)
-        self._loop.install(law, ImpedanceCommand.hold(pose))
-        self.step(1)
-        self._loop.t0 = self._loop.t_abs
+        self._loop.install(law, ImpedanceCommand.hold(pose), restart_clock=True)
+        self.step(1)  # this tick may have begun before the install: the next one adopted it
         self.resets += 1
         return self.step(1)
 

@@ -74,6 +74,7 @@ class ControlLoop:
         self._lock = threading.Lock()
         self._pending_law: Controller | None = None
         self._pending_cmd: ImpedanceCommand | None = None
+        self._pending_clock = False
         self.law: Controller | None = None
         self.ticks = 0
         self.t_abs = 0.0
@@ -119,11 +120,14 @@ class ControlLoop:
         with self._lock:
             self._pending_cmd = cmd
 
-    def install(self, law: Controller, cmd: ImpedanceCommand) -> None:
-        """Run ``law`` with ``cmd`` from the next tick on."""
+    def install(self, law: Controller, cmd: ImpedanceCommand, restart_clock: bool = False) -> None:
+        """Run ``law`` with ``cmd`` from the next tick on; ``restart_clock``: that tick also
+        reads ``t = period`` (the clock is restarted in the control thread, on the tick that
+        adopts the law, so no state published in between can read a stale or zero time)."""
         with self._lock:
             self._pending_law = law
             self._pending_cmd = cmd
+            self._pending_clock = restart_clock
 
     def wait(self, n: int, timeout: float) -> None:
         """Block until ``n`` more ticks ran; raise the latched fault, or :class:`ConnectionLost`
@@ -193,6 +197,8 @@ class ControlLoop:
         with self._lock:
             if self._pending_law is not None:
                 self.law, self._pending_law = self._pending_law, None
+            if self._pending_clock:
+                self.t0, self._pending_clock = self.t_abs - self.period, False
             if self._pending_cmd is not None:
                 self.law.set_command(self._pending_cmd, self.t_abs)  # type: ignore[union-attr]
                 self._pending_cmd = None
