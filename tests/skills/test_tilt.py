@@ -17,11 +17,13 @@ from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.tilt import (
     ALIGN,
     LATERAL,
+    LEAD_TIME,
     LIFT,
     LIFT_SPEED,
     SEARCH,
     TiltConfig,
     TiltState,
+    rim_lead,
     tilted_drop,
     wedge_lag,
 )
@@ -153,6 +155,28 @@ def test_a_drop_deeper_than_a_hole_gives_lifts_back_over_the_top_and_goes_on_upr
     assert state.phase == LATERAL
 
 
+def test_with_a_lead_the_set_points_go_back_so_that_the_low_rim_follows_the_path():
+    assert rim_lead(0.25, 0.03) == pytest.approx(0.015 * np.cos(0.25))
+    with pytest.raises(SkillError, match="lead"):
+        TiltConfig(lead=-1e-3)
+    t = np.array([0.0, 10.0])
+    pos = np.array([[0.0, 0.0, 0.0], [0.0, 0.1, 0.0]])  # along +y: the rim leans +y
+    traj = SetpointTrajectory.from_path(t, pos)
+    run = FollowSetpoints(traj, FollowConfig(tilt=TiltConfig(lead=0.01))).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    _tick(run, pc, (0.0, 0.0, 0.0), 0.0)
+    assert np.allclose(pc.p_d[:2], 0.0)  # from where the part is
+    _tick(run, pc, (0.0, 0.0, 0.0), 0.5 * LEAD_TIME)
+    assert np.allclose(pc.p_d[:2], (0.0, 0.005 * LEAD_TIME - 0.005))  # half way back
+    _tick(run, pc, (0.0, 0.0, 0.0), 2.0)
+    assert np.allclose(pc.p_d[:2], (0.0, 0.02 - 0.01))  # the low rim on the path
+    upright = FollowSetpoints(traj, FollowConfig()).compile({})
+    upright.enter(pc)
+    _tick(upright, pc, (0.0, 0.0, 0.0), 2.0)
+    assert np.allclose(pc.p_d[:2], (0.0, 0.02))
+
+
 def test_peg2d_jam_free_tilt_is_where_the_high_rim_clears_the_near_edge():
     task = get_task("peg2d", peg_diameter=0.03, clearance=3e-4, peg_chamfer=0.0, hole_chamfer=0.0)
     r, big_r = 0.015, 0.01515
@@ -162,6 +186,7 @@ def test_peg2d_jam_free_tilt_is_where_the_high_rim_clears_the_near_edge():
     wide = get_task("peg2d", peg_diameter=0.008, clearance=5e-4, peg_chamfer=0.0, hole_chamfer=0.0)
     assert task_follow_config(wide).tilt.retry_angle is None  # acos(4 / 4.25) > 0.25 rad
     assert config.off_depth == pytest.approx(tilted_drop(0.25, 0.03, 3e-4) + 0.002)
+    assert config.lead == pytest.approx(rim_lead(0.25, 0.03))
 
 
 def test_no_drop_is_felt_while_the_part_still_tilts():

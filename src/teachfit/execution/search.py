@@ -22,7 +22,7 @@ from teachfit.execution.follow import run_trajectory
 from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.skills.follow import FollowConfig
-from teachfit.skills.tilt import TiltConfig, tilted_drop, wedge_lag
+from teachfit.skills.tilt import TiltConfig, rim_lead, tilted_drop, wedge_lag
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
@@ -229,7 +229,8 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
     task's ``jam_free_tilt`` where that is smaller, then at ``search_tilt`` again, and so on;
     a drop deeper than the tilted part can sink into the hole (:func:`tilted_drop` at the
     larger tilt, plus the hole's chamfer and ``OFF_MARGIN``) left the top over its outer
-    edge: lifted back onto it."""
+    edge: lifted back onto it; the set-points go a :func:`rim_lead` behind the trajectory, so
+    that the low rim follows it."""
     angle = float(getattr(task, "search_tilt", 0.0))
     if angle <= 0.0:
         return None
@@ -242,6 +243,7 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
         lateral_reach=p.peg_diameter + p.clearance,
         stall_lag=wedge_lag(angle, p.friction, load, stiffness),
         off_depth=tilted_drop(angle, p.peg_diameter, p.clearance) + p.hole_chamfer + OFF_MARGIN,
+        lead=rim_lead(angle, p.peg_diameter),
     )
 
 

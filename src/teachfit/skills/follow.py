@@ -33,7 +33,7 @@ from teachfit.skills.graph import Node, Skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
-from teachfit.skills.tilt import LATERAL, LIFT, SEARCH, TiltConfig, TiltState
+from teachfit.skills.tilt import LATERAL, LEAD_TIME, LIFT, SEARCH, TiltConfig, TiltState
 
 
 @dataclass(frozen=True)
@@ -145,13 +145,18 @@ class _FollowRun(PrimitiveRun):
     def enter(self, pc: Percept) -> None:
         self.direction[:] = (1.0, 0.0)
         self.offset[:] = pc.p_d - self.traj.pos[0] if self.cfg.anchor == "entry" else 0.0
-        pc.goal[:] = self.traj.pos[-1] + self.offset
         pc.done = False
         self.press_correction = 0.0
         self.z0, self.hold = float(pc.p[2]), None
         if self.tilt is not None:
             self.tilt.reset(self.z0)
         self.paused, self.blend_time, self.t_last = 0.0, 0.0, 0.0
+        if self.tilt is not None and self.tilt.cfg.lead > 0.0:  # the low rim follows the path
+            shift = self.tilt.cfg.lead * self.tilt.d
+            self.offset[:2] -= shift
+            self.blend[:] = shift  # from where the part is, back by the lead over LEAD_TIME
+            self.blend_t0, self.blend_time = pc.t_node, LEAD_TIME
+        pc.goal[:] = self.traj.pos[-1] + self.offset
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         cfg = self.cfg
