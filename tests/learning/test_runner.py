@@ -109,7 +109,9 @@ def test_workers_die_with_a_killed_parent_and_finished_trials_stay(tmp_path: Pat
 
 def test_a_second_ctrl_c_aborts_with_a_clear_line_and_status_130(tmp_path: Path) -> None:
     db = tmp_path / "twice.db"
-    proc = _learn(db, "--starts", "4", "--workers", "1")  # trials of ~2.5 s
+    # trials of 16 executions, ~3 s on an idle machine (4 took ~0.7 s: the running trial
+    # could finish, and the run end normally, before the second Ctrl-C arrived)
+    proc = _learn(db, "--starts", "16", "--workers", "1")
     try:
         n = _wait_stored(proc, db, 1)
         _wait_stored(proc, db, n + 1)  # a trial was just stored: the next one has just begun
