@@ -78,7 +78,7 @@ def learn_skill(
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.bench.learning import method_options
     from teachfit.learning.objective import SkillObjective
-    from teachfit.learning.runner import run_study
+    from teachfit.learning.runner import Interrupts, run_study
     from teachfit.learning.study import METHODS, Study, StudyMismatchError, stored_tags
     from teachfit.tasks.registry import get_task
 
@@ -134,59 +134,62 @@ def learn_skill(
             f"[yellow]the study already holds {st.n_finished} trial(s) >= --trials "
             f"{trials}[/]: nothing to run; raise --trials to continue"
         )
-    best = [math.inf]
-    try:
-        with progress_bar() as bar:
-            done = min(st.n_finished, trials)
-            job = bar.add_task(f"{method} {task}", total=trials, completed=done)
+    # one guard for the run and the report: a second Ctrl-C while the report is written
+    # (after a first one ended the run) still aborts with the clear line below
+    with Interrupts():
+        try:
+            best = [math.inf]
+            with progress_bar() as bar:
+                done = min(st.n_finished, trials)
+                job = bar.add_task(f"{method} {task}", total=trials, completed=done)
 
-            def progress(rec: object) -> None:
-                if rec.feasible:  # type: ignore[attr-defined]
-                    best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
-                bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
+                def progress(rec: object) -> None:
+                    if rec.feasible:  # type: ignore[attr-defined]
+                        best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
+                    bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
 
-            if ray:
-                from teachfit.learning.ray_runner import run_study_ray
+                if ray:
+                    from teachfit.learning.ray_runner import run_study_ray
 
-                rep = run_study_ray(
-                    st, obj, trials, address=ray, workers=workers, on_trial=progress
+                    rep = run_study_ray(
+                        st, obj, trials, address=ray, workers=workers, on_trial=progress
+                    )
+                else:
+                    rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+            console.print(
+                f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
+                f"trials/s), {rep.failed} failed by crash/divergence; study holds "
+                f"{st.n_finished}"
+            )
+            if not rep.interrupted and st.n_finished < trials:
+                console.print(
+                    f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
+                    f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials"
                 )
-            else:
-                rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
-    except KeyboardInterrupt:  # a second Ctrl-C / SIGTERM: running trials were dropped
-        console.print(
-            f"[red]interrupted again[/]: aborted; the {st.n_finished} finished trial(s) are "
-            "stored, the running ones were dropped; continue with the same command and --resume"
-        )
-        raise typer.Exit(130) from None
-    console.print(
-        f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
-        f"trials/s), {rep.failed} failed by crash/divergence; study holds "
-        f"{st.n_finished}"
-    )
-    if not rep.interrupted and st.n_finished < trials:
-        console.print(
-            f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
-            f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials"
-        )
-    if out is None and "://" not in study:
-        out = Path(study).with_suffix(".params.toml")
-    if st.n_finished:
-        _report_best(
-            st,
-            obj,
-            out,
-            plot,
-            traces,
-            best_plot,
-            f"{method} on {task}, seed {seed}, {starts} start(s) per trial",
-        )
-    if rep.interrupted:
-        console.print(
-            f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
-            "with the same command and --resume"
-        )
-        raise typer.Exit(130)
+            if out is None and "://" not in study:
+                out = Path(study).with_suffix(".params.toml")
+            if st.n_finished:
+                _report_best(
+                    st,
+                    obj,
+                    out,
+                    plot,
+                    traces,
+                    best_plot,
+                    f"{method} on {task}, seed {seed}, {starts} start(s) per trial",
+                )
+            if rep.interrupted:
+                console.print(
+                    f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
+                    "with the same command and --resume"
+                )
+                raise typer.Exit(130)
+        except KeyboardInterrupt:  # a second Ctrl-C / SIGTERM: running trials were dropped
+            console.print(
+                f"[red]interrupted again[/]: aborted; the {st.n_finished} finished trial(s) are "
+                "stored, the running ones were dropped; continue with the same command and --resume"
+            )
+            raise typer.Exit(130) from None
 
 
 def _report_best(

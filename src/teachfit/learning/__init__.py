@@ -6,7 +6,7 @@ from teachfit.learning.bo import BayesOpt
 from teachfit.learning.cmaes import CMAES
 from teachfit.learning.lhs import LatinHypercube
 from teachfit.learning.pso import PSO
-from teachfit.learning.runner import RunReport, run_study
+from teachfit.learning.runner import Interrupts, RunReport, run_study
 from teachfit.learning.study import METHODS, Study, StudyMismatchError, make_learner
 
 __all__ = [
@@ -16,6 +16,7 @@ __all__ = [
     "BayesOpt",
     "Candidate",
     "Finished",
+    "Interrupts",
     "LatinHypercube",
     "Learner",
     "LearningError",

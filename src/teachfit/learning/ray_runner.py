@@ -26,7 +26,7 @@ from typing import Any
 
 from teachfit.core.params import LearningError
 from teachfit.learning.base import Candidate, TrialResult
-from teachfit.learning.runner import POLL_S, Objective, RunReport, _Signals, evaluate
+from teachfit.learning.runner import POLL_S, Interrupts, Objective, RunReport, evaluate
 from teachfit.learning.study import Study, TrialRecord
 
 
@@ -107,7 +107,7 @@ def run_study_ray(
         slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
         task = ray.remote(num_cpus=1, max_retries=0)(evaluate)
         obj_ref = ray.put(objective)
-        with _Signals(handle_signals) as sig:
+        with Interrupts(handle_signals) as sig:
             while True:
                 while not sig.stop and len(pending) < slots:
                     cand = study.ask(budget)

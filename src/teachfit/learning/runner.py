@@ -113,28 +113,51 @@ def _worker_init(parent: int | None) -> None:
     die_with_parent(parent)
 
 
-class _Signals:
-    """First SIGINT/SIGTERM: ask to stop; second: KeyboardInterrupt. Restored on exit."""
+class Interrupts:
+    """First SIGINT/SIGTERM: ask to stop (``stop``); second: ``KeyboardInterrupt``, once.
 
-    def __init__(self, enabled: bool) -> None:
+    Signals after that one are ignored (the program is already aborting). Nested in an
+    outer one (e.g. a command that reports after :func:`run_study`), the inner one is the
+    outer one: a second Ctrl-C while the command writes its report still aborts cleanly.
+    Handlers are restored when the outermost one exits; inactive outside the main thread.
+    """
+
+    _active: Interrupts | None = None
+
+    def __init__(self, enabled: bool = True) -> None:
         self.enabled = enabled and threading.current_thread() is threading.main_thread()
         self.stop = False
+        self.aborted = False
         self._old: dict[int, Any] = {}
+        self._outer: Interrupts | None = None
 
     def _handle(self, signum: int, frame: object) -> None:
+        if self.aborted:
+            return
         if self.stop:
+            self.aborted = True
             raise KeyboardInterrupt
         self.stop = True
 
-    def __enter__(self) -> _Signals:
-        if self.enabled:
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._old[sig] = signal.signal(sig, self._handle)
+    def __enter__(self) -> Interrupts:
+        if not self.enabled:
+            return self
+        if Interrupts._active is not None:
+            self._outer = Interrupts._active
+            return self._outer
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._old[sig] = signal.signal(sig, self._handle)
+        Interrupts._active = self
         return self
 
     def __exit__(self, *exc: object) -> None:
+        if self._outer is not None or not self._old:
+            self._outer = None
+            return
+        Interrupts._active = None
         for sig, old in self._old.items():
             signal.signal(sig, old)
+        self._old.clear()
 
 
 def _kill_pool(pool: ProcessPoolExecutor) -> None:
@@ -179,7 +202,7 @@ def run_study(
         if on_trial is not None:
             on_trial(rec)
 
-    with _Signals(handle_signals) as sig:
+    with Interrupts(handle_signals) as sig:
         try:
             if n_workers == 0:
                 while not sig.stop:
@@ -210,7 +233,7 @@ def _run_pool(
     objective: Objective,
     budget: int,
     n_workers: int,
-    sig: _Signals,
+    sig: Interrupts,
     store: Callable[[Candidate, TrialResult | None, str], None],
     mp_context: str | None,
 ) -> None:
