@@ -88,6 +88,22 @@ def test_phases_tilt_drop_slide_to_the_wall_and_align():
     assert run.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
 
 
+def test_in_the_lateral_phase_the_set_point_is_free_across_the_lean():
+    traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
+    tilt = TiltConfig(angle=0.2, direction=0.0, drop_depth=5e-4, lateral_speed=0.005)
+    run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    _tick(run, pc, (0.0, 0.0, 0.0008), 0.5)  # resting tilted
+    _tick(run, pc, (0.0, 0.0, 0.0002), 0.6)  # dropped: slide along +x
+    assert run.tilt.phase == LATERAL
+    cmd = _tick(run, pc, (0.0005, 0.003, 0.0002), 0.8)  # the wall pushed the rim 3 mm across
+    assert run.tilt.phase == LATERAL
+    assert pc.p_d[1] == pytest.approx(0.003)  # across: where the TCP is, no spring back
+    assert pc.p_d[0] == pytest.approx(0.005 * 0.2)  # along: from the drop at the speed
+    assert cmd.twist[0] == pytest.approx(0.005) and cmd.twist[1] == 0.0
+
+
 def test_after_a_missed_align_it_retries_at_the_other_tilt_and_feels_a_drop_at_once():
     traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
     tilt = TiltConfig(angle=0.25, retry_angle=0.14, drop_depth=5e-4, stall_lag=0.002)

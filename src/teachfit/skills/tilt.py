@@ -18,7 +18,8 @@ feel near the hole's line along ``d`` (millimetres, not tenths; see *Lead* below
    TCP along ``d`` at ``lateral_speed``: the low rim slides across the hole until its far
    wall stops it (the set-point then leads the TCP by ``stall_lag``), or the TCP has gone
    ``lateral_reach`` (the hole's diameter); back up within half ``drop_depth`` of the
-   reference height, the rim rode out over the edge: the search goes on;
+   reference height, the rim rode out over the edge: the search goes on. Across ``d`` the
+   part is free (*Free across*);
 3. *align*: x-y held where the TCP is (the follower's soft hold stiffness), the tilt goes to
    zero linearly over ``align_time`` while the push goes on: turning about the rim that
    rests on the far wall, the part swings over the hole and slides in. Upright and not
@@ -45,6 +46,13 @@ ahead, and a wide part's tour passed with the rim 10-14 mm from the hole's centr
 0.5 mm, μ 0.5, 5 of 20 starts): the part sinks deep enough to feel only where the rim is
 near the hole's line along ``d`` (offset across it, its neighbours on the rim rest on the top
 beside the hole and it sinks a fraction of a millimetre).
+
+Free across. A drop is felt with the low rim up to a few millimetres beside the hole's line
+along ``d`` (Ø 30 mm, 0.5 mm, μ 0.5: 5-9 mm on the starts that failed). Held there by the
+across-stiffness, the rim slid along that chord and rode out short of the far wall. In the
+lateral phase the set-point across ``d`` is where the TCP is, so the hole's curved wall,
+pushing the rim along its normal, centres it on the line, as a hand sliding a tilted peg
+relaxes sideways (that variant: 17/20 -> 18/20 starts; BENCHMARKS.md).
 
 Jams. A wide part that dropped in deep at a large tilt can jam while it turns upright: its
 high rim comes down on the top beside the near edge while its side still rests on the far
@@ -296,6 +304,11 @@ class TiltState:
             twist[:2] = LIFT_SPEED * gap / dist
 
     def lateral(self, pc: Percept, twist: np.ndarray) -> None:
-        """In the lateral phase: the x-y set-point and velocity along ``d`` from the drop."""
+        """In the lateral phase: the x-y set-point and velocity along ``d`` from the drop;
+        across ``d`` the set-point is where the TCP is (no spring across: see *Free across*)."""
         pc.p_d[:2] = self.origin + self.cfg.lateral_speed * (pc.t_node - self.t0) * self.d
+        n0, n1 = -self.d[1], self.d[0]
+        across = (pc.p[0] - pc.p_d[0]) * n0 + (pc.p[1] - pc.p_d[1]) * n1
+        pc.p_d[0] += across * n0
+        pc.p_d[1] += across * n1
         twist[:2] = self.cfg.lateral_speed * self.d
