@@ -2,6 +2,7 @@
 hole that an upright peg misses."""
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 import pytest
@@ -88,12 +89,19 @@ def test_phases_tilt_drop_slide_to_the_wall_and_align():
     assert run.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
 
 
-def test_in_the_lateral_phase_the_set_point_is_free_across_the_lean():
+def _standing_still(tilt: TiltConfig) -> tuple[Any, Percept]:
+    """A tilted follower of a trajectory that stands at the origin, entered at t = 0."""
     traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
-    tilt = TiltConfig(angle=0.2, direction=0.0, drop_depth=5e-4, lateral_speed=0.005)
     run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
     pc = Percept(Pose(np.zeros(3)), 0.01)
     run.enter(pc)
+    return run, pc
+
+
+def test_in_the_lateral_phase_the_set_point_is_free_across_the_lean():
+    run, pc = _standing_still(
+        TiltConfig(angle=0.2, direction=0.0, drop_depth=5e-4, lateral_speed=0.005)
+    )
     _tick(run, pc, (0.0, 0.0, 0.0008), 0.5)  # resting tilted
     _tick(run, pc, (0.0, 0.0, 0.0002), 0.6)  # dropped: slide along +x
     assert run.tilt.phase == LATERAL
@@ -105,11 +113,9 @@ def test_in_the_lateral_phase_the_set_point_is_free_across_the_lean():
 
 
 def test_after_a_missed_align_it_retries_at_the_other_tilt_and_feels_a_drop_at_once():
-    traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
-    tilt = TiltConfig(angle=0.25, retry_angle=0.14, drop_depth=5e-4, stall_lag=0.002)
-    run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
-    pc = Percept(Pose(np.zeros(3)), 0.01)
-    run.enter(pc)
+    run, pc = _standing_still(
+        TiltConfig(angle=0.25, retry_angle=0.14, drop_depth=5e-4, stall_lag=0.002)
+    )
     state = run.tilt
     for t, z in ((0.5, 0.003), (0.6, 0.0024), (1.2, 0.0024), (1.5, 0.0), (2.4, 0.0)):
         _tick(run, pc, (0.0, 0.0, z), t)  # rest, drop, blocked, align, upright on the edge
