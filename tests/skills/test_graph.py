@@ -304,3 +304,16 @@ def test_with_fixed_moves_a_learned_parameter_to_the_context():
         peg_in_hole.build("impedance").with_fixed({"tilt": 0.5})
     with pytest.raises(SkillError, match="unknown learned"):
         sk.with_fixed({"tilt": 0.05})  # already fixed
+
+
+def test_with_domains_bounds_a_learned_parameter_and_clips_its_default():
+    sk = peg_in_hole.build("impedance").with_domains({"a_r": ParamDomain(0.0, 0.01)})
+    assert sk.space.domains["a_r"] == ParamDomain(0.0, 0.01)
+    assert sk.params.learned["a_r"].default == 0.01  # 0.02 clipped into the new domain
+    assert sk.space.domains["force"] == peg_in_hole.LEARNED["force"].domain  # the others kept
+    with pytest.raises(SkillError, match="outside its domain"):
+        sk.resolve({"a_r": 0.05})
+    with pytest.raises(SkillError, match="unknown learned"):
+        sk.with_domains({"stiffness_z": ParamDomain(0.0, 1.0)})
+    fixed = peg_in_hole.build("impedance").with_fixed({"tilt": 0.05})
+    assert "tilt" not in fixed.with_domains({"tilt": ParamDomain(0.0, 0.1)}).space.names

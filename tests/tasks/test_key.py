@@ -169,3 +169,12 @@ def test_ground_truth_inserted_with_symmetry(task: Key) -> None:
 def test_impossible_parameters(overrides, match) -> None:
     with pytest.raises(TaskError, match=f"key: .*{match}"):
         KeyParams(**overrides)
+
+
+@pytest.mark.parametrize("name", ["key", "puzzle"])
+def test_the_rotational_amplitude_is_bounded_by_the_yaw_play(name: str) -> None:
+    task = get_task(name)
+    play = task.params.clearance / task.yaw_lever
+    assert task.yaw_play == pytest.approx(play)
+    assert task.skill_domains == {"a_r": (0.0, pytest.approx(play))}
+    assert get_task(name, a_r_max=0.1).skill_domains == {"a_r": (0.0, 0.1)}

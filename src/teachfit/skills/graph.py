@@ -19,7 +19,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 from teachfit.core.errors import SkillError
-from teachfit.core.params import ParamSpace
+from teachfit.core.params import ParamDomain, ParamSpace
 from teachfit.skills.conditions import Check, Condition
 from teachfit.skills.params import SkillParams
 from teachfit.skills.primitive import Primitive, PrimitiveRun
@@ -172,6 +172,11 @@ class Skill:
         """The same skill with some learned parameters fixed (moved to the context) at
         ``values``: a task that does not learn them (see :meth:`SkillParams.with_fixed`)."""
         return replace(self, params=self.params.with_fixed(values))
+
+    def with_domains(self, domains: Mapping[str, ParamDomain]) -> Skill:
+        """The same skill with some learned parameters searched over other domains (see
+        :meth:`SkillParams.with_domains`)."""
+        return replace(self, params=self.params.with_domains(domains))
 
     # ------------------------------------------------------------------------- compiling
     def resolve(self, learned: Mapping[str, float] | None = None) -> dict[str, float]:

@@ -132,6 +132,22 @@ class SkillParams:
         lrn = {n: p for n, p in self.learned.items() if n not in values}
         return SkillParams(ctx, lrn)
 
+    def with_domains(self, domains: Mapping[str, ParamDomain]) -> SkillParams:
+        """A copy in which the learned parameters named in ``domains`` search those domains
+        instead (a task that bounds them tighter, as seed B gives each task its own largest
+        rotational amplitude, Sec. V); a default outside its new domain is clipped into it.
+        Unknown names are errors; names the task fixed are skipped (nothing left to bound)."""
+        bad = sorted(n for n in domains if n not in self.learned and n not in self.context)
+        if bad:
+            raise SkillError(f"unknown learned parameter(s) {bad}; known: {list(self.learned)}")
+        lrn = dict(self.learned)
+        for n, dom in domains.items():
+            if n in lrn:
+                p = lrn[n]
+                default = min(max(p.default, dom.low), dom.high)
+                lrn[n] = LearnedParam(default, dom, p.unit, p.doc)
+        return SkillParams(self.context, lrn)
+
     def check_learned(
         self, values: Mapping[str, float], users: Mapping[str, Iterable[str]] | None = None
     ) -> dict[str, float]:

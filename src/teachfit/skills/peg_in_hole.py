@@ -218,13 +218,16 @@ def build(controller: str = "adaptive") -> Skill:
 @dataclass(frozen=True)
 class HoleContext:
     """What the task context gives the skill: the estimated hole frame, the true goal,
-    context parameter values and learned parameters the task fixes (``fixed``: name -> value,
-    e.g. the key's initial tilt, which seed B does not learn)."""
+    context parameter values, learned parameters the task fixes (``fixed``: name -> value,
+    e.g. the key's initial tilt, which seed B does not learn) and learned parameters it
+    bounds tighter (``domains``: name -> domain, e.g. the key's largest rotational
+    amplitude)."""
 
     hole2world_est: Pose
     goal2world: Pose
     values: dict[str, float]
     fixed: dict[str, float] = field(default_factory=dict)
+    domains: dict[str, ParamDomain] = field(default_factory=dict)
 
 
 #: error of the hole-pose estimate when a task has no ``estimated_hole`` of its own
@@ -253,8 +256,9 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
 
 def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     """Context for ``task``: estimated hole pose, goal depth, approach height above the
-    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping and
-    the learned parameters its optional ``skill_fixed`` mapping fixes."""
+    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping, the
+    learned parameters its optional ``skill_fixed`` mapping fixes and the ``(low, high)``
+    domains its optional ``skill_domains`` mapping gives."""
     hole = task.hole2world
     est = estimate_hole(task, rng)
     above = float(task.surface_z - hole.pos[2])  # surface above the hole entry (valleys)
@@ -271,7 +275,9 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     values.update(dict(getattr(task, "skill_context", {}) or {}))
     goal = hole.compose(Pose(np.array([0.0, 0.0, -float(task.success_depth)])))
     fixed = {k: float(v) for k, v in (getattr(task, "skill_fixed", {}) or {}).items()}
-    return HoleContext(est, goal, values, fixed)
+    bounds = getattr(task, "skill_domains", {}) or {}
+    domains = {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
+    return HoleContext(est, goal, values, fixed, domains)
 
 
 def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:

@@ -44,6 +44,12 @@ class PrismHoleParams(SkillProtocolParams):
         "height of the block's top surface (m, world z)", 0.040, above=0
     )
     success_depth: float = doc_field("insertion depth that counts as success (m)", 0.010, above=0)
+    a_r_max: float = doc_field(
+        "largest rotational oscillation amplitude the skill may learn (rad); 0: the part's yaw "
+        "play in the hole, clearance / yaw lever",
+        0.0,
+        at_least=0,
+    )
 
     @property
     @abstractmethod
@@ -101,9 +107,29 @@ class PrismHoleTask(SkillTask):
         """Length (m) over which the clearance limits the part's yaw in the hole."""
 
     @property
+    def yaw_play(self) -> float:
+        """How far a centred part can turn in the hole before it touches a wall (rad),
+        ``clearance / yaw_lever``."""
+        return self.params.clearance / self.yaw_lever
+
+    @property
     def rz_tolerance(self) -> float:
         """Twice the yaw play of a centred part plus 0.01 rad for soft-contact penetration."""
-        return 2 * self.params.clearance / self.yaw_lever + 0.01
+        return 2 * self.yaw_play + 0.01
+
+    @property
+    def skill_domains(self) -> dict[str, tuple[float, float]]:
+        """The learned skill parameters this task bounds tighter than the skill's domain:
+        the rotational oscillation amplitude ``a_r`` up to ``a_r_max``, by default the
+        part's :attr:`yaw_play`.
+
+        Seed B gives each task its own "maximum rotational amplitude of the oscillatory
+        motion" (Sec. V; the values are lost in the extracted text) and derives the domains
+        from system and safety limits. For a part that cannot turn freely in its hole the
+        limit is the hole: an amplitude beyond the yaw play only twists the part's corners
+        into the walls. A round part (``peg``) keeps the skill's 0.1 rad.
+        """
+        return {"a_r": (0.0, self.params.a_r_max or self.yaw_play)}
 
     @property
     def detection_radius(self) -> float:
