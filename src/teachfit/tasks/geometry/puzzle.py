@@ -16,6 +16,10 @@ How hard (issue 16, part 4), each value from what the paper says in words (Sec. 
   chamferless piece: no parameters then insert it from the starts deviated across the
   lateral move (beyond the 1.5 mm oscillation amplitude), so every method is capped at one
   start in four.
+* the rotational oscillation's amplitude ``a_r`` is learned within the piece's yaw play in the
+  hole, ``clearance / side_length`` = 0.013 rad (the paper gives each task its own "maximum
+  rotational amplitude"; ``a_r_max`` overrides): random parameters succeed as often as with
+  the skill's 0.1 rad (14 % [12, 18] against 15 % [12, 18], ten set-ups).
 
 Random parameters then succeed in 10 of 48 executions (21 %) instead of 25 of 48 (52 %) with
 no deviation; ``teachfit bench learning --random-rate N`` measures it (BENCHMARKS.md, seed B).
