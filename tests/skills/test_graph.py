@@ -311,8 +311,13 @@ def test_with_domains_bounds_a_learned_parameter_and_clips_its_default():
     assert sk.space.domains["a_r"] == ParamDomain(0.0, 0.01)
     assert sk.params.learned["a_r"].default == 0.01  # 0.02 clipped into the new domain
     assert sk.space.domains["force"] == peg_in_hole.LEARNED["force"].domain  # the others kept
-    with pytest.raises(SkillError, match="outside its domain"):
+    with pytest.raises(SkillError, match=r"outside its domain \[0, 0.01\] \(used by") as err:
         sk.resolve({"a_r": 0.05})
+    assert ";" not in str(err.value)  # no one to name as the bound's author
+    why = "task t bounds it"
+    named = peg_in_hole.build("impedance").with_domains({"a_r": ParamDomain(0.0, 0.01)}, why)
+    with pytest.raises(SkillError, match=r"\['insert'\]\); task t bounds it$"):
+        named.resolve({"a_r": 0.05})
     with pytest.raises(SkillError, match="unknown learned"):
         sk.with_domains({"stiffness_z": ParamDomain(0.0, 1.0)})
     fixed = peg_in_hole.build("impedance").with_fixed({"tilt": 0.05})

@@ -65,7 +65,7 @@ def peg_in_hole_setup(
     deviate = getattr(task.protocol, "start_frames", None)
     frames = tuple(deviate(ctx.hole2world_est, starts)) if callable(deviate) else ()
     return SkillSetup(
-        base.with_context(ctx.values).with_fixed(ctx.fixed).with_domains(ctx.domains),
+        base.with_context(ctx.values).with_fixed(ctx.fixed).with_domains(ctx.domains, ctx.bound),
         task,
         ctx.hole2world_est,
         ctx.goal2world,

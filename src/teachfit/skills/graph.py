@@ -173,10 +173,10 @@ class Skill:
         ``values``: a task that does not learn them (see :meth:`SkillParams.with_fixed`)."""
         return replace(self, params=self.params.with_fixed(values))
 
-    def with_domains(self, domains: Mapping[str, ParamDomain]) -> Skill:
+    def with_domains(self, domains: Mapping[str, ParamDomain], why: str = "") -> Skill:
         """The same skill with some learned parameters searched over other domains (see
         :meth:`SkillParams.with_domains`)."""
-        return replace(self, params=self.params.with_domains(domains))
+        return replace(self, params=self.params.with_domains(domains, why))
 
     # ------------------------------------------------------------------------- compiling
     def resolve(self, learned: Mapping[str, float] | None = None) -> dict[str, float]:

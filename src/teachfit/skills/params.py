@@ -65,12 +65,14 @@ class ContextParam:
 
 @dataclass(frozen=True)
 class LearnedParam:
-    """A parameter to learn: a ``default`` inside its ``domain`` (``unit``)."""
+    """A parameter to learn: a ``default`` inside its ``domain`` (``unit``); ``bound`` says
+    who narrowed the domain and how to widen it (empty: the skill's own domain)."""
 
     default: float
     domain: ParamDomain
     unit: str = ""
     doc: str = ""
+    bound: str = ""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "default", float(self.default))
@@ -132,11 +134,12 @@ class SkillParams:
         lrn = {n: p for n, p in self.learned.items() if n not in values}
         return SkillParams(ctx, lrn)
 
-    def with_domains(self, domains: Mapping[str, ParamDomain]) -> SkillParams:
+    def with_domains(self, domains: Mapping[str, ParamDomain], why: str = "") -> SkillParams:
         """A copy in which the learned parameters named in ``domains`` search those domains
         instead (a task that bounds them tighter, as seed B gives each task its own largest
         rotational amplitude, Sec. V); a default outside its new domain is clipped into it.
-        Unknown names are errors; names the task fixed are skipped (nothing left to bound)."""
+        ``why`` (who bounds them, how to widen) is added to an out-of-domain error. Unknown
+        names are errors; names the task fixed are skipped (nothing left to bound)."""
         bad = sorted(n for n in domains if n not in self.learned and n not in self.context)
         if bad:
             raise SkillError(f"unknown learned parameter(s) {bad}; known: {list(self.learned)}")
@@ -145,7 +148,7 @@ class SkillParams:
             if n in lrn:
                 p = lrn[n]
                 default = min(max(p.default, dom.low), dom.high)
-                lrn[n] = LearnedParam(default, dom, p.unit, p.doc)
+                lrn[n] = LearnedParam(default, dom, p.unit, p.doc, why)
         return SkillParams(self.context, lrn)
 
     def check_learned(
@@ -166,12 +169,13 @@ class SkillParams:
         out = self.defaults
         for name, v in values.items():
             x = float(v)
-            dom = self.learned[name].domain
+            dom, bound = self.learned[name].domain, self.learned[name].bound
             if not (math.isfinite(x) and dom.contains(x)):
                 nodes = sorted((users or {}).get(name, ()))
                 where = f" (used by node(s) {nodes})" if nodes else ""
+                where += f"; {bound}" if bound else ""
                 raise SkillError(
-                    f"parameter {name!r} = {x} is outside its domain [{dom.low}, {dom.high}]"
+                    f"parameter {name!r} = {x} is outside its domain [{dom.low:g}, {dom.high:g}]"
                     f"{where}",
                     node=nodes[0] if len(nodes) == 1 else None,
                 )

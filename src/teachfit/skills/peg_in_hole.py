@@ -221,13 +221,14 @@ class HoleContext:
     context parameter values, learned parameters the task fixes (``fixed``: name -> value,
     e.g. the key's initial tilt, which seed B does not learn) and learned parameters it
     bounds tighter (``domains``: name -> domain, e.g. the key's largest rotational
-    amplitude)."""
+    amplitude; ``bound``: who bounds them and how to widen them, for error messages)."""
 
     hole2world_est: Pose
     goal2world: Pose
     values: dict[str, float]
     fixed: dict[str, float] = field(default_factory=dict)
     domains: dict[str, ParamDomain] = field(default_factory=dict)
+    bound: str = ""
 
 
 #: error of the hole-pose estimate when a task has no ``estimated_hole`` of its own
@@ -277,7 +278,8 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     fixed = {k: float(v) for k, v in (getattr(task, "skill_fixed", {}) or {}).items()}
     bounds = getattr(task, "skill_domains", {}) or {}
     domains = {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
-    return HoleContext(est, goal, values, fixed, domains)
+    bound = f"task {task.name} bounds it: a task parameter widens it (teachfit tasks)"
+    return HoleContext(est, goal, values, fixed, domains, bound if domains else "")
 
 
 def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:
