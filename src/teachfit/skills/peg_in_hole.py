@@ -279,7 +279,7 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     bounds = getattr(task, "skill_domains", {}) or {}
     domains = {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
     bound = f"task {task.name} bounds it: a task parameter widens it (teachfit tasks)"
-    return HoleContext(est, goal, values, fixed, domains, bound if domains else "")
+    return HoleContext(est, goal, values, fixed, domains, bound)
 
 
 def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:
