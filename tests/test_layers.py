@@ -12,6 +12,7 @@ ROOT = Path(teachfit.__file__).parent
 #: bottom to top; a package may import only packages of a lower (or its own) layer
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("core",),
+    ("metrics",),  # statistics of outcomes: needs only core, so every layer may use it
     ("tasks", "control"),
     ("robot",),
     ("demonstrations",),
@@ -20,7 +21,6 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("capture",),
     ("execution",),
     ("learning",),
-    ("metrics",),
     ("viz",),
     ("bench",),
     ("quickstart",),

@@ -1,4 +1,4 @@
-"""Table I of the planning paper (METHODS.md C), reproduced over many seeds per task.
+"""Table I of Wang et al. 2019 (docs/methods.md), reproduced over many seeds per task.
 
 For each task and seed: a synthetic demonstration (seeded), then the demonstration-guided
 planner (seeded, OMPL included); beside it the same planner without demonstration, with a

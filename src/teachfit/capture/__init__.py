@@ -1,4 +1,6 @@
-"""Demonstrations captured from video: multi-camera ArUco tracking of the parts (METHODS.md C).
+"""Demonstrations captured from video: multi-camera ArUco tracking of the parts.
+
+The capture of Wang et al. 2019 (docs/methods.md).
 
 A person assembles parts that carry square markers while calibrated cameras film; the tracker
 turns the videos into the relative pose sequence ``L2G`` (the paper's G_T_L) that the planner

@@ -1,4 +1,6 @@
-"""Adaptive Cartesian impedance control (METHODS.md B; Yang et al. T-RO 2011, Cartesian form).
+"""Adaptive Cartesian impedance control (Johannsmeier et al. 2019, docs/methods.md).
+
+The Cartesian form of Yang et al., T-RO 2011.
 
 Per control period ``T`` and element-wise per task coordinate ``i`` (x, y, z, rx, ry, rz in the
 world frame at the TCP), with ``e = x_d - x`` (m, rad: rotation vector) and ``de = dx_d - dx``

@@ -7,7 +7,7 @@ eqs. 8-9) or :class:`AdaptiveSpec` (seed B's adaptive impedance with its meta-pa
 The laws themselves are in :mod:`teachfit.control`.
 
 Also here: the meta-parameters of the adaptive impedance controller, the system limits, and the
-bounds the limits imply on the meta-parameters (METHODS.md B).
+bounds the limits imply on the meta-parameters (docs/methods.md, Johannsmeier et al. 2019).
 
 All quantities are per task coordinate (x, y, z, rx, ry, rz; world frame at the TCP) and
 stored as 6-tuples of floats so that the dataclasses are frozen, hashable and comparable.

@@ -17,15 +17,16 @@ For K components (Gaussian mixture regression) with responsibilities
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
 from scipy.special import softmax
 
 from teachfit.core.errors import ModelError
-from teachfit.models.exploration import component_logpdf, fit_regularised_gmm
+from teachfit.models.exploration import fit_regularised_gmm
+from teachfit.models.mixture import GaussianMixture, component_logpdf
 
 #: Absolute standard-deviation floors: steps (m or rad per sample) and actions (N or N m).
 STEP_FLOOR = {"x": 1e-7, "y": 1e-7, "z": 1e-7, "rz": 1e-6}
@@ -33,7 +34,7 @@ ACTION_FLOOR = {"x": 1e-3, "y": 1e-3, "z": 1e-3, "rz": 1e-4}
 
 
 @dataclass(frozen=True)
-class DynamicsModel:
+class DynamicsModel(GaussianMixture):
     """Gaussian mixture over the joint vector ``[Δs, a]`` (length 2D).
 
     Attributes
@@ -47,28 +48,11 @@ class DynamicsModel:
         Joint covariances, symmetric positive definite.
     """
 
-    dims: tuple[str, ...]
-    weights: np.ndarray
-    means: np.ndarray
-    covs: np.ndarray
+    KIND: ClassVar[str] = "dynamics model"
 
     def __post_init__(self) -> None:
-        d = len(self.dims)
-        w = np.asarray(self.weights, dtype=float)
-        mu = np.asarray(self.means, dtype=float).reshape(w.size, 2 * d)
-        cov = np.asarray(self.covs, dtype=float).reshape(w.size, 2 * d, 2 * d)
-        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(mu)) and np.all(np.isfinite(cov))):
-            raise ModelError("dynamics model has NaN or inf parameters")
-        if np.any(w <= 0) or abs(w.sum() - 1.0) > 1e-6:
-            raise ModelError("mixture weights must be positive and sum to 1")
-        try:
-            np.linalg.cholesky(cov)
-        except np.linalg.LinAlgError:
-            raise ModelError("dynamics covariances must be positive definite") from None
-        object.__setattr__(self, "dims", tuple(self.dims))
-        object.__setattr__(self, "weights", w / w.sum())
-        object.__setattr__(self, "means", mu)
-        object.__setattr__(self, "covs", cov)
+        super().__post_init__()
+        d, cov = self.dim, self.covs
         s, a = slice(0, d), slice(d, 2 * d)
         # Gain Σ_as Σ_ss^{-1} per component: solve Σ_ss Gᵀ = Σ_sa (Σ_ss symmetric).
         gain = np.swapaxes(np.linalg.solve(cov[:, s, s], cov[:, s, a]), 1, 2)  # (K, D, D)
@@ -76,10 +60,10 @@ class DynamicsModel:
         object.__setattr__(self, "_gain", gain)
         object.__setattr__(self, "_cond_cov", 0.5 * (cond + np.swapaxes(cond, 1, 2)))
 
-    @property
-    def dim(self) -> int:
-        """Number of search DOFs D."""
-        return len(self.dims)
+    def _shaped(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d = len(self.dims)
+        mu = np.asarray(self.means, dtype=float).reshape(w.size, 2 * d)
+        return mu, np.asarray(self.covs, dtype=float).reshape(w.size, 2 * d, 2 * d)
 
     def condition(self, step: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Conditional mean and covariance of the action given steps.
@@ -120,25 +104,6 @@ class DynamicsModel:
     def feedforward(self, step: np.ndarray) -> np.ndarray:
         """Feed-forward action wrench μ*(Δs*), shape like ``step``."""
         return self.condition(step)[0]
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready parameters."""
-        return {
-            "dims": list(self.dims),
-            "weights": self.weights.tolist(),
-            "means": self.means.tolist(),
-            "covs": self.covs.tolist(),
-        }
-
-    @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> DynamicsModel:
-        """Inverse of :meth:`to_dict`; raises ModelError on missing keys or bad values."""
-        try:
-            return cls(
-                tuple(d["dims"]), np.array(d["weights"]), np.array(d["means"]), np.array(d["covs"])
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise ModelError(f"invalid dynamics model: {exc}") from exc
 
 
 def fit_dynamics(

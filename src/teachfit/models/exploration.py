@@ -16,16 +16,16 @@ data's spread, so the model stays well-posed yet only puts mass where the teache
 from __future__ import annotations
 
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import ClassVar, Literal
 
 import numpy as np
-from scipy.special import logsumexp
 from scipy.stats.qmc import MultivariateNormalQMC
-from sklearn.mixture import GaussianMixture
+from sklearn import mixture as sk_mixture
 
 from teachfit.core.errors import ModelError
+from teachfit.models.mixture import GaussianMixture, mixture_logpdf
 
 #: Default absolute standard-deviation floor per kind of DOF (m for lengths, rad for angles).
 ABS_FLOOR = {"x": 1e-4, "y": 1e-4, "z": 1e-4, "rz": 1e-3}
@@ -93,11 +93,11 @@ def fit_regularised_gmm(
             if len(candidates) == 1:
                 best = (0.0, w, mu, cov)
                 break
-            logl = _mixture_logpdf(z, w, mu, cov).sum()
+            logl = mixture_logpdf(z, w, mu, cov).sum()
             n_cov = d if covariance == "diag" else d * (d + 1) / 2
             bic = -2.0 * logl + (d + n_cov) * np.log(n)
         else:
-            gm = GaussianMixture(
+            gm = sk_mixture.GaussianMixture(
                 n_components=k,
                 covariance_type=covariance,
                 reg_covar=rel_floor**2,
@@ -116,26 +116,8 @@ def fit_regularised_gmm(
     return np.asarray(w, dtype=float), means, covs
 
 
-def _mixture_logpdf(
-    x: np.ndarray, weights: np.ndarray, means: np.ndarray, covs: np.ndarray
-) -> np.ndarray:
-    """log Σ_k w_k N(x | μ_k, Σ_k) for x (M, D); returns (M,)."""
-    return logsumexp(component_logpdf(x, means, covs) + np.log(weights)[None], axis=1)
-
-
-def component_logpdf(x: np.ndarray, means: np.ndarray, covs: np.ndarray) -> np.ndarray:
-    """log N(x | μ_k, Σ_k) for x (M, D), means (K, D), covs (K, D, D); returns (M, K)."""
-    x = np.atleast_2d(np.asarray(x, dtype=float))
-    d = means.shape[1]
-    chol = np.linalg.cholesky(covs)  # (K, D, D)
-    diff = x[:, None, :] - means[None]  # (M, K, D)
-    sol = np.linalg.solve(chol[None], diff[..., None])[..., 0]  # (M, K, D)
-    logdet = 2.0 * np.log(np.diagonal(chol, axis1=1, axis2=2)).sum(axis=1)
-    return -0.5 * (np.sum(sol**2, axis=2) + logdet[None] + d * np.log(2.0 * np.pi))
-
-
 @dataclass(frozen=True)
-class ExplorationDistribution:
+class ExplorationDistribution(GaussianMixture):
     """Gaussian mixture p_e(s) over search states (search frame).
 
     Attributes
@@ -150,44 +132,7 @@ class ExplorationDistribution:
         Component covariances, symmetric positive definite (m², m·rad, rad²).
     """
 
-    dims: tuple[str, ...]
-    weights: np.ndarray
-    means: np.ndarray
-    covs: np.ndarray
-
-    def __post_init__(self) -> None:
-        w = np.asarray(self.weights, dtype=float)
-        mu = np.atleast_2d(np.asarray(self.means, dtype=float))
-        cov = np.asarray(self.covs, dtype=float).reshape(mu.shape[0], mu.shape[1], mu.shape[1])
-        k, d = mu.shape
-        if len(self.dims) != d or w.shape != (k,):
-            raise ModelError(
-                f"inconsistent shapes: dims {self.dims}, weights {w.shape}, means {mu.shape}"
-            )
-        if not (np.all(np.isfinite(w)) and np.all(np.isfinite(mu)) and np.all(np.isfinite(cov))):
-            raise ModelError("exploration distribution has NaN or inf parameters")
-        if np.any(w <= 0) or abs(w.sum() - 1.0) > 1e-6:
-            raise ModelError("mixture weights must be positive and sum to 1")
-        if not np.allclose(cov, np.swapaxes(cov, 1, 2), rtol=1e-9, atol=1e-15):
-            raise ModelError("covariances must be symmetric")
-        try:
-            np.linalg.cholesky(cov)
-        except np.linalg.LinAlgError:
-            raise ModelError("covariances must be positive definite") from None
-        object.__setattr__(self, "dims", tuple(self.dims))
-        object.__setattr__(self, "weights", w / w.sum())
-        object.__setattr__(self, "means", mu)
-        object.__setattr__(self, "covs", cov)
-
-    @property
-    def dim(self) -> int:
-        """Number of search DOFs D."""
-        return len(self.dims)
-
-    @property
-    def n_components(self) -> int:
-        """Number of mixture components K."""
-        return self.weights.size
+    KIND: ClassVar[str] = "exploration distribution"
 
     @property
     def mean(self) -> np.ndarray:
@@ -206,7 +151,7 @@ class ExplorationDistribution:
     def logpdf(self, s: np.ndarray) -> np.ndarray:
         """log p_e(s) for s of shape (M, D) or (D,); returns (M,) or a scalar."""
         s = np.asarray(s, dtype=float)
-        out = _mixture_logpdf(np.atleast_2d(s), self.weights, self.means, self.covs)
+        out = mixture_logpdf(np.atleast_2d(s), self.weights, self.means, self.covs)
         return out[0] if s.ndim == 1 else out
 
     def pdf(self, s: np.ndarray) -> np.ndarray:
@@ -250,25 +195,6 @@ class ExplorationDistribution:
         return ExplorationDistribution(
             self.dims, self.weights, self.means * f, self.covs * np.outer(f, f)[None]
         )
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready parameters (lists of floats)."""
-        return {
-            "dims": list(self.dims),
-            "weights": self.weights.tolist(),
-            "means": self.means.tolist(),
-            "covs": self.covs.tolist(),
-        }
-
-    @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> ExplorationDistribution:
-        """Inverse of :meth:`to_dict`; raises ModelError on missing keys or bad values."""
-        try:
-            return cls(
-                tuple(d["dims"]), np.array(d["weights"]), np.array(d["means"]), np.array(d["covs"])
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise ModelError(f"invalid exploration distribution: {exc}") from exc
 
 
 def fit_exploration(

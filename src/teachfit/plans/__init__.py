@@ -1,4 +1,4 @@
-"""Motion planning guided by demonstrated key poses (METHODS.md C).
+"""Motion planning guided by demonstrated key poses (docs/methods.md, Wang et al. 2019).
 
 Parametric parts (:mod:`.parts`), mesh-mesh collision (:mod:`.collision`), synthetic
 demonstrations (:mod:`.synth`), key-pose ranking (:mod:`.keyposes`) and the planner loop

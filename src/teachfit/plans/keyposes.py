@@ -1,4 +1,6 @@
-"""Candidate key poses from a demonstration and their ranking (METHODS.md C, paper Fig. 6).
+"""Candidate key poses from a demonstration and their ranking.
+
+Wang et al. 2019 (docs/methods.md), the paper's Fig. 6.
 
 The paper's rule (:func:`rank_key_poses`): the demonstration's most violently changing pose
 parameter (pitch, for the L) is fitted with a polynomial over time; its derivative at each

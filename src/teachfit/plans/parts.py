@@ -4,7 +4,7 @@ Every assembly is expressed in the frame ``G`` of its fixed part. The moving par
 is attached to its mesh as documented per task, and the planner searches over ``L2G``, the pose
 of ``L`` in ``G``.
 
-L-groove (METHODS.md C, paper Fig. 3)
+L-groove (docs/methods.md, Wang et al. 2019; the paper's Fig. 3)
     ``G``: origin at the centre of the cavity floor, x along the groove, z up. The cavity is
     closed at both ends and covered by a lip on its -x side; the exposed opening (length
     ``opening_length``, at the +x end of the cavity) is shorter than the L's base, so the L must

@@ -1,7 +1,7 @@
 """Motion planning of the moving part's 6-DOF pose guided by demonstrated key poses.
 
-The loop of the paper (METHODS.md C, Fig. 7): plan from the initial to the final pose with
-RRT-Connect (OMPL, SE(3), validity by coal in Python: box or mesh checks, see
+The loop of Wang et al. 2019 (docs/methods.md; the paper's Fig. 7): plan from the initial
+to the final pose with RRT-Connect (OMPL, SE(3), validity by coal in Python: box or mesh checks, see
 :mod:`.collision`); when an attempt finds no path within ``te`` seconds, insert the next ranked
 key pose and plan segment by segment. A key pose in collision is first replaced by the nearest
 collision-free pose sampled around it. The ranking puts first the chain of key poses joined by
