@@ -90,7 +90,7 @@ def test_an_arm_slows_the_teacher_only_on_tasks_that_search_in_rz():
     assert explicit.rz_wiggle_frequency == 0.15
     for name in ("peg2d", "socket3d", "puzzle"):  # the floating tool has no hints
         task = get_task(name)
-        assert FloatingToolRobot.teacher_hints(task) == {}
+        assert FloatingToolRobot.teacher_hints(task).overrides() == {}
         assert style_for(task, robot=FloatingToolRobot) == style_for(task)
 
 

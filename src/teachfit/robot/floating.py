@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import mujoco
@@ -23,8 +22,9 @@ from teachfit.core.control import ControllerSpec, FixedGainSpec
 from teachfit.core.errors import ControlError, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.floating_kernel import FloatingKernel
-from teachfit.robot.interface import NO_TEACHER_HINTS, law_fault
+from teachfit.robot.interface import law_fault
 from teachfit.robot.sensor_filter import LowPass2
 from teachfit.tasks.base import Task
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
@@ -213,7 +213,7 @@ class FloatingToolRobot:
         self._law.set_command(cmd, self.data.time)
 
     @staticmethod
-    def teacher_hints(task: Task) -> Mapping[str, object]:
+    def teacher_hints(task: Task) -> TeacherHints:
         """None: the blind teacher guides the free tool as seed A's teacher guided the arm."""
         return NO_TEACHER_HINTS
 

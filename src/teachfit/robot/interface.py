@@ -24,8 +24,6 @@ The measured wrench is the one the *environment exerts on the tool*.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from types import MappingProxyType
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
@@ -34,6 +32,7 @@ from teachfit.core.control import ControllerSpec
 from teachfit.core.errors import ControlError
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.core.teaching import TeacherHints
 
 if TYPE_CHECKING:
     from teachfit.tasks.base import Task
@@ -82,16 +81,12 @@ class Robot(Protocol):
         """Release the robot (stop the control loop, free the connection or the simulator)."""
         ...
 
-    def teacher_hints(self, task: Task) -> Mapping[str, object]:
+    def teacher_hints(self, task: Task) -> TeacherHints:
         """How a person guiding this robot demonstrates ``task``: overrides of the blind
-        teacher's style fields (:class:`~teachfit.execution.teacher.TeacherStyle`), applied by
+        teacher's style fields (:class:`~teachfit.core.teaching.TeacherHints`), applied by
         ``execution.teacher.style_for`` on fields left at their defaults. The one per-robot
         table; :data:`NO_TEACHER_HINTS` for a robot that needs none (the floating tool)."""
         ...
-
-
-#: the teacher hints of a robot a person guides as the paper's teacher did (read-only, empty)
-NO_TEACHER_HINTS: Mapping[str, object] = MappingProxyType({})
 
 
 def law_fault(law: object, t: float) -> ControlError | None:

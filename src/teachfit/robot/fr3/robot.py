@@ -18,8 +18,6 @@ tick, as the FR3's firmware does); a MuJoCo warning or a NaN/inf state raises
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
-from types import MappingProxyType
 
 import mujoco
 import numpy as np
@@ -29,6 +27,7 @@ from teachfit.core.control import ControllerSpec, FixedGainSpec
 from teachfit.core.errors import LimitViolation, RobotFault, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.core.teaching import TeacherHints
 from teachfit.robot.fr3 import kernel
 from teachfit.robot.fr3 import model as fr3_model
 from teachfit.robot.fr3.control import TorqueImpedance, operational_inertia
@@ -57,17 +56,13 @@ class FR3Robot:
     #: apparent mass moves with less bandwidth than the free tool's (its wander and tremor
     #: low-passed over 0.1 s: unfiltered, their 100 Hz velocity steps shake the arm at
     #: 10-25 Hz and f_z with them; BENCHMARKS.md, session 6)
-    TEACHER_HINTS: Mapping[str, float] = MappingProxyType(
-        {"press_feel": 0.15, "hand_smoothing": 0.1}
-    )
+    TEACHER_HINTS = TeacherHints(press_feel=0.15, hand_smoothing=0.1)
     #: and on tasks that search in rz: the arm's yaw follows the teacher's 0.4 Hz wiggle about
     #: 2 degrees late (the floating tool's 0.3) and its joint friction stops the valleys from
     #: turning the part into line, so at the default pace the pins never meet both holes
     #: (socket3d: 0 of 6 starts in 60 s); a person guiding this heavier, stickier arm moves
     #: and turns slower
-    TEACHER_RZ_HINTS: Mapping[str, float] = MappingProxyType(
-        {"speed": 0.006, "rz_wiggle_frequency": 0.15}
-    )
+    TEACHER_RZ_HINTS = TeacherHints(speed=0.006, rz_wiggle_frequency=0.15)
 
     def __init__(
         self,
@@ -280,11 +275,12 @@ class FR3Robot:
         )
 
     @classmethod
-    def teacher_hints(cls, task: Task) -> Mapping[str, object]:
+    def teacher_hints(cls, task: Task) -> TeacherHints:
         """The blind teacher's style on this arm for ``task`` (``execution.teacher.style_for``):
         :data:`TEACHER_HINTS`, with :data:`TEACHER_RZ_HINTS` where ``task`` searches in rz."""
-        rz = cls.TEACHER_RZ_HINTS if "rz" in task.search_dims else {}
-        return MappingProxyType({**cls.TEACHER_HINTS, **rz})
+        if "rz" in task.search_dims:
+            return cls.TEACHER_HINTS.then(cls.TEACHER_RZ_HINTS)
+        return cls.TEACHER_HINTS
 
     def close(self) -> None:
         """Nothing to release but the simulator's memory (kept until garbage collection)."""

@@ -25,7 +25,6 @@ Cartesian impedance approach with our own law.
 from __future__ import annotations
 
 import sys
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -37,11 +36,11 @@ from teachfit.core.control import AdaptiveSpec, ControllerSpec, FixedGainSpec, I
 from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, RobotFault
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
 from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
-from teachfit.robot.interface import NO_TEACHER_HINTS
 
 if TYPE_CHECKING:
     from teachfit.tasks.base import Task
@@ -194,7 +193,7 @@ class FrankaRobot:
         return self.step(1)
 
     @staticmethod
-    def teacher_hints(task: Task) -> Mapping[str, object]:
+    def teacher_hints(task: Task) -> TeacherHints:
         """None: the simulated teacher drives no real arm (a person guides it)."""
         return NO_TEACHER_HINTS
 

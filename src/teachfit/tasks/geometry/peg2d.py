@@ -10,10 +10,12 @@ the search is in x-y.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import ClassVar
 
+from teachfit.core.teaching import TeacherHints
 from teachfit.tasks.base import Task
 from teachfit.tasks.geometry.round_peg import RoundPegParams
 from teachfit.tasks.params import doc_field
@@ -157,8 +159,8 @@ class Peg2D(Task):
         and a 6 N push)."""
         return self.params.friction * (push + GRAVITY * self.scene.peg_mass)
 
-    def teacher_hints(self) -> dict[str, float]:
-        """The blind teacher's sweep scaled to this cell (m, s; TeacherStyle fields).
+    def teacher_hints(self) -> TeacherHints:
+        """The blind teacher's sweep scaled to this cell (m, s).
 
         The defaults (rows 2.5 mm apart, 15 mm half-width, 60 s) suit the default cell. Rows
         are at most 1.6 capture half-widths apart, so that a pass always crosses the hole
@@ -177,13 +179,13 @@ class Peg2D(Task):
         half = DEFAULT_HALFWIDTH + max(0.0, lag)
         rows = (self.params.demo_offset + half) / pitch + 1  # start to past the hole
         duration = rows * (2 * half + pitch) / TEACHER_SPEED
-        hints: dict[str, float] = {
-            "spiral_pitch": pitch,
-            "sweep_halfwidth": half,
-            "max_duration": float(min(600.0, max(60.0, duration))),
-            "hold_depth": self.hold_depth,
-        }
+        hints = TeacherHints(
+            spiral_pitch=pitch,
+            sweep_halfwidth=half,
+            max_duration=float(min(600.0, max(60.0, duration))),
+            hold_depth=self.hold_depth,
+        )
         if tilt > 0:  # sharp edges: the hand tilts the peg as the searcher does and slides
-            hints["tilt"] = tilt  # it across the hole after the drop
-            hints["tilt_reach"] = self.params.peg_diameter + self.params.clearance
+            reach = self.params.peg_diameter + self.params.clearance  # it across the hole
+            hints = dataclasses.replace(hints, tilt=tilt, tilt_reach=reach)
         return hints

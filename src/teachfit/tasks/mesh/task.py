@@ -23,6 +23,7 @@ from scipy.spatial import ConvexHull
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
+from teachfit.core.teaching import TeacherHints
 from teachfit.tasks.geometry.skill import SkillTask
 from teachfit.tasks.mesh.cell import MeshCell, build_cell
 from teachfit.tasks.mesh.spec import read_spec
@@ -162,8 +163,8 @@ class MeshTask(SkillTask):
     def rz_tolerance(self) -> float:
         return self.cell.fit.rz_tolerance
 
-    def teacher_hints(self) -> dict[str, float]:
-        """The blind teacher's search scaled to this cell (m, rad; TeacherStyle fields).
+    def teacher_hints(self) -> TeacherHints:
+        """The blind teacher's search scaled to this cell (m, rad).
 
         The teacher's defaults suit the built-in cells (a 1-2 mm chamfered entry, a 5 mm
         belief, a 15 mm half-width sweep). A user's part may enter only within a few tenths
@@ -181,17 +182,18 @@ class MeshTask(SkillTask):
         stiffness, push = 2000.0, 6.0
         lag = p.friction * (push + HELD_MASS * 9.81) / stiffness
         room = self.detection_radius - p.demo_offset - 2 * pitch
-        hints = {
-            "belief_sigma": sigma,
-            "spiral_pitch": pitch,
-            "sweep_halfwidth": max(pitch, min(4 * sigma + lag, room)),
-            "wander_amplitude": pitch / 4,
-            "arm_stiffness": stiffness,
-            "push_force": push,
-            "speed": 0.008,
-        }
+        hints = TeacherHints(
+            belief_sigma=sigma,
+            spiral_pitch=pitch,
+            sweep_halfwidth=max(pitch, min(4 * sigma + lag, room)),
+            wander_amplitude=pitch / 4,
+            arm_stiffness=stiffness,
+            push_force=push,
+            speed=0.008,
+        )
         if self.has_rz:
-            hints |= {"rz_belief_sigma": self.rz_tolerance / 6, "rz_wiggle": self.rz_tolerance / 3}
+            tol = self.rz_tolerance
+            hints = dataclasses.replace(hints, rz_belief_sigma=tol / 6, rz_wiggle=tol / 3)
         return hints
 
 
