@@ -237,13 +237,9 @@ class MotionPlanner:
 
     # -- public -------------------------------------------------------------------------------
     def plan(
-        self,
-        demo: object | None = None,
-        *,
-        te: float | None = None,
-        max_checks: int | None = None,
-        seed: int = 0,
-    ) -> PlanResult:
+        self, demo: object | None = None, *, te: float | None = None,
+        max_checks: int | None = None, seed: int = 0,
+    ) -> PlanResult:  # fmt: skip
         """Plan from start to goal, inserting ranked key poses of ``demo`` as needed.
 
         Parameters
@@ -259,13 +255,64 @@ class MotionPlanner:
         seed : int
             Seed of the key-pose repair sampling and of OMPL's samplers (:func:`seed_ompl`).
 
-        Raises
-        ------
-        PlanningError
-            Demonstration of another task, or with fewer than two poses; a bad budget or seed.
+        Raises :class:`PlanningError` for a demonstration of another task or with fewer than
+        two poses, and for a bad budget or seed.
         """
         t0 = time.perf_counter()
         checks0 = self.checker.n_checks
+        by_checks, per_attempt, budget_label = self._budget(te, max_checks)
+        seed_ompl(seed)
+        rng = np.random.default_rng(seed)
+        keys, repaired, straight = self._candidates(demo, rng)
+        n_cand = 0 if keys is None else len(keys.indices)
+        run = _Attempts(self, by_checks, per_attempt, straight, self._demonstrated(demo, keys))
+        path, chosen = None, list(range(n_cand))
+        for k in range(min(self.config.first_key_poses, n_cand), n_cand + 1):
+            chosen = [] if keys is None else sorted(int(i) for i in keys.order[:k])
+            path = run.attempt(*self._waypoints(chosen, repaired, n_cand))
+            if path is not None:
+                break
+        t_plan = time.perf_counter() - t0
+        if path is None:  # every attempt failed
+            replaced = sum(1 for v in repaired.values() if v is None)
+            message = f"no path within {budget_label} per attempt after {run.count} attempt(s)"
+        else:
+            path = self._finish(path)
+            replaced = self._replaced(keys, repaired, chosen)
+            message = "ok" if path is not None else "path failed dense verification"
+        return PlanResult(
+            success=path is not None,
+            path=np.empty((0, 7)) if path is None else path,
+            time_s=t_plan,
+            total_s=time.perf_counter() - t0,
+            attempts=run.count,
+            used_key_poses=len(chosen),
+            candidates=n_cand,
+            replaced_key_poses=replaced,
+            collision_checks=self.checker.n_checks - checks0,
+            planner=self.config.planner,
+            message=message,
+            key_poses=keys,
+        )
+
+    def _waypoints(
+        self, chosen: list[int], repaired: dict[int, np.ndarray | None], n_cand: int
+    ) -> tuple[list[int], dict[int, np.ndarray]]:
+        """An attempt's waypoint ids and states: the start (-1), the ``chosen`` key poses that
+        have a repair, the approach above the goal where the task has one (``n_cand + 1``),
+        and the goal (``n_cand``)."""
+        ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
+        states = {-1: self.start, n_cand: self.goal}
+        states |= {i: s for i in ids[1:-1] if (s := repaired[i]) is not None}
+        if self.approach is not None:  # the goal is reached by the straight insertion
+            ids.insert(-1, n_cand + 1)
+            states[n_cand + 1] = self.approach
+        return ids, states
+
+    def _budget(self, te: float | None, max_checks: int | None) -> tuple[bool, float, str]:
+        """``(by_checks, budget per attempt, its label)``: collision checks when ``max_checks``
+        (or the config's) is set, else seconds (``te``, the config's, or a default by the
+        checker's kind)."""
         if te is None:
             te = self.config.te or (0.002 if self.checker.on_boxes else 0.02)
         te = float(te)
@@ -274,94 +321,39 @@ class MotionPlanner:
         checks = self.config.max_checks if max_checks is None else max_checks
         if checks is not None and checks < 1:
             raise PlanningError(f"max_checks must be >= 1, got {checks!r}")
-        by_checks = checks is not None
-        budget_of_attempt = float(checks) if by_checks else te
-        seed_ompl(seed)
-        rng = np.random.default_rng(seed)
-        keys: KeyPoses | None = None
-        repaired: dict[int, np.ndarray | None] = {}
-        straight: dict[tuple[int, int], bool] = {}
-        if demo is not None:
-            keys, eligible = self._rank(demo)
+        if checks is not None:
+            return True, float(checks), f"{checks} collision checks"
+        return False, te, f"te={te} s"
+
+    def _candidates(
+        self, demo: object | None, rng: np.random.Generator
+    ) -> tuple[KeyPoses | None, dict[int, np.ndarray | None], dict[tuple[int, int], bool]]:
+        """The demonstration's ranked key poses (None without one), their repairs by position,
+        and the straight motions between them found free or not while ranking."""
+        if demo is None:
+            return None, {}, {}
+        keys, eligible = self._rank(demo)
+        repaired = self._repair_all(keys, rng)
+        keys, straight, n_chain = self._chain_first(keys, repaired)
+        shorter = self._demo_chain(demo, n_chain) if n_chain > 2 else None
+        if shorter is not None:
+            keys, _ = self._rank(demo, include=shorter, eligible=eligible)
             repaired = self._repair_all(keys, rng)
-            keys, straight, n_chain = self._chain_first(keys, repaired)
-            shorter = self._demo_chain(demo, n_chain) if n_chain > 2 else None
-            if shorter is not None:
-                keys, _ = self._rank(demo, include=shorter, eligible=eligible)
-                repaired = self._repair_all(keys, rng)
-                keys, straight = self._chain_through(keys, shorter)
-        n_cand = 0 if keys is None else len(keys.indices)
-        via = self._demonstrated(demo, keys)
-        solved: dict[tuple[int, int], np.ndarray] = {}
-        failed: dict[tuple[int, int], float] = {}
-        attempts = 0
-        for k in range(min(self.config.first_key_poses, n_cand), n_cand + 1):
-            chosen = [] if keys is None else sorted(int(i) for i in keys.order[:k])
-            ids = [-1] + [i for i in chosen if repaired[i] is not None] + [n_cand]
-            states = {-1: self.start, n_cand: self.goal} | {i: repaired[i] for i in ids[1:-1]}
-            if self.approach is not None:  # the goal is reached by the straight insertion
-                ids.insert(-1, n_cand + 1)
-                states[n_cand + 1] = self.approach
-            attempts += 1
-            ta, ca = time.perf_counter(), self.checker.n_checks
-            pieces = []
-            for a, b in zip(ids[:-1], ids[1:], strict=True):
-                if (a, b) in solved:
-                    pieces.append(solved[(a, b)])
-                    continue
-                spent = self.checker.n_checks - ca if by_checks else time.perf_counter() - ta
-                budget = budget_of_attempt - spent
-                if failed.get((a, b), -1.0) * 1.5 >= budget:
-                    break  # failed before with as much budget: insert another key pose
-                if straight.get((a, b)):  # found free while ranking
-                    seg = np.stack([states[a], states[b]])
-                else:
-                    seg = self._plan_segment(
-                        states[a], states[b], budget, by_checks, via(a, b), (a, b) not in straight
-                    )
-                if seg is None:
-                    failed[(a, b)] = budget
-                    break
-                solved[(a, b)] = seg
-                pieces.append(seg)
-            else:
-                path = np.concatenate([pieces[0]] + [p[1:] for p in pieces[1:]])
-                t_plan = time.perf_counter() - t0
-                path = self._finish(path)
-                demo_states = matrix_to_state(keys.L2G) if chosen else None
-                n_replaced = sum(
-                    1
-                    for i in chosen
-                    if repaired[i] is None or not np.array_equal(repaired[i], demo_states[i])  # type: ignore[index]
-                )
-                return PlanResult(
-                    success=path is not None,
-                    path=np.empty((0, 7)) if path is None else path,
-                    time_s=t_plan,
-                    total_s=time.perf_counter() - t0,
-                    attempts=attempts,
-                    used_key_poses=len(chosen),
-                    candidates=n_cand,
-                    replaced_key_poses=n_replaced,
-                    collision_checks=self.checker.n_checks - checks0,
-                    planner=self.config.planner,
-                    message="ok" if path is not None else "path failed dense verification",
-                    key_poses=keys,
-                )
-        per_attempt = f"{checks} collision checks" if by_checks else f"te={te} s"
-        return PlanResult(
-            success=False,
-            path=np.empty((0, 7)),
-            time_s=time.perf_counter() - t0,
-            total_s=time.perf_counter() - t0,
-            attempts=attempts,
-            used_key_poses=n_cand,
-            candidates=n_cand,
-            replaced_key_poses=sum(1 for v in repaired.values() if v is None),
-            collision_checks=self.checker.n_checks - checks0,
-            planner=self.config.planner,
-            message=f"no path within {per_attempt} per attempt after {attempts} attempt(s)",
-            key_poses=keys,
+            keys, straight = self._chain_through(keys, shorter)
+        return keys, repaired, straight
+
+    @staticmethod
+    def _replaced(
+        keys: KeyPoses | None, repaired: dict[int, np.ndarray | None], chosen: list[int]
+    ) -> int:
+        """How many of the ``chosen`` key poses were in collision (replaced or dropped)."""
+        if keys is None or not chosen:
+            return 0
+        demo_states = matrix_to_state(keys.L2G)
+        return sum(
+            1
+            for i in chosen
+            if repaired[i] is None or not np.array_equal(repaired[i], demo_states[i])
         )
 
     def _rank(
@@ -557,3 +549,51 @@ def _chain_ahead(keys: KeyPoses, chain: list[int]) -> KeyPoses:
     in their order."""
     rest = [int(i) for i in keys.order if int(i) not in chain]
     return dataclasses.replace(keys, order=np.array(chain + rest, dtype=int))
+
+
+class _Attempts:
+    """The planner's attempts of one query: each plans the segments between its key poses,
+    reusing the segments solved before and giving up on one that failed before with as much
+    budget (another key pose is then inserted)."""
+
+    def __init__(
+        self,
+        planner: MotionPlanner,
+        by_checks: bool,
+        per_attempt: float,
+        straight: dict[tuple[int, int], bool],
+        via: Callable[[int, int], np.ndarray | None],
+    ) -> None:
+        self.planner, self.by_checks, self.per_attempt = planner, by_checks, per_attempt
+        self.straight, self.via = straight, via
+        self.solved: dict[tuple[int, int], np.ndarray] = {}
+        self.failed: dict[tuple[int, int], float] = {}
+        self.count = 0
+
+    def attempt(self, ids: list[int], states: dict[int, np.ndarray]) -> np.ndarray | None:
+        """The path through ``states[ids]`` in order, or None when a segment fails."""
+        pl, checker = self.planner, self.planner.checker
+        self.count += 1
+        ta, ca = time.perf_counter(), checker.n_checks
+        pieces = []
+        for a, b in zip(ids[:-1], ids[1:], strict=True):
+            if (a, b) in self.solved:
+                pieces.append(self.solved[(a, b)])
+                continue
+            spent = checker.n_checks - ca if self.by_checks else time.perf_counter() - ta
+            budget = self.per_attempt - spent
+            if self.failed.get((a, b), -1.0) * 1.5 >= budget:
+                return None  # failed before with as much budget: insert another key pose
+            if self.straight.get((a, b)):  # found free while ranking
+                seg = np.stack([states[a], states[b]])
+            else:
+                try_straight = (a, b) not in self.straight
+                seg = pl._plan_segment(
+                    states[a], states[b], budget, self.by_checks, self.via(a, b), try_straight
+                )
+            if seg is None:
+                self.failed[(a, b)] = budget
+                return None
+            self.solved[(a, b)] = seg
+            pieces.append(seg)
+        return np.concatenate([pieces[0]] + [p[1:] for p in pieces[1:]])
