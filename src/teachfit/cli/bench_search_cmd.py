@@ -112,6 +112,25 @@ def bench_search(
     """
     from teachfit.bench import search as bs
 
+    todo, rows_of, ergodic = _check(table, task, demo, methods, variants)
+    bs.use_robot(robot)
+    if variants:
+        names = {"1": ["peg2d"], "3": ["socket3d"], "all": ["peg2d", "socket3d"]}[table]
+        for name in names:
+            _variants(name, variants, seed, starts or 20, points, workers, markdown, plot, ergodic)
+    elif task is not None:
+        _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
+    else:
+        _paper_tables(todo, seed, starts, points, trajectories, workers, markdown, rows_of)
+
+
+def _check(
+    table: str, task: str | None, demo: str | None, methods: str | None, variants: int
+) -> tuple[tuple[str, ...], list[str] | None, bool]:
+    """The tables to run, the methods chosen (None: all) and whether the ergodic rows run;
+    refuses a combination of options that does not fit before anything is recorded."""
+    from teachfit.bench import search as bs
+
     if table not in TABLES:
         raise TeachfitError(f"unknown table {table!r}; available: {list(TABLES)}")
     if demo is not None and task is None:
@@ -127,35 +146,35 @@ def bench_search(
         bs.chosen_methods(
             rows_of, *((bs.TABLE1_METHODS, "I") if table == "1" else (bs.TABLE3_METHODS, "III"))
         )
-    bs.use_robot(robot)
-    if variants:
-        names = {"1": ["peg2d"], "3": ["socket3d"], "all": ["peg2d", "socket3d"]}.get(table)
-        if names is None or task is not None:
-            raise TeachfitError("--variants runs --table 1, 3 or all, and takes no --task")
-        for name in names:
-            _variants(name, variants, seed, starts or 20, points, workers, markdown, plot, ergodic)
-        return
-    if task is not None:
-        _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
-        return
+    if variants and (table not in ("1", "3", "all") or task is not None):
+        raise TeachfitError("--variants runs --table 1, 3 or all, and takes no --task")
+    return todo, rows_of, ergodic
+
+
+def _paper_tables(
+    todo: Sequence[str],
+    seed: int,
+    starts: int | None,
+    points: int | None,
+    trajectories: int,
+    workers: int | None,
+    markdown: Path | None,
+    rows_of: list[str] | None,
+) -> None:
+    """The paper's tables in ``todo``, each printed (and appended to ``markdown``)."""
+    from teachfit.bench import search as bs
+
     with progress_bar() as bar:
         if "1" in todo:
             n = starts or 30
             k = len(bs.chosen_methods(rows_of, bs.TABLE1_METHODS, "I"))
             job = bar.add_task("Table I: TSHIX (QMC, i.i.d.) and ergodic", total=k * n)
             rows = bs.table1(
-                seed,
-                n,
-                points or 300,
-                workers=workers,
-                progress=lambda: bar.advance(job),
+                seed, n, points or 300, workers=workers, progress=lambda: bar.advance(job),
                 methods=rows_of,
-            )
-            _emit(
-                f"Table I (peg2d, 0.5 mm clearance, 1 demo, {n} starts, seed {seed})",
-                rows,
-                markdown,
-            )
+            )  # fmt: skip
+            title = f"Table I (peg2d, 0.5 mm clearance, 1 demo, {n} starts, seed {seed})"
+            _emit(title, rows, markdown)
         if "2" in todo or "ablation" in todo:
             sizes = (100, 200, 300, 400, 500) if "2" in todo else ()
             abl = (100, 200, 400) if "ablation" in todo else ()
@@ -164,34 +183,21 @@ def bench_search(
                 seed, sizes, trajectories, abl, workers=workers, progress=lambda: bar.advance(job)
             )
             if rows2:
-                _emit(
-                    f"Table II (peg2d, one start, {trajectories} TSHIX runs per N, seed {seed})",
-                    rows2,
-                    markdown,
-                )
+                title = f"Table II (peg2d, one start, {trajectories} TSHIX runs per N, seed {seed})"
+                _emit(title, rows2, markdown)
             if rows_a:
-                _emit(
-                    f"Feed-forward ablation (same start, no feed-forward, seed {seed})",
-                    rows_a,
-                    markdown,
-                )
+                title = f"Feed-forward ablation (same start, no feed-forward, seed {seed})"
+                _emit(title, rows_a, markdown)
         if "3" in todo:
-            n = starts or 15
+            n, n_points = starts or 15, points or 600
             k = len(bs.chosen_methods(rows_of, bs.TABLE3_METHODS, "III"))
             job = bar.add_task("Table III: socket3d", total=k * n)
             rows = bs.table3(
-                seed,
-                n,
-                points or 600,
-                workers=workers,
-                progress=lambda: bar.advance(job),
+                seed, n, n_points, workers=workers, progress=lambda: bar.advance(job),
                 methods=rows_of,
-            )
-            _emit(
-                f"Table III (socket3d x-y-rz, {n} starts, {points or 600} points, seed {seed})",
-                rows,
-                markdown,
-            )
+            )  # fmt: skip
+            title = f"Table III (socket3d x-y-rz, {n} starts, {n_points} points, seed {seed})"
+            _emit(title, rows, markdown)
 
 
 def _task_table(

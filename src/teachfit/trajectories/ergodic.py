@@ -216,21 +216,67 @@ def ergodic_trajectory(
         ``method="ergodic"``; ``meta["ergodic_metric"]`` holds E of the result.
     """
     d = exploration.dim
-    if d not in (2, 3):
-        raise PlanningError(f"ergodic search supports D = 2 or 3, got {d}")
-    if (length is None) == (duration is None):
-        raise PlanningError("give exactly one of length or duration")
-    if not (np.isfinite(speed) and speed > 0):
-        raise PlanningError(f"speed must be positive, got {speed}")
-    total = length if length is not None else duration * speed
-    if not (np.isfinite(total) and total > 0):
-        raise PlanningError("length / duration must be positive")
+    total = _requested_length(d, speed, length, duration)
     ls = default_length_scale(exploration) if length_scale is None else float(length_scale)
     w = metric_weights(exploration.dims, ls)
     s0 = np.zeros(d) if start is None else np.asarray(start, float)
     lo, hi = search_box(exploration, include=s0) if box is None else box
     basis = CosineBasis(lo, hi, n_coeffs or _default_coeffs(d))
     phi = basis.distribution_coefficients(exploration)
+    path = _smc_path(basis, phi, basis.to_unit(s0), w, total, speed, steps_per_box)
+    states = basis.lo + path * (basis.hi - basis.lo)
+    t, timed = timed_path(
+        states,
+        exploration.dims,
+        speed=speed,
+        angular_speed=angular_speed,
+        length_scale=ls,
+        rate_hz=rate_hz,
+    )
+    metric = basis.metric(basis.trajectory_coefficients(timed, t), phi)
+    return SearchTrajectory(
+        t,
+        timed,
+        exploration.dims,
+        "ergodic",
+        start=s0,
+        meta={
+            "ergodic_metric": metric,
+            "box_lo": basis.lo.tolist(),
+            "box_hi": basis.hi.tolist(),
+            "n_coeffs": basis.n_coeffs,
+            "length_scale": ls,
+        },
+    )
+
+
+def _requested_length(d: int, speed: float, length: float | None, duration: float | None) -> float:
+    """The weighted path length (m) asked for by ``length`` or ``duration`` at ``speed``."""
+    if d not in (2, 3):
+        raise PlanningError(f"ergodic search supports D = 2 or 3, got {d}")
+    if (length is None) == (duration is None):
+        raise PlanningError("give exactly one of length or duration")
+    if not (np.isfinite(speed) and speed > 0):
+        raise PlanningError(f"speed must be positive, got {speed}")
+    total = float(length) if length is not None else float(duration or 0.0) * speed
+    if not (np.isfinite(total) and total > 0):
+        raise PlanningError("length / duration must be positive")
+    return float(total)
+
+
+def _smc_path(
+    basis: CosineBasis,
+    phi: np.ndarray,
+    u: np.ndarray,
+    w: np.ndarray,
+    total: float,
+    speed: float,
+    steps_per_box: int,
+) -> np.ndarray:
+    """(n + 1, D) states in the unit box from ``u``: each step of the spectral multiscale
+    coverage law goes ``total / n`` in the metric (weights ``w``) down the gradient of the
+    ergodic metric's running sum, reflected at the box's faces."""
+    d = u.shape[0]
     lam_h = basis.weights / basis.norm
     size_w = (basis.hi - basis.lo) * w  # box sides in the metric
     ds = float(size_w.min()) / steps_per_box
@@ -239,9 +285,7 @@ def ergodic_trajectory(
         raise PlanningError("requested trajectory too long for the integration step")
     ds = total / n_steps
     dt = ds / speed
-    kk = np.arange(basis.n_coeffs)
-    pik = np.pi * kk
-    u = basis.to_unit(s0)
+    pik = np.pi * np.arange(basis.n_coeffs)
     path = np.empty((n_steps + 1, d))
     path[0] = u
     acc = np.zeros_like(phi)  # Σ_steps (f_k / h_k ... ) accumulated as S_k * h_k
@@ -269,27 +313,4 @@ def ergodic_trajectory(
         u = np.abs(u)  # reflect at the faces of the unit box
         u = np.where(u > 1.0, 2.0 - u, u)
         path[i + 1] = u
-    states = basis.lo + path * (basis.hi - basis.lo)
-    t, timed = timed_path(
-        states,
-        exploration.dims,
-        speed=speed,
-        angular_speed=angular_speed,
-        length_scale=ls,
-        rate_hz=rate_hz,
-    )
-    metric = basis.metric(basis.trajectory_coefficients(timed, t), phi)
-    return SearchTrajectory(
-        t,
-        timed,
-        exploration.dims,
-        "ergodic",
-        start=s0,
-        meta={
-            "ergodic_metric": metric,
-            "box_lo": basis.lo.tolist(),
-            "box_hi": basis.hi.tolist(),
-            "n_coeffs": basis.n_coeffs,
-            "length_scale": ls,
-        },
-    )
+    return path
