@@ -53,27 +53,8 @@ def random_walk(
         raise PlanningError("need 0 <= step_min <= step_max")
     d = len(dims)
     s0 = np.zeros(d) if start is None else np.asarray(start, float)
-    pts = [s0.copy()]
-    cur = s0.copy()
-    for _ in range(int(n_steps)):
-        for _try in range(50):
-            ang = rng.uniform(0.0, 2.0 * np.pi)
-            step = rng.uniform(lo, step_max)
-            nxt = cur.copy()
-            nxt[:2] += step * np.array([np.cos(ang), np.sin(ang)])
-            if d == 3:
-                nxt[2] += rng.uniform(-rz_step_max, rz_step_max)
-            ok = np.linalg.norm(nxt[:2] - s0[:2]) <= radius
-            if d == 3:
-                ok = ok and abs(nxt[2] - s0[2]) <= rz_radius + 1e-15
-            if ok:
-                break
-        else:  # reflect: head for the centre instead
-            to_c = s0 - cur
-            nxt = cur + to_c * min(1.0, step_max / max(np.linalg.norm(to_c[:2]), 1e-15))
-        if np.linalg.norm(nxt - cur) > 0:
-            pts.append(nxt)
-            cur = nxt
+    walk = _Walk(s0, rng, lo, step_max, radius, rz_step_max, rz_radius)
+    pts = [s0.copy()] + [p for _ in range(int(n_steps)) if (p := walk.move()) is not None]
     if len(pts) < 2:
         raise PlanningError("random walk did not move")
     t, states = timed_path(
@@ -92,6 +73,54 @@ def random_walk(
         start=s0,
         meta={"n_steps": int(n_steps), "radius": radius, "step_max": step_max},
     )
+
+
+class _Walk:
+    """The random walk's waypoints: each :meth:`move` from the current one (see
+    :func:`random_walk`)."""
+
+    def __init__(
+        self,
+        s0: np.ndarray,
+        rng: np.random.Generator,
+        lo: float,
+        step_max: float,
+        radius: float,
+        rz_step_max: float,
+        rz_radius: float,
+    ) -> None:
+        self.s0, self.cur, self.rng = s0, s0.copy(), rng
+        self.lo, self.step_max, self.radius = lo, step_max, radius
+        self.rz_step_max, self.rz_radius = rz_step_max, rz_radius
+
+    def _draw(self) -> np.ndarray | None:
+        """A move inside the disc (and the rz band), redrawn up to 50 times; None if none."""
+        cur, s0, d = self.cur, self.s0, self.s0.size
+        for _try in range(50):
+            ang = self.rng.uniform(0.0, 2.0 * np.pi)
+            step = self.rng.uniform(self.lo, self.step_max)
+            nxt = cur.copy()
+            nxt[:2] += step * np.array([np.cos(ang), np.sin(ang)])
+            if d == 3:
+                nxt[2] += self.rng.uniform(-self.rz_step_max, self.rz_step_max)
+            ok = np.linalg.norm(nxt[:2] - s0[:2]) <= self.radius
+            if d == 3:
+                ok = ok and abs(nxt[2] - s0[2]) <= self.rz_radius + 1e-15
+            if ok:
+                return nxt
+        return None
+
+    def move(self) -> np.ndarray | None:
+        """The next waypoint (reflected towards the centre when no draw fits), or None when
+        it did not move."""
+        cur, nxt = self.cur, self._draw()
+        if nxt is None:  # reflect: head for the centre instead
+            to_c = self.s0 - cur
+            nxt = cur + to_c * min(1.0, self.step_max / max(np.linalg.norm(to_c[:2]), 1e-15))
+        if not np.linalg.norm(nxt - cur) > 0:
+            return None
+        self.cur = nxt
+        return nxt
 
 
 def archimedean_spiral(

@@ -107,23 +107,9 @@ def optimise_ergodic(
     phi = basis.distribution_coefficients(exploration)
     step = float(np.mean(np.linalg.norm(np.diff(x0 * w, axis=0), axis=1))) or 1e-3
     start = x0[0].copy()
-
     e0 = ergodic_cost_and_gradient(x0, basis, phi)[0]
-    k_reg = control_weight * e0  # the speed term is scaled to the initial metric
-
-    def cost(flat: np.ndarray) -> tuple[float, np.ndarray]:
-        x = np.vstack([start, flat.reshape(-1, len(dims))])
-        e, g = ergodic_cost_and_gradient(x, basis, phi)
-        dx = np.diff(x * w, axis=0)
-        n = np.maximum(np.linalg.norm(dx, axis=1), 1e-12)
-        r = n / step - 1.0  # relative deviation from the initial, uniform speed
-        reg = k_reg * float(np.mean(r**2))
-        gd = (2.0 * k_reg / r.size) * (r / (n * step))[:, None] * dx * w
-        greg = np.zeros_like(x)
-        greg[1:] += gd
-        greg[:-1] -= gd
-        return e + reg, (g + greg)[1:].ravel()
-
+    # the speed term is scaled to the initial metric
+    cost = _Cost(start, basis, phi, w, step, control_weight * e0)
     res = minimize(
         cost, x0[1:].ravel(), jac=True, method="L-BFGS-B", options={"maxiter": int(iterations)}
     )
@@ -152,3 +138,34 @@ def optimise_ergodic(
         "length_scale": scale,
     }
     return SearchTrajectory(t, states, dims, "ergodic-opt", start=start, meta=meta)
+
+
+class _Cost:
+    """The optimised cost and its gradient over the free knots (``start`` fixed):
+    ``E + k_reg · mean((|Δx| / step - 1)²)``, steps measured with the metric weights ``w``."""
+
+    def __init__(
+        self,
+        start: np.ndarray,
+        basis: CosineBasis,
+        phi: np.ndarray,
+        w: np.ndarray,
+        step: float,
+        k_reg: float,
+    ) -> None:
+        self.start, self.basis, self.phi, self.w = start, basis, phi, w
+        self.step, self.k_reg = step, k_reg
+
+    def __call__(self, flat: np.ndarray) -> tuple[float, np.ndarray]:
+        w, step, k_reg = self.w, self.step, self.k_reg
+        x = np.vstack([self.start, flat.reshape(-1, self.start.size)])
+        e, g = ergodic_cost_and_gradient(x, self.basis, self.phi)
+        dx = np.diff(x * w, axis=0)
+        n = np.maximum(np.linalg.norm(dx, axis=1), 1e-12)
+        r = n / step - 1.0  # relative deviation from the initial, uniform speed
+        reg = k_reg * float(np.mean(r**2))
+        gd = (2.0 * k_reg / r.size) * (r / (n * step))[:, None] * dx * w
+        greg = np.zeros_like(x)
+        greg[1:] += gd
+        greg[:-1] -= gd
+        return e + reg, (g + greg)[1:].ravel()

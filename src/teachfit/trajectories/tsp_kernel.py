@@ -47,6 +47,9 @@ def _push(queue: np.ndarray, inq: np.ndarray, head_tail: np.ndarray, v: int) -> 
         inq[v] = True
 
 
+# Long on purpose (> 60 lines): the innermost loop of the solver, compiled; the candidate scan,
+# the two move kinds' gains and the move share a dozen locals, which a split would pass through
+# calls on every candidate.
 @njit(cache=True)
 def _improve_node(
     x: np.ndarray,
@@ -175,6 +178,9 @@ def _local_search(
     return gain
 
 
+# Long on purpose (> 60 lines): the iterated local search's whole loop in one compiled
+# function (kick, local search from the kick's ends, acceptance, best tour kept), so that its
+# buffers are allocated once and nothing crosses into Python per kick.
 @njit(cache=True)
 def improve_tour(
     x: np.ndarray,

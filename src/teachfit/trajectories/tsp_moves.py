@@ -180,6 +180,8 @@ def _best_step(
     return best_val, best_t3
 
 
+# Long on purpose (> 60 lines): one Lin-Kernighan chain, compiled; its depth loop keeps the
+# chain's partial gain, flips and best closing point in locals that a split would pass around.
 @njit(cache=True)
 def _lk_node(
     x: np.ndarray,

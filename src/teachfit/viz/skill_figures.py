@@ -103,58 +103,22 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
     pos = {name: (_STEP * (i + 1), 0.0) for i, name in enumerate(order)}
     n = len(order)
     fig, ax = plt.subplots(figsize=(1.6 * _STEP * (n + 1.4), 5.4), constrained_layout=True)
-    start, end = (0.0, 0.0), (_STEP * (n + 1), 0.0)
-    ax.add_patch(plt.Circle(start, 0.12, color="k"))
-    ax.add_patch(plt.Circle(end, 0.15, fc="white", ec="green", lw=3))
-    ax.add_patch(plt.Circle(end, 0.09, color="green"))
-    ax.text(end[0], end[1] - 0.3, "success", ha="center", fontsize=8, color="green")
-    pre = skill.pre.describe() if skill.pre is not None else "always"
-    _arrow(ax, (start[0] + 0.12, 0.0), (pos[skill.start][0] - 0.44, 0.0), f"pre: {pre}", dy=0.05)
+    end = _draw_entry_and_exit(ax, skill, pos, n)
     for node in skill.nodes:
         _box(ax, pos[node.name], node.name, node.primitive.describe(), "#dbe9f6")
     for tr in skill.transitions:
         a, b = pos[tr.source], pos[tr.target]
         forward = b[0] > a[0] and order.index(tr.target) == order.index(tr.source) + 1
         rad = 0.0 if forward else -0.35
+        dy = 0.05 if forward else 0.45
         _arrow(
-            ax,
-            (a[0] + 0.44, a[1]),
-            (b[0] - 0.44, b[1]),
-            tr.condition.describe(),
-            rad=rad,
-            dy=0.05 if forward else 0.45,
+            ax, (a[0] + 0.44, a[1]), (b[0] - 0.44, b[1]), tr.condition.describe(), rad=rad, dy=dy
         )
     last = pos[order[-1]]
-    _arrow(
-        ax,
-        (last[0] + 0.44, 0.0),
-        (end[0] - 0.16, 0.0),
-        skill.success.describe(),
-        color="green",
-        dy=0.05,
-    )
+    success = skill.success.describe()
+    _arrow(ax, (last[0] + 0.44, 0.0), (end[0] - 0.16, 0.0), success, color="green", dy=0.05)
     if skill.recovery is not None:
-        rec = ((pos[order[0]][0] + last[0]) / 2, -1.6)
-        _box(
-            ax,
-            rec,
-            f"recovery: {skill.recovery.name}",
-            skill.recovery.primitive.describe(),
-            "#f6dbdb",
-            half=0.7,
-        )
-        for node in skill.nodes:
-            a = pos[node.name]
-            _arrow(
-                ax,
-                (a[0], a[1] - 0.33),
-                (rec[0] + 0.5 * (a[0] - rec[0]) / n, rec[1] + 0.33),
-                node.error.describe() if node.error else "",
-                color="firebrick",
-                style="--",
-                dy=-0.1,
-                frac=0.3,
-            )
+        _draw_recovery(ax, skill, pos, ((pos[order[0]][0] + last[0]) / 2, -1.6), n)
     ax.text(
         0.0,
         1.05,
@@ -164,13 +128,61 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
         transform=ax.transData,
     )
     ax.text(0.0, 0.85, f"task frame: {skill.frame}", fontsize=7, color="0.3")
+    _legend(ax)
+    ax.set_xlim(-0.4, end[0] + 0.4)
+    ax.set_ylim(-2.1, 1.25)
+    ax.set_aspect("equal")
+    ax.axis("off")
+    return save_figure(fig, path, dpi=130)
+
+
+def _draw_entry_and_exit(
+    ax: plt.Axes, skill: Skill, pos: dict[str, tuple[float, float]], n: int
+) -> tuple[float, float]:
+    """The entry dot with the precondition's arrow and the success mark; returns the mark's
+    position."""
+    start, end = (0.0, 0.0), (_STEP * (n + 1), 0.0)
+    ax.add_patch(plt.Circle(start, 0.12, color="k"))
+    ax.add_patch(plt.Circle(end, 0.15, fc="white", ec="green", lw=3))
+    ax.add_patch(plt.Circle(end, 0.09, color="green"))
+    ax.text(end[0], end[1] - 0.3, "success", ha="center", fontsize=8, color="green")
+    pre = skill.pre.describe() if skill.pre is not None else "always"
+    _arrow(ax, (start[0] + 0.12, 0.0), (pos[skill.start][0] - 0.44, 0.0), f"pre: {pre}", dy=0.05)
+    return end
+
+
+def _draw_recovery(
+    ax: plt.Axes,
+    skill: Skill,
+    pos: dict[str, tuple[float, float]],
+    rec: tuple[float, float],
+    n: int,
+) -> None:
+    """The recovery node at ``rec`` and every node's error exit to it (dashed, red)."""
+    assert skill.recovery is not None
+    recovery = f"recovery: {skill.recovery.name}"
+    _box(ax, rec, recovery, skill.recovery.primitive.describe(), "#f6dbdb", half=0.7)
+    for node in skill.nodes:
+        a = pos[node.name]
+        _arrow(
+            ax,
+            (a[0], a[1] - 0.33),
+            (rec[0] + 0.5 * (a[0] - rec[0]) / n, rec[1] + 0.33),
+            node.error.describe() if node.error else "",
+            color="firebrick",
+            style="--",
+            dy=-0.1,
+            frac=0.3,
+        )
+
+
+def _legend(ax: plt.Axes) -> None:
     from matplotlib.lines import Line2D
 
+    entry = "entry (if the precondition holds)"
     ax.legend(
         handles=[
-            Line2D(
-                [], [], ls="none", marker="o", color="k", label="entry (if the precondition holds)"
-            ),
+            Line2D([], [], ls="none", marker="o", color="k", label=entry),
             Line2D([], [], color="k", label="transition, when its condition holds"),
             Line2D([], [], color="green", label="success condition"),
             Line2D([], [], color="firebrick", ls="--", label="error condition -> recovery"),
@@ -180,11 +192,6 @@ def plot_skill_graph(skill: Skill, path: str | Path) -> Path:
         ncol=2,
         frameon=False,
     )
-    ax.set_xlim(-0.4, end[0] + 0.4)
-    ax.set_ylim(-2.1, 1.25)
-    ax.set_aspect("equal")
-    ax.axis("off")
-    return save_figure(fig, path, dpi=130)
 
 
 def plot_traces(traces: Sequence[ExecutionResult], path: str | Path, title: str = "") -> Path:
