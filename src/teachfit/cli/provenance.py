@@ -13,7 +13,8 @@ one line a reader sees, e.g.::
 ``+dirty`` when its tracked files differ from it, ``unknown`` outside a git checkout; ``date``
 is UTC; ``load`` the 1-minute load average when the run started. A block copied by hand from an
 older record says ``source=transcribed`` (its figures were not written by the command; the next
-real run replaces it). :func:`blocks` splits a file into its headed blocks, oldest first.
+real run replaces it) and may name the commit that recorded them (``recorded_in``).
+:func:`blocks` splits a file into its headed blocks, oldest first.
 """
 
 from __future__ import annotations
@@ -149,15 +150,26 @@ def current(command: str | None = None) -> Provenance:
     )
 
 
+def _short(load: str) -> str:
+    try:
+        return f"{float(load):.1f}"
+    except ValueError:
+        return load
+
+
 def header(p: Provenance) -> str:
     """The two header lines (machine-readable comment, then the visible line), no newline."""
     pairs = " ".join(f"{k}={shlex.quote(v)}" for k, v in p.values().items())
     when = p.date.replace("T", " ")[:16] + " UTC" if "T" in p.date else p.date
-    load = f", load {float(p.load):.1f}" if p.load else ""
-    origin = "transcribed from an earlier record: " if p.source == "transcribed" else ""
+    load = f", load {_short(p.load)}" if p.load else ""
+    origin = ""
+    if p.source == "transcribed":
+        where = p.extra.get("recorded_in")
+        of = f" of {where}" if where else ""
+        origin = f"transcribed from the record{of}, not the command's output: "
     visible = (
         f"*{origin}`{p.command}` · teachfit {p.version}, commit {p.commit} · {when} · "
-        f"{p.cpu}, {p.cores} cores{load}*"
+        f"CPU {p.cpu}, {p.cores} cores{load}*"
     )
     return f"{MARK}{html.escape(pairs, quote=False)} -->\n{visible}"
 
