@@ -159,7 +159,7 @@ def _short(load: str) -> str:
 
 def header(p: Provenance) -> str:
     """The two header lines (machine-readable comment, then the visible line), no newline."""
-    pairs = " ".join(f"{k}={shlex.quote(v)}" for k, v in p.values().items())
+    pairs = " ".join(f"{k}={shlex.quote(v)}" for k, v in p.values().items() if v or k != "load")
     when = p.date.replace("T", " ")[:16] + " UTC" if "T" in p.date else p.date
     load = f", load {_short(p.load)}" if p.load else ""
     origin = ""
