@@ -11,9 +11,9 @@ one line a reader sees, e.g.::
 
 (each on one line). ``commit`` is the short git commit of the source tree teachfit runs from,
 ``+dirty`` when its tracked files differ from it, ``unknown`` outside a git checkout; ``date``
-is UTC; ``load`` the 1-minute load average when the run started. A block copied by hand from an
-older record says ``source=transcribed`` (its figures were not written by the command; the next
-real run replaces it) and may name the commit that recorded them (``recorded_in``).
+is UTC; ``load`` the 1-minute load average when the header is written. A block copied by hand
+from an older record says ``source=transcribed`` (its figures were not written by the command;
+the next real run replaces it) and may name the commit that recorded them (``recorded_in``).
 :func:`blocks` splits a file into its headed blocks, oldest first.
 """
 
