@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 import typer
@@ -107,3 +108,25 @@ def test_version_and_old_spellings() -> None:
     # hidden old spellings still parse: -n of search plan is --points
     res = runner.invoke(app, ["search", "plan", "--help"])
     assert "--points" in res.output and " -n " not in res.output
+
+
+ROOT = Path(__file__).resolve().parents[2]
+#: the project's prose beside the code: the results page, the changelog, the notes and results
+PROSE = (
+    ROOT / "BENCHMARKS.md",
+    ROOT / "CHANGELOG.md",
+    *sorted((ROOT / "docs").rglob("*.md")),
+    *sorted((ROOT / "benchmarks" / "results").glob("*.md")),
+)
+
+
+def test_the_prose_speaks_of_the_project_not_of_work_sessions() -> None:
+    word = re.compile(r"\bsession \d", re.IGNORECASE)
+    assert len(PROSE) > 3
+    hits = [
+        f"{path.relative_to(ROOT)}:{n}"
+        for path in PROSE
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if word.search(line)
+    ]
+    assert not hits, f"work sessions named in {hits}"

@@ -139,8 +139,14 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
 
 def append_markdown(path: Path, text: str) -> Path:
     """Append ``text`` to the markdown file ``path`` (created with its folder if missing): every
-    ``--markdown FILE`` appends, so one file can collect several benchmark runs."""
+    ``--markdown FILE`` appends, so one file can collect several benchmark runs. A command's
+    first append to ``path`` in one run (process) starts with its provenance header (command
+    line, version, commit, UTC date, machine: :mod:`teachfit.cli.provenance`), so the newest
+    run's block is the text after the file's last header."""
+    from teachfit.cli import provenance
     from teachfit.core.atomic import atomic_append_text
 
+    if provenance.first_in_run(path):
+        text = provenance.header(provenance.current()) + "\n\n" + text.lstrip("\n")
     sep = "\n" if path.is_file() and path.stat().st_size else ""
     return atomic_append_text(path, sep + text.rstrip("\n") + "\n", "markdown file")
