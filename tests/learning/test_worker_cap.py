@@ -29,7 +29,7 @@ def test_cap_workers_by_trials_left_and_cores() -> None:
     assert cap_workers(3, 10, cpus=2) == (3, "")  # within both limits: as asked, silently
     assert cap_workers(None, 10, cpus=6) == (6, "")  # the default: one per core
     assert cap_workers(None, 2, cpus=6) == (2, "")  # ... but no more than trials left
-    assert cap_workers(5, 0, cpus=2)[0] == 1  # nothing left: one (the pool starts none)
+    assert cap_workers(5, 0, cpus=2) == (1, "")  # nothing to run: the pool starts none
 
 
 def test_a_thousand_workers_for_four_trials_fork_four(

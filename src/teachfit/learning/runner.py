@@ -101,14 +101,15 @@ _log = logging.getLogger(__name__)
 def cap_workers(requested: int | None, left: int, cpus: int | None = None) -> tuple[int, str]:
     """Worker processes for ``left`` trials still to run: ``requested`` (``None``: one per
     core), but at least 1, at most ``left`` and at most :data:`WORKERS_PER_CPU` per core.
-    Returns the count and, when an explicit request was cut, a one-line note (else "")."""
+    Returns the count and, when an explicit request was cut for trials to run, a one-line
+    note (else "")."""
     cpus = max(cpus or os.cpu_count() or 1, 1)
     wanted = cpus if requested is None else requested
     n = max(1, min(wanted, left, WORKERS_PER_CPU * cpus))
-    if requested is None or n >= requested:
+    if requested is None or n >= requested or left <= 0:
         return n, ""
     return n, (
-        f"{requested} workers asked: using {n} ({max(left, 0)} trial(s) left, "
+        f"{requested} workers asked: using {n} ({left} trial(s) left, "
         f"{cpus} core(s), at most one worker per trial and {WORKERS_PER_CPU} per core)"
     )
 
