@@ -6,10 +6,12 @@ or, with ``workers=0``, in this process. Each finished trial is stored at once
 
 * the objective raises, or returns a non-finite cost (a diverging simulation): the trial is
   stored as failed with the study's penalty cost;
-* a worker process dies (segfault, ``os._exit``, out of memory): the pool breaks and every
-  trial running in it is lost. If only one was running, it is the culprit and fails; else the
-  lost trials are re-run one at a time in a fresh pool, which finds the culprit and completes
-  the innocent ones (they had not finished, so nothing is repeated).
+* a worker process dies (segfault, ``os._exit``, out of memory, killed): the pool breaks and
+  every trial running in it is lost. The pool is replaced (also when a worker died idle, found
+  as the next trial is submitted), and the lost trials are re-run one at a time in the fresh
+  pool: one that breaks it again, alone, is the culprit and fails; the others complete (they
+  had not finished, so nothing is repeated). Their claims stay this process's meanwhile, so
+  other processes sharing the study neither wait on them forever nor run them twice.
 
 SIGINT / SIGTERM: the first one stops asking for new trials and lets the running ones finish
 and be stored, then :func:`run_study` returns with ``interrupted=True``; a second one aborts at
@@ -31,13 +33,14 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import logging
 import math
 import multiprocessing
 import os
 import signal
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
@@ -60,6 +63,7 @@ class RunReport:
     failed: int
     interrupted: bool
     wall_s: float
+    workers: int = 0  # worker processes used (0: trials ran in this process)
 
     @property
     def trials_per_s(self) -> float:
@@ -87,6 +91,28 @@ def evaluate(objective: Objective, params: Mapping[str, float]) -> tuple[TrialRe
 
 #: seconds between looks at a study while only other processes run its trials
 POLL_S = 0.5
+
+#: at most this many worker processes per core: more only cost memory and start-up time
+WORKERS_PER_CPU = 4
+
+_log = logging.getLogger(__name__)
+
+
+def cap_workers(requested: int | None, left: int, cpus: int | None = None) -> tuple[int, str]:
+    """Worker processes for ``left`` trials still to run: ``requested`` (``None``: one per
+    core), but at least 1, at most ``left`` and at most :data:`WORKERS_PER_CPU` per core.
+    Returns the count and, when an explicit request was cut for trials to run, a one-line
+    note (else "")."""
+    cpus = max(cpus or os.cpu_count() or 1, 1)
+    wanted = cpus if requested is None else requested
+    n = max(1, min(wanted, left, WORKERS_PER_CPU * cpus))
+    if requested is None or n >= requested or left <= 0:
+        return n, ""
+    return n, (
+        f"{requested} workers asked: using {n} ({left} trial(s) left, "
+        f"{cpus} core(s), at most one worker per trial and {WORKERS_PER_CPU} per core)"
+    )
+
 
 _PR_SET_PDEATHSIG = 1
 
@@ -181,7 +207,9 @@ def run_study(
     ``objective(params)`` gets physical parameter values and returns a cost, ``(cost,
     feasible)`` or a :class:`TrialResult`; with workers it must be picklable (a module-level
     function or a :func:`functools.partial` of one). ``workers=None``: one per core; ``0``: in
-    this process (no crash isolation). Stops early if the learner has nothing left to ask.
+    this process (no crash isolation); never more than the trials left or
+    :data:`WORKERS_PER_CPU` per core (:func:`cap_workers`; a cut request is logged as a
+    warning). Stops early if the learner has nothing left to ask.
     ``on_trial(record)`` is called in this process after each trial is stored (progress).
     """
     if budget < 0:
@@ -189,6 +217,10 @@ def run_study(
     n_workers = (os.cpu_count() or 1) if workers is None else int(workers)
     if n_workers < 0:
         raise LearningError(f"workers must be >= 0, got {workers}")
+    if n_workers > 0:
+        n_workers, note = cap_workers(workers, budget - study.n_finished)
+        if note:
+            _log.warning(note)  # one line on stderr when nothing else handles the log
     t0 = time.perf_counter()
     restored, here = study.n_finished, study.n_here
     failed = 0
@@ -225,7 +257,126 @@ def run_study(
         failed=failed,
         interrupted=interrupted,
         wall_s=time.perf_counter() - t0,
+        workers=n_workers,
     )
+
+
+class _PoolRun:
+    """Trials of one :func:`run_study` call in a process pool, replaced whenever it breaks."""
+
+    def __init__(
+        self,
+        study: Study,
+        objective: Objective,
+        budget: int,
+        n_workers: int,
+        store: Callable[[Candidate, TrialResult | None, str], None],
+        mp_context: str | None,
+    ) -> None:
+        self.study, self.objective, self.budget, self.n = study, objective, budget, n_workers
+        self.store = store
+        self.ctx = multiprocessing.get_context(mp_context) if mp_context else None
+        method = (self.ctx or multiprocessing).get_start_method()
+        self.parent = os.getpid() if method in ("fork", "spawn") else None  # forkserver: not us
+        self.pool = self._new_pool()
+        self.pending: dict[Future[tuple[TrialResult | None, str]], Candidate] = {}
+        self.suspects: list[Candidate] = []  # lost in a broken pool: re-run one at a time
+        self.alone: Candidate | None = None  # the suspect running alone in a fresh pool
+        self.retry: list[Candidate] = []  # claimed, never started: submit again
+
+    def _new_pool(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(
+            self.n, mp_context=self.ctx, initializer=_worker_init, initargs=(self.parent,)
+        )
+
+    def _replace_pool(self) -> None:
+        self.pool.shutdown(wait=True)
+        self.pool = self._new_pool()
+
+    def _submit(self, cand: Candidate, alone: bool) -> bool:
+        try:
+            fut = self.pool.submit(evaluate, self.objective, self.study.params_of(cand))
+        except BrokenProcessPool:
+            # the pool broke before this trial got in (a worker died, maybe idle): it never
+            # heals; with nothing running in it replace it now, else the wait() path does
+            (self.suspects if alone else self.retry).insert(0, cand)
+            if not self.pending:
+                self._replace_pool()
+            return False
+        self.pending[fut] = cand
+        if alone:
+            self.alone = cand
+        return True
+
+    def fill(self, sig: Interrupts) -> None:
+        """Submit trials until every worker is busy; a suspect runs alone."""
+        while not sig.stop and self.alone is None:
+            alone = bool(self.suspects)
+            if alone and self.pending:
+                return
+            if alone:
+                cand: Candidate | None = self.suspects.pop(0)
+            elif len(self.pending) >= self.n:
+                return
+            elif self.retry:
+                cand = self.retry.pop(0)
+            else:
+                # None: a population waits for its tells, the budget is taken, or exhausted
+                cand = self.study.ask(self.budget)
+                if cand is None:
+                    return
+            if not self._submit(cand, alone):
+                return
+
+    def collect(self) -> None:
+        """Store the trials that finished within 0.2 s; recover from a broken pool."""
+        done, _ = wait(self.pending, timeout=0.2, return_when=FIRST_COMPLETED)
+        lost = self._take(done)
+        if lost:
+            self._recover(lost)
+
+    def _take(self, futures: Iterable[Future[tuple[TrialResult | None, str]]]) -> list[Candidate]:
+        """Store the trials of ``futures`` (pending); returns those lost with a broken pool."""
+        lost: list[Candidate] = []
+        for fut in list(futures):
+            cand = self.pending.pop(fut)
+            try:
+                result, error = fut.result()
+            except BrokenProcessPool:
+                lost.append(cand)
+                continue
+            if cand is self.alone:
+                self.alone = None
+            self.store(cand, result, error)
+        return lost
+
+    def _recover(self, lost: list[Candidate]) -> None:
+        # every other running trial is lost with the pool (it ends all its workers)
+        lost += self._take(self.pending)
+        culprit = self.alone if lost == [self.alone] else None
+        self.alone = None
+        self._replace_pool()
+        if culprit is not None:  # it broke a fresh pool, alone, a second time
+            self.store(culprit, None, "worker process crashed")
+        else:  # the trial that killed its worker is among them, or none (killed from outside)
+            self.suspects = lost + self.suspects
+
+    def run(self, sig: Interrupts) -> None:
+        while True:
+            self.fill(sig)
+            if not self.pending:
+                if sig.stop:
+                    break
+                if self.suspects or self.retry:
+                    continue
+                if self.study.settled(self.budget):
+                    break  # budget used, or the learner has nothing more to ask
+                time.sleep(POLL_S)  # other processes run trials this learner waits for
+                continue
+            self.collect()
+        if self.suspects or self.retry:
+            self.study.abandon()  # claimed here but not run (stopped): others may run them
+        self.pool.shutdown(wait=True)
 
 
 def _run_pool(
@@ -237,78 +388,9 @@ def _run_pool(
     store: Callable[[Candidate, TrialResult | None, str], None],
     mp_context: str | None,
 ) -> None:
-    ctx = multiprocessing.get_context(mp_context) if mp_context else None
-    method = (ctx or multiprocessing).get_start_method()
-    parent = os.getpid() if method in ("fork", "spawn") else None  # forkserver: not us
-
-    def new_pool() -> ProcessPoolExecutor:
-        return ProcessPoolExecutor(
-            n_workers, mp_context=ctx, initializer=_worker_init, initargs=(parent,)
-        )
-
-    pool = new_pool()
-    pending: dict[Future[tuple[TrialResult | None, str]], Candidate] = {}
-    suspects: list[Candidate] = []  # trials lost in a broken pool, re-run one at a time
-    retry: list[Candidate] = []  # asked but never started (submitted to a broken pool)
+    run = _PoolRun(study, objective, budget, n_workers, store, mp_context)
     try:
-        while True:
-            while not sig.stop:
-                if suspects:
-                    if pending:
-                        break
-                    cand: Candidate | None = suspects.pop(0)
-                elif retry:
-                    cand = retry.pop(0)
-                else:
-                    if len(pending) >= n_workers:
-                        break
-                    # None: a population waits for its tells, the budget is taken, or exhausted
-                    cand = study.ask(budget)
-                    if cand is None:
-                        break
-                try:
-                    fut = pool.submit(evaluate, objective, study.params_of(cand))
-                except BrokenProcessPool:  # broke before we saw it: submit it again later
-                    retry.insert(0, cand)
-                    break
-                pending[fut] = cand
-                if suspects or len(pending) >= n_workers:
-                    break
-            if not pending:
-                if sig.stop:
-                    break
-                if suspects or retry:
-                    continue
-                if study.settled(budget):
-                    break  # budget used, or the learner has nothing more to ask
-                time.sleep(POLL_S)  # other processes run trials this learner waits for
-                continue
-            done, _ = wait(pending, timeout=0.2, return_when=FIRST_COMPLETED)
-            broken: list[Candidate] = []
-            for fut in done:
-                cand = pending.pop(fut)
-                try:
-                    result, error = fut.result()
-                except BrokenProcessPool:
-                    broken.append(cand)
-                    continue
-                store(cand, result, error)
-            if broken:
-                # every other running trial is lost with the pool: collect them too
-                for fut, cand in list(pending.items()):
-                    try:
-                        result, error = fut.result()
-                        store(cand, result, error)
-                    except BrokenProcessPool:
-                        broken.append(cand)
-                pending.clear()
-                pool.shutdown(wait=True)
-                pool = new_pool()
-                if len(broken) == 1:
-                    store(broken[0], None, "worker process crashed")
-                else:
-                    suspects = broken + suspects
+        run.run(sig)
     except BaseException:
-        _kill_pool(pool)
+        _kill_pool(run.pool)
         raise
-    pool.shutdown(wait=True)
