@@ -1,4 +1,4 @@
-"""Seed A's feed-forward ablation as paired runs, one N at a time (results survive a stop).
+"""Ehlers et al.'s feed-forward ablation as paired runs, one N at a time (results survive a stop).
 
 Usage: ``python benchmarks/feedforward_pairs.py [--robot fr3] [--trajectories 20]
 [--sizes 100,200,400] [--seed 0] [--workers 1]``

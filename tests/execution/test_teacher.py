@@ -48,7 +48,8 @@ def test_demos_that_end_at_once_or_never_are_discarded():
 
 
 def test_worst_case_sweep_spans_start_to_hole_and_across():
-    """Seed A: one end of the exploration distribution lies at the demonstration's start."""
+    """Ehlers et al. 2019: one end of the exploration distribution is at the demonstration's
+    start."""
     task = get_task("peg2d")
     demos, _ = BlindTeacher(task, seed=2).record(1)
     xy = demos[0].pos[:, :2]

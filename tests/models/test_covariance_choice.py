@@ -35,7 +35,7 @@ def test_a_correlation_every_demonstration_shares_keeps_the_full_covariance():
     assert choice.covariance == "full" and choice.scores["full"] > choice.scores["diag"]
 
 
-def test_one_demonstration_keeps_seed_a_full_covariance():
+def test_one_demonstration_keeps_the_papers_full_covariance():
     choice = choose_covariance([_states(1.0, 0)], _fit)
     assert (choice.covariance, choice.criterion, choice.scores) == (
         "full",

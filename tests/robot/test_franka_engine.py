@@ -40,8 +40,8 @@ def test_a_search_trajectory_runs_on_the_franka_through_the_engine(franka_sim: o
 
 
 def test_a_skill_trial_runs_on_the_franka(franka_sim: object) -> None:
-    """Seed B's peg-in-hole skill with the adaptive law, as a learning trial would run it, on
-    the Franka through the protocol. franky-sim has no cell: the skill descends through its
+    """Johannsmeier et al.'s peg-in-hole skill with the adaptive law, as a learning trial would run
+    it, on the Franka through the protocol. franky-sim has no cell: the skill descends through its
     approach into free space, and what ends it depends on the real loop's timing (its time
     limit or error exit, or its depth condition once the part is below the entry height, which
     a pose-based detector cannot tell from an insertion without the cell)."""

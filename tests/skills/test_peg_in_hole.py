@@ -22,7 +22,8 @@ def test_default_skill_inserts_on_the_arm_after_a_real_lateral_move():
 
 
 def test_key_context_fixes_the_tilt_and_learns_the_rest():
-    # seed B (Sec. V) does not learn the key's initial alignment; the other tasks learn it
+    # Johannsmeier et al. 2019 (Sec. V) does not learn the key's initial alignment; the other tasks
+    # learn it
     key = get_task("key")
     ctx = peg_in_hole.hole_context(key, np.random.default_rng(0))
     assert ctx.fixed == {"tilt": key.params.fixed_tilt}

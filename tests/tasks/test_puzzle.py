@@ -1,4 +1,5 @@
-"""The ``puzzle`` task, and seed B's start protocol shared by ``puzzle``, ``key`` and ``peg``."""
+"""The ``puzzle`` task, and Johannsmeier et al.'s start protocol shared by ``puzzle``, ``key``
+and ``peg``."""
 
 from __future__ import annotations
 
@@ -116,7 +117,8 @@ def test_toml(tmp_path) -> None:
     assert t.hole2world.rz == pytest.approx(0.5)
 
 
-# ------------------------------------------------ seed B's protocol, shared by the three tasks
+# ------------------------------------------------ Johannsmeier et al.'s protocol, shared by the
+# three tasks
 @pytest.mark.parametrize("name", SEED_B_TASKS)
 def test_skill_starts_are_four_deterministic_poses_above_the_hole(name: str) -> None:
     t = get_task(name)

@@ -1,11 +1,11 @@
 """Each seed alone against the three joined, on the same trials (``teachfit bench assembly``).
 
 For a task and taught-hole errors (m), every method of
-:data:`~teachfit.execution.assembly.METHODS` -- (a) seed B's skill alone, (b) seed A's learned
-search alone from the taught pose, (c) the plan executed open loop, (d) the joined pipeline --
-runs the same ``trials`` trials (taught hole, start, seeds from
+:data:`~teachfit.execution.assembly.METHODS` -- (a) Johannsmeier et al.'s skill alone, (b) Ehlers et
+al.'s learned search alone from the taught pose, (c) the plan executed open loop, (d) the joined
+pipeline -- runs the same ``trials`` trials (taught hole, start, seeds from
 :func:`~teachfit.execution.batch.episode_seed`). The search model is learned from the seeded
-blind teacher's demonstrations, as in seed A's benchmarks: one worst-case demonstration on
+blind teacher's demonstrations, as in Ehlers et al.'s benchmarks: one worst-case demonstration on
 ``peg2d`` and on other x-y tasks, two from opposite ends on ``socket3d`` and other x-y-rz tasks.
 Rows give success (Wilson 95 % interval) and the median time to insertion (s from the start,
 the approach included). With ``learned`` parameters (e.g. ``teachfit learn skill --skill

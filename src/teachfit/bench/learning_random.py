@@ -1,15 +1,15 @@
 """How hard a skill task is for learning: the success of random parameters, and throughput.
 
-Seed B uses Latin hypercube sampling as "an uninformed sampler to gain insights into the
-difficulty of the problems at hand" (Sec. IV). :func:`random_rate` measures exactly that: per
-task, ``experiments`` set-ups (seeds ``seed + e``: hole estimate, starts, sensor noise), each
+Johannsmeier et al. 2019 uses Latin hypercube sampling as "an uninformed sampler to gain insights
+into the difficulty of the problems at hand" (Sec. IV). :func:`random_rate` measures exactly that:
+per task, ``experiments`` set-ups (seeds ``seed + e``: hole estimate, starts, sensor noise), each
 evaluating ``trials`` parameter sets of a Latin hypercube design (every learned parameter
 uniform in its domain, the log ones in log scale) from the ``n_starts`` starts. It reports
 the fraction of executions that succeeded with its Wilson 95 % interval, the fraction of
 feasible trials (any start succeeded) and the throughput in executions per CPU-second (this
 process and its workers together, ``resource.getrusage``), from which :func:`grid_projection`
-projects the wall time of seed B's whole Fig. 6 grid. A learning benchmark discriminates
-between methods only if random parameters mostly fail (the issue asks for <= 40 %).
+projects the wall time of Johannsmeier et al.'s whole Fig. 6 grid. A learning benchmark
+discriminates between methods only if random parameters mostly fail (the issue asks for <= 40 %).
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Seed B's learning runner, measured: the speed-up from workers and the trials/s per count.
+"""Johannsmeier et al.'s learning runner, measured: the speed-up from workers and the trials/s per
+count.
 
 :func:`speedup` times one study with 1 and with N workers (alternating runs, fastest kept);
 :func:`scaling` measures trials/s for several worker counts in one run (local pools or Ray).

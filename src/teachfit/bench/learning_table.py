@@ -1,4 +1,4 @@
-"""Seed B's Fig. 6 grid as text: the per-cell table and the methods' ordering per task.
+"""Johannsmeier et al.'s Fig. 6 grid as text: the per-cell table and the methods' ordering per task.
 
 Per task x method (over its experiments, seeds ``seed + e``): the mean best cost with its 95 %
 t interval (s), the best parameters' success rate, how many experiments found a feasible trial
@@ -39,9 +39,9 @@ __all__ = [
     "unsolved_setups",
 ]
 
-#: Seed B's reading of Fig. 6 (Sec. VI), by task: "all four algorithms are suited to a certain
-#: degree" for puzzle and key, BO finds worse solutions with a larger interval and stops early;
-#: on the peg BO found no solution, LHS's interval is too large, PSO better, CMA-ES best.
+#: Johannsmeier et al.'s reading of Fig. 6 (Sec. VI), by task: "all four algorithms are suited to a
+#: certain degree" for puzzle and key, BO finds worse solutions with a larger interval and stops
+#: early; on the peg BO found no solution, LHS's interval is too large, PSO better, CMA-ES best.
 PAPER_ORDERING = {
     "puzzle": "cmaes ≈ pso ≈ lhs < bo (BO worse on average, wider interval, stops early)",
     "key": "cmaes ≈ pso ≈ lhs < bo (BO worse on average, wider interval, stops early)",

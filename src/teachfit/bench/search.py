@@ -1,14 +1,14 @@
-"""Seed A's search experiments reproduced in simulation, beside the paper's numbers.
+"""Ehlers et al.'s search experiments reproduced in simulation, beside the paper's numbers.
 
 - Table I: one demonstration; 30 starts in a 3 cm circle halfway between the demonstration's
   start and the hole; TSHIX (300 points, a new trajectory per start) vs. one ergodic trajectory
-  of about the mean TSHIX length, both with the GMR feed-forward. We add TSHIX with seed A's
+  of about the mean TSHIX length, both with the GMR feed-forward. We add TSHIX with Ehlers et al.'s
   i.i.d. sampling beside our default quasi-random sampling.
 - Table II: one start, 20 TSHIX trajectories per N = 100 ... 500: success and planning time.
 - Ablation: the same without the feed-forward, N = 100, 200, 400.
 - Table III: ``socket3d`` (x, y, rz), 15 starts in the socket's upper half, 600 points: random
   walk, spiral, TSHIX from one and from two demonstrations (started at opposite ends; with
-  seed A's full covariance and with per-DOF variances only) and the 3D ergodic trajectory
+  Ehlers et al.'s full covariance and with per-DOF variances only) and the 3D ergodic trajectory
   (which the paper could not produce).
 
 Every execution is a :class:`~teachfit.bench.search_jobs.SearchJob` run in worker processes.
@@ -275,8 +275,8 @@ def record_socket_demos(task: object, seed: int) -> tuple[list[Demonstration], l
 
     Opposite ends in position (left and right of the upper half, against the wall) and in yaw
     (turned by 60-100 % of ``start_rz`` one way, then the other), so that together they span
-    the start variability as seed A asks of demonstrations. Cached like the teacher's own
-    recordings (:mod:`teachfit.execution.teacher_cache`).
+    the start variability as Ehlers et al. 2019 asks of demonstrations. Cached like the teacher's
+    own recordings (:mod:`teachfit.execution.teacher_cache`).
     """
     key = cache_key(
         task=task, style=TeacherStyle(), seed=seed, robot=ROBOT[0], n=2, limit=6, kind="socket"
@@ -319,7 +319,7 @@ def table3(
     chosen = chosen_methods(methods, TABLE3_METHODS, "III")
     task = get_task("socket3d")
     demos = _socket_demos(task, seed)
-    # seed A's rows keep its full covariance; `learn search` (covariance "auto") chooses by
+    # Ehlers et al.'s rows keep its full covariance; `learn search` (covariance "auto") chooses by
     # held-out likelihood and picks per-DOF variances on these two demonstrations
     one = SearchModel.fit(demos[:1], task.name, covariance="full")
     two = SearchModel.fit(demos, task.name, covariance="full")

@@ -1,6 +1,6 @@
 """One search execution as a self-contained, picklable job, and a parallel map over jobs.
 
-Seed A's protocols run hundreds of independent executions; each :class:`SearchJob` carries
+Ehlers et al.'s protocols run hundreds of independent executions; each :class:`SearchJob` carries
 everything it needs as plain values (task name and overrides, the model as its JSON document,
 the start pose, the generator and its seed), so a worker process rebuilds the task, robot and
 model from it without pickling any user object. Workers cache the robot per task.

@@ -1,4 +1,4 @@
-"""Seed A's Table I protocol on any task, e.g. a user's mesh task file.
+"""Ehlers et al.'s Table I protocol on any task, e.g. a user's mesh task file.
 
 One model from the task's demonstrations (recorded by the seeded blind teacher, or given);
 ``n_starts`` starts of the task's ``"table1"`` protocol (its teacher starts where it has no

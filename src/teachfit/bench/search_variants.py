@@ -1,4 +1,4 @@
-"""Seed A's Table I / Table III protocols on a seeded sample of task variants.
+"""Ehlers et al.'s Table I / Table III protocols on a seeded sample of task variants.
 
 Each variant (:mod:`teachfit.tasks.variants`) is run as a user would run it, nothing tuned per
 variant: the blind teacher records on that variant (one demonstration for ``peg2d``; two from
@@ -27,7 +27,7 @@ from teachfit.tasks.variants import Variant, sample_variants
 
 #: the protocol of each task: (protocol name, TSHIX points, demonstrations)
 PROTOCOLS = {"peg2d": ("table1", 300, 1), "socket3d": ("table3", 600, 2)}
-#: seed A's goal per task: TSHIX success on every variant at least this
+#: Ehlers et al.'s goal per task: TSHIX success on every variant at least this
 GOALS = {"peg2d": 0.90, "socket3d": 0.85}
 
 
@@ -125,7 +125,7 @@ def run_variants(
 
 
 def goal_misses(results: Sequence[VariantResult]) -> list[VariantResult]:
-    """The variants whose TSHIX success is below seed A's goal for their task (or not run)."""
+    """The variants whose TSHIX success is below the goal for their task (or not run)."""
     return [
         r
         for r in results

@@ -1,4 +1,4 @@
-"""``teachfit bench search``: seed A's tables in simulation, ours beside the paper's."""
+"""``teachfit bench search``: Ehlers et al.'s tables in simulation, ours beside the paper's."""
 
 from __future__ import annotations
 

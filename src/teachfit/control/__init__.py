@@ -1,5 +1,6 @@
-"""Control laws a robot runs in its own loop: Cartesian impedance (seed A eqs. 8-9) and
-adaptive impedance (seed B), chosen by a :data:`~teachfit.core.control.ControllerSpec`."""
+"""Control laws a robot runs in its own loop: Cartesian impedance (Ehlers et al. 2019 eqs. 8-9) and
+adaptive impedance (Johannsmeier et al. 2019), chosen by a
+:data:`~teachfit.core.control.ControllerSpec`."""
 
 from __future__ import annotations
 

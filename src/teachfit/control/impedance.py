@@ -1,4 +1,4 @@
-"""Cartesian impedance control with a superposed feed-forward wrench (seed A, eqs. 8-9).
+"""Cartesian impedance control with a superposed feed-forward wrench (Ehlers et al. 2019, eqs. 8-9).
 
     f_c   = K_p e_p + D_p de_p + f_ff
     tau_c = K_th e_th + D_th de_th + tau_ff
@@ -76,7 +76,7 @@ def aligned_stiffness(
     N/m perpendicular to it in the plane, ``z`` N/m vertically, and ``rotational`` N·m/rad.
 
     High stiffness along the motion tracks the search path; low stiffness across it lets the
-    part fall into a hole it passes over (seed A, Sec. III-D).
+    part fall into a hole it passes over (Ehlers et al. 2019, Sec. III-D).
     """
     d = np.asarray(direction, dtype=float)[:2]
     n = float(np.hypot(d[0], d[1]))

@@ -2,9 +2,9 @@
 
 A robot runs its 1 kHz loop itself (a real arm's firmware callback, the simulator's step), so
 what the layers above hand it is data: a :data:`ControllerSpec`, either
-:class:`FixedGainSpec` (Cartesian impedance with the gains each command carries, seed A
-eqs. 8-9) or :class:`AdaptiveSpec` (seed B's adaptive impedance with its meta-parameters).
-The laws themselves are in :mod:`teachfit.control`.
+:class:`FixedGainSpec` (Cartesian impedance with the gains each command carries, Ehlers et al. 2019
+eqs. 8-9) or :class:`AdaptiveSpec` (Johannsmeier et al.'s adaptive impedance with its
+meta-parameters). The laws themselves are in :mod:`teachfit.control`.
 
 Also here: the meta-parameters of the adaptive impedance controller, the system limits, and the
 bounds the limits imply on the meta-parameters (docs/methods.md, Johannsmeier et al. 2019).
@@ -165,7 +165,8 @@ class FixedGainSpec:
 
 @dataclass(frozen=True)
 class AdaptiveSpec:
-    """Seed B's adaptive impedance: the command's stiffness is the floor, adapted on top.
+    """Johannsmeier et al.'s adaptive impedance: the command's stiffness is the floor, adapted on
+    top.
 
     ``damping_ratio`` is ``xi`` of the adaptive damping term (``None``: each command's).
     """

@@ -7,8 +7,8 @@ every method sees the same trials), a *taught* hole pose: the true hole moved by
 skill's task frame is the taught hole; the true hole is known only to the simulator (ground
 truth, recorded beside the measured outcome). Methods (:data:`METHODS`):
 
-- ``"skill"``: seed B's skill alone (its recovery only retracts);
-- ``"search"``: seed A's learned search alone, started on the surface at the taught pose (the
+- ``"skill"``: Johannsmeier et al.'s skill alone (its recovery only retracts);
+- ``"search"``: Ehlers et al.'s learned search alone, started on the surface at the taught pose (the
   same :class:`~teachfit.skills.search.LearnedSearch` node as the joined skill's) until the
   task's success detector fires;
 - ``"open-loop"``: the plan executed open loop: move above the taught hole, then straight down
@@ -95,8 +95,9 @@ def open_loop_skill(controller: str = "adaptive") -> Skill:
 
 
 def search_skill(model: SearchModel, controller: str = "adaptive") -> Skill:
-    """Seed A alone: the joined skill's search node from the start pose until the task's
-    success detector fires (as seed A's runner, :func:`~teachfit.skills.follow.follow_skill`)."""
+    """Ehlers et al. 2019 alone: the joined skill's search node from the start pose until the task's
+    success detector fires (as Ehlers et al.'s runner,
+    :func:`~teachfit.skills.follow.follow_skill`)."""
     joined = peg_in_hole_search.build(model, controller)
     node = joined.node("search")
     return Skill(

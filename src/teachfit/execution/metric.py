@@ -1,7 +1,7 @@
-"""The learning metric (seed B, Def. 5): ``(success, cost)`` of one execution.
+"""The learning metric (Johannsmeier et al. 2019, Def. 5): ``(success, cost)`` of one execution.
 
-Seed B's cost for peg-in-hole: the execution time from first contact to full insertion; when
-the error condition fired (e.g. the time limit), the maximum time plus a factor times the
+Johannsmeier et al.'s cost for peg-in-hole: the execution time from first contact to full insertion;
+when the error condition fired (e.g. the time limit), the maximum time plus a factor times the
 distance still to go to the goal pose in the hole:
 
     success:  q = t_end - t_contact                                   (s)

@@ -1,7 +1,8 @@
-"""A planned L-into-groove or tenon path (seed C) executed in contact, the last step a skill.
+"""A planned L-into-groove or tenon path (Wang et al. 2019) executed in contact, the last step a
+skill.
 
-Seed C executed its plans on the robot open loop and failed when vision was off. Here the plan
-(:class:`~teachfit.plans.planner.MotionPlanner`, guided by a demonstration) is executed by the
+Wang et al. 2019 executed its plans on the robot open loop and failed when vision was off. Here the
+plan (:class:`~teachfit.plans.planner.MotionPlanner`, guided by a demonstration) is executed by the
 impedance-controlled floating robot holding the part in MuJoCo physics
 (:class:`~teachfit.plans.cell.PartsCell`), with the fixed part where it truly is -- its
 captured pose off by a sampled capture error (:func:`capture_error`) -- while the robot
@@ -18,7 +19,7 @@ believes the captured pose:
   along the path, shifts its end across the insertion by the next offset of a ring and
   follows it again (:data:`L_RETRY`); the tenon's ``spiral`` presses its face on the mortise
   and spirals across until the hole catches it (:data:`SPIRAL`);
-- ``"open-loop"``: the same path tracked stiffly to its end, as seed C did.
+- ``"open-loop"``: the same path tracked stiffly to its end, as Wang et al. 2019 did.
 
 Task frame ``T`` of both: the captured fixed-part frame turned so that ``T``'s z is ``G``'s x,
 i.e. the insertion (towards ``G``'s -x) is ``T``'s -z and "depth" counts along it.

@@ -1,4 +1,5 @@
-"""A learning trial (seed B, Sec. V): one parameter set evaluated from several start poses.
+"""A learning trial (Johannsmeier et al. 2019, Sec. V): one parameter set evaluated from several
+start poses.
 
 An experiment fixes the task, the estimated hole pose (taught once, with its error) and the
 start poses (four slightly different ones) in a :class:`SkillSetup`; each trial then runs the
@@ -97,7 +98,7 @@ class SkillTrial:
     Parameters
     ----------
     setup : the experiment's fixed part.
-    controller : ``"adaptive"`` (seed B) or ``"impedance"``.
+    controller : ``"adaptive"`` (Johannsmeier et al. 2019) or ``"impedance"``.
     metric : defaults to ``LearningMetric(time_limit = the skill's t_max)``.
     config : engine settings.
     robot : name in :data:`~teachfit.robot.registry.ROBOTS`; ``robot_options`` its options.

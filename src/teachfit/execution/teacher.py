@@ -4,11 +4,13 @@ The teacher starts from a worst-case offset, presses the part onto the surface a
 compliant robot kinesthetically in a deliberate search pattern until the part drops in. The
 belief about where the hole is is off by ``belief_sigma``. Patterns:
 
-- ``"sweep"`` (default, the worst-case demonstration seed A asks for): a raster of passes
+- ``"sweep"`` (default, the worst-case demonstration Ehlers et al. 2019 asks for): a raster of
+passes
   across the believed direction, ``2 sweep_halfwidth`` wide and ``spiral_pitch`` apart, that
   starts at the start pose and advances towards (and beyond) the belief. The demonstrated
   states then span the whole region between the start and the hole, so "one end of the
-  exploration distribution is approximately at the starting position" (seed A, Sec. IV-B).
+  exploration distribution is approximately at the starting position" (Ehlers et al. 2019, Sec.
+  IV-B).
 - ``"spiral"``: straight towards the belief, then an outward Archimedean spiral around it.
 - ``"zigzag"``: straight towards the belief, then a zig-zag raster around it.
 
@@ -18,7 +20,7 @@ about z around its belief. The press is not constant either: it wanders slowly a
 ``push_force`` (another Ornstein-Uhlenbeck process, ``press_wander`` N over ``press_timescale``
 s; see :meth:`BlindTeacher.press`). What is recorded is what a kinesthetic demonstration
 records: TCP pose and wrist wrench at ``record_rate``. Demonstrations that end at once or never
-are discarded, as in seed A.
+are discarded, as in Ehlers et al. 2019.
 
 The style and the hints of a task and a robot are in :mod:`.teacher_style`, the hand's path,
 noise and press in :mod:`.teacher_motion`; this module records with them (a progress bar, and

@@ -7,8 +7,8 @@ and its two-sided 95 % confidence interval from Student's t:
 
     mean_k +- t_{0.975, m-1} * sd_k / sqrt(m)
 
-(seed B, Fig. 6: mean per trial and the 95 % confidence interval). With one experiment the
-band collapses onto the curve.
+(Johannsmeier et al. 2019, Fig. 6: mean per trial and the 95 % confidence interval). With one
+experiment the band collapses onto the curve.
 """
 
 from __future__ import annotations

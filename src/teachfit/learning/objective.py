@@ -6,7 +6,7 @@ start poses -- that turns into ``params -> TrialResult`` in whichever process ca
 worker of :func:`~teachfit.learning.runner.run_study`, a Ray worker, or this one). The MuJoCo
 scene and robot are built once per process and objective and then reused across trials.
 
-Cost (seed B, Sec. V): the mean over the starts of the learning metric
+Cost (Johannsmeier et al. 2019, Sec. V): the mean over the starts of the learning metric
 (:class:`~teachfit.execution.metric.LearningMetric`): the time from first contact to full
 insertion (s) on success, ``t_max + k_d * remaining distance`` on failure. A trial is
 feasible if any start succeeded. ``info`` carries ``success_rate``, ``sim_s`` (simulated robot

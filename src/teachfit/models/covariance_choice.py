@@ -1,7 +1,7 @@
 """Choosing p_e's covariance structure from the demonstrations themselves.
 
-Seed A fits one Gaussian with a full covariance. With two demonstrations started at opposite
-corners with opposite yaw, that covariance holds a correlation (x against rz, 0.76 on
+Ehlers et al. 2019 fits one Gaussian with a full covariance. With two demonstrations started at
+opposite corners with opposite yaw, that covariance holds a correlation (x against rz, 0.76 on
 ``socket3d``) that no third start follows, and TSHIX then misses starts of the other sign
 (Table III: 67 % with the full covariance, 100 % with per-DOF variances). Which structure
 generalises is measured on the data: **leave one demonstration out**. For each demonstration
@@ -10,8 +10,8 @@ demonstration ``i``'s states,
 
     score(c) = (1 / M) Σ_i  mean_{s ∈ demo i} log p_e^{c, -i}(s),
 
-and the structure with the higher score is chosen (``full`` on a tie: seed A's choice). With a
-single demonstration there is nothing held out: seed A's full covariance is kept, and the
+and the structure with the higher score is chosen (``full`` on a tie: Ehlers et al.'s choice). With
+a single demonstration there is nothing held out: Ehlers et al.'s full covariance is kept, and the
 choice says so.
 """
 

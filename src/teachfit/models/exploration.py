@@ -224,7 +224,7 @@ def fit_exploration(
     seed : int
         Seed of the EM initialisation (K > 1).
     covariance : {"full", "diag"}
-        Full maximum-likelihood covariances (seed A), or per-DOF variances only.
+        Full maximum-likelihood covariances (Ehlers et al. 2019), or per-DOF variances only.
     """
     dims = tuple(dims)
     x = _check_data(states, "exploration")

@@ -36,7 +36,7 @@ class FloatingToolParams:
 
     ``mass`` (kg) and ``inertia`` (kg·m², diagonal) are the apparent inertia the controller
     moves (a light arm's end-effector). The wrist sensor is modelled as an ATI Mini45 on a Net
-    F/T (seed A's): its gauges are sampled every physics tick (1 kHz here; 7 kHz on the real
+    F/T (Ehlers et al.'s): its gauges are sampled every physics tick (1 kHz here; 7 kHz on the real
     one) with white noise of ``ft_noise`` (N, N·m, standard deviation per unfiltered sample,
     of the order of the Mini45's documented resolution), then low-pass filtered on the device
     (``ft_cutoff`` Hz, a second-order Butterworth, one of the Net F/T's selectable cutoffs:
@@ -214,7 +214,7 @@ class FloatingToolRobot:
 
     @staticmethod
     def teacher_hints(task: Task) -> TeacherHints:
-        """None: the blind teacher guides the free tool as seed A's teacher guided the arm."""
+        """None: the blind teacher guides the free tool as the paper's teacher guided the arm."""
         return NO_TEACHER_HINTS
 
     def close(self) -> None:

@@ -2,8 +2,9 @@
 
 Why: a tick of :class:`~teachfit.robot.floating.FloatingToolRobot` is one ``mj_step`` (6-60
 µs, most of it narrow-phase collision in contact) plus the control law, ~30 small numpy
-operations that cost 35-45 µs from Python (BENCHMARKS.md, seed B throughput). Compiled, the
-law costs well under a microsecond; the whole ``step(n)`` of ``n`` ticks becomes one call.
+operations that cost 35-45 µs from Python (BENCHMARKS.md, Johannsmeier et al. 2019 throughput).
+Compiled, the law costs well under a microsecond; the whole ``step(n)`` of ``n`` ticks becomes one
+call.
 
 This reuses the FR3 kernel's pattern and parts (:mod:`teachfit.robot.fr3.kernel`): MuJoCo's C
 routines through ``ctypes`` on the bindings' own ``libmujoco`` with the model and data

@@ -1,7 +1,7 @@
 """The wrench sensors' digital low-pass: a second-order Butterworth run at the physics rate.
 
 Real wrench sensing filters on the device at kHz rates before anyone logs at 100 Hz. ATI's Net
-F/T (seed A's wrist sensor) samples its gauges at 7 kHz and applies a user-selected low-pass
+F/T (Ehlers et al.'s wrist sensor) samples its gauges at 7 kHz and applies a user-selected low-pass
 (Net F/T manual, 9620-05-NET FT, "Low-pass filter": cutoffs 838, 326, 152, 73, 35, 18 or
 8 Hz, or none); Franka's ``O_F_ext_hat_K`` / ``tau_ext_hat_filtered`` is likewise a filtered
 estimate (cutoff not documented). A 100 Hz log of a first-order 80 Hz filter point-samples

@@ -185,9 +185,9 @@ class TshixPlanner:
     solver : {"fast", "lkh"}
         TSP solver.
     sampling : {"qmc", "random"}
-        ``"random"``: i.i.d. draws from p_e (seed A). ``"qmc"`` (default): scrambled Sobol
-        points through p_e's inverse CDF, equally distributed but more even, so the tour leaves
-        fewer gaps (measured in BENCHMARKS.md, Table I).
+        ``"random"``: i.i.d. draws from p_e (Ehlers et al. 2019). ``"qmc"`` (default): scrambled
+        Sobol points through p_e's inverse CDF, equally distributed but more even, so the tour
+        leaves fewer gaps (measured in BENCHMARKS.md, Table I).
     """
 
     exploration: ExplorationDistribution

@@ -1,5 +1,5 @@
-"""Figures of skill learning (seed B, Fig. 6): learning curves, parameter traces, and the
-best execution's force and pose over time.
+"""Figures of skill learning (Johannsmeier et al. 2019, Fig. 6): learning curves, parameter traces,
+and the best execution's force and pose over time.
 
 matplotlib with the Agg backend; every function writes ``path`` (png/pdf/svg by suffix) and
 returns it.

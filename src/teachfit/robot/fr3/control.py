@@ -1,4 +1,5 @@
-"""Cartesian impedance in joint torques for the FR3 (seed B eq. 2, seed A eqs. 8-9).
+"""Cartesian impedance in joint torques for the FR3 (Johannsmeier et al. 2019 eq. 2, Ehlers et al.
+2019 eqs. 8-9).
 
 Each 1 ms tick, with the kinematics and dynamics of the current state (``mj_step1`` done):
 
