@@ -40,7 +40,7 @@ from teachfit.demonstrations.rosbag_import import is_bag, read_bag
 from teachfit.demonstrations.segment import Segmenter
 from teachfit.execution.recording import is_run_log
 from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
-from teachfit.tasks.registry import load_task
+from teachfit.tasks.registry import TASKS, load_task
 
 T = TypeVar("T")
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)
@@ -133,7 +133,10 @@ def import_(
     log: Annotated[
         Path, typer.Argument(help="robot log: CSV, ROS 1 .bag, ROS 2 bag folder, .db3 or .mcap")
     ],
-    task: Annotated[str, o.task("the task the log demonstrates (teachfit tasks)")] = "peg2d",
+    task: Annotated[
+        str | None,
+        o.task("required: the task the log demonstrates (teachfit tasks, or a task .toml)"),
+    ] = None,
     columns: Annotated[
         Path, typer.Option(help="CSV column map (TOML) to read the log with")
     ] = Path("columns.toml"),
@@ -177,7 +180,13 @@ def import_(
 ) -> None:
     """Import a real robot log (CSV or ROS bag) as demonstrations into --out (an existing file
     needs --append or --overwrite)."""
-    load_task(task)
+    if task is None:
+        raise TeachfitError(
+            f"give --task: which task {log} demonstrates (one of {', '.join(sorted(TASKS))}, "
+            "or a task .toml file); a real log does not say, and a demonstration of the wrong "
+            "task is refused by search run and learn"
+        )
+    task = load_task(task).name
     if out.is_dir():
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
     frame = None if transform is None else _option("--transform", FrameTransform.parse, transform)
@@ -230,13 +239,13 @@ def import_(
     table.add_column("demonstration", no_wrap=True)
     for col in ("start", "duration", "samples", "rate", "x-y extent", "peak |F|"):
         table.add_column(col, justify="right", no_wrap=True)
-    for piece, demo in zip(result.pieces, result.demos, strict=True):
+    for piece in result.pieces:
         table.add_row(
             piece.name,
             f"{piece.start_s:.2f}",
             f"{piece.duration_s:.2f}",
             str(piece.samples),
-            f"{demo.rate_hz:.1f}",
+            f"{piece.rate_hz:g}",
             f"{piece.extent_mm[0]:.1f} x {piece.extent_mm[1]:.1f}",
             "-" if piece.peak_force_n is None else f"{piece.peak_force_n:.1f}",
         )
