@@ -171,7 +171,7 @@ def test_bad_csv_is_refused_in_one_line(
             ["comma_decimals.csv", "--columns", "semi.toml"],
             ["file comma_decimals.csv, row 2, column 't_ms'", "(a decimal comma"],
         ),
-        (["log.csv", "--columns", "missing.toml"], ["file missing.toml: cannot read"]),
+        (["log.csv", "--columns", "missing.toml"], ["file missing.toml: no such column map"]),
         (["log.csv", "--columns", "log.csv"], ["file log.csv: invalid TOML"]),
         (["not_a_bag", *BAG_TOPICS], ["file not_a_bag: cannot read as a ROS bag"]),
     ],
@@ -258,3 +258,19 @@ def test_good_variants_write_only_the_named_output(
     added = set(_files(inputs)) - set(before)
     assert added == {out}
     assert all(_files(inputs)[k] == size for k, size in before.items())
+
+
+@pytest.mark.parametrize("flag", ["--overwrite", "--append"])
+def test_output_that_is_an_input_is_refused(
+    inputs: Path, monkeypatch: pytest.MonkeyPatch, flag: str
+) -> None:
+    monkeypatch.chdir(inputs)
+    before = _files(inputs)
+    for out, named in (("log.csv", "log.csv"), ("log.toml", "log.toml"), ("good_db3/x.h5", "")):
+        source = "good_db3" if named == "" else "log.csv"
+        extra = BAG_TOPICS if named == "" else ["--columns", "log.toml"]
+        argv = ["demo", "import", "--task", "peg2d", source, *extra, "--out", out, flag]
+        res = runner.invoke(app, argv)
+        assert res.exit_code == 2 and res.output.startswith(f"error: --out {out} is "), res.output
+        assert "the input" in res.output and len(res.output.strip().splitlines()) == 1
+    assert _files(inputs) == before

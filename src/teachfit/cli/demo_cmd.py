@@ -189,6 +189,7 @@ def import_(
     task = load_task(task).name
     if out.is_dir():
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
+    _not_an_input(out, log, columns)
     frame = None if transform is None else _option("--transform", FrameTransform.parse, transform)
     if is_bag(log):
         if pose_topic is None:
@@ -254,6 +255,18 @@ def import_(
         f"imported {len(result.demos)} demonstration(s) in frame {result.demos[0].frame!r} "
         f"from {log} -> {out}"
     )
+
+
+def _not_an_input(out: Path, *inputs: Path) -> None:
+    """Refuse an ``--out`` that is one of the command's inputs (or inside a bag folder): with
+    --overwrite the log or its map would be replaced by the HDF5 file."""
+    for given in inputs:
+        inside = given.is_dir() and given.resolve() in out.resolve().parents
+        if inside or (out.exists() and given.exists() and out.samefile(given)):
+            raise TeachfitError(
+                f"--out {out} is {'inside ' if inside else ''}the input {given}: give another "
+                "file name, such as demos.h5"
+            )
 
 
 @app.command("export")

@@ -270,6 +270,12 @@ class ColumnMap:
         try:
             with path.open("rb") as f:
                 data = tomllib.load(f)
+        except FileNotFoundError as exc:
+            raise DatasetError(
+                "no such column map: write one naming the log's columns (examples/columns.toml "
+                "documents every key)",
+                path=str(path),
+            ) from exc
         except OSError as exc:
             raise DatasetError(f"cannot read ({exc.strerror})", path=str(path)) from exc
         except UnicodeDecodeError as exc:
