@@ -69,6 +69,7 @@ def test_orientation_jump(make_log, tmp_path: Path) -> None:
     message = refused(csv, cmap)
     assert "orientation jumps by" in message and "between rows 200 and 201" in message
     assert "check the quaternion columns" in message
+    assert "a column swapped or missing part way" in message and "--segment" not in message
 
 
 def test_milliseconds_read_as_seconds(make_log) -> None:

@@ -34,7 +34,7 @@ from teachfit.demonstrations.dataset import (
 )
 from teachfit.demonstrations.export import export_csv
 from teachfit.demonstrations.frames import FrameTransform
-from teachfit.demonstrations.importing import ImportOptions, build_demos
+from teachfit.demonstrations.importing import ImportOptions, ImportResult, build_demos
 from teachfit.demonstrations.plausibility import CHECKS
 from teachfit.demonstrations.rosbag_import import is_bag, read_bag
 from teachfit.demonstrations.segment import Segmenter
@@ -180,13 +180,7 @@ def import_(
 ) -> None:
     """Import a real robot log (CSV or ROS bag) as demonstrations into --out (an existing file
     needs --append or --overwrite)."""
-    if task is None:
-        raise TeachfitError(
-            f"give --task: which task {log} demonstrates (one of {', '.join(sorted(TASKS))}, "
-            "or a task .toml file); a real log does not say, and a demonstration of the wrong "
-            "task is refused by search run and learn"
-        )
-    task = load_task(task).name
+    task = _import_task(task, log)
     if out.is_dir():
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
     _not_an_input(out, log, columns)
@@ -234,6 +228,11 @@ def import_(
         console.print(f"[yellow]note:[/] {escape(note)}")
     _check_target(out, append, overwrite)
     _store(out, list(result.demos), append, overwrite)
+    _print_import(result, log, out)
+
+
+def _print_import(result: ImportResult, log: Path, out: Path) -> None:
+    """The table of imported demonstrations and the closing line."""
     table = Table(
         title=f"{log} -> {out}", caption="start, duration: s; rate: Hz; extent: mm; |F|: N"
     )
@@ -255,6 +254,17 @@ def import_(
         f"imported {len(result.demos)} demonstration(s) in frame {result.demos[0].frame!r} "
         f"from {log} -> {out}"
     )
+
+
+def _import_task(task: str | None, log: Path) -> str:
+    """The name of the task a log demonstrates: ``--task`` is required, a log does not say."""
+    if task is None:
+        raise TeachfitError(
+            f"give --task: which task {log} demonstrates (one of {', '.join(sorted(TASKS))}, "
+            "or a task .toml file); a real log does not say, and a demonstration of the wrong "
+            "task is refused by search run and learn"
+        )
+    return load_task(task).name
 
 
 def _not_an_input(out: Path, *inputs: Path) -> None:

@@ -115,8 +115,9 @@ def _points_down(quat: np.ndarray) -> bool:
     return bool(np.median(axes[:, 2]) < -0.5)
 
 
-def _order_fix(log: RawLog, limits: Limits) -> str:
-    """The fix for an implausible orientation: the component order that fits, or why none."""
+def _order_fix(log: RawLog, limits: Limits, kind: str) -> str:
+    """The fix for an implausible orientation (``kind`` "jump" or "tilt" as read): the
+    component order that fits, or why none does."""
     raw = from_wxyz(log.quat, log.quat_order)  # the components as read from the file
     others = {o: _orientation_fault(to_wxyz(raw, o), limits) for o in QUAT_ORDERS}
     others.pop(log.quat_order)
@@ -125,6 +126,11 @@ def _order_fix(log: RawLog, limits: Limits) -> str:
     if not fits:
         tried = "; ".join(f"read as {o} the tool {_fault_text(f)}" for o, f in others.items() if f)
         order = "quat_order" if log.fix_in is not None else "the quaternion fields"
+        if kind == "jump":  # no tool turns that far in one sample
+            return (
+                f"no component order fits ({tried}): check the quaternion columns and {order} "
+                "(a column swapped or missing part way, or samples of two sources interleaved)"
+            )
         return (
             f"no component order fits ({tried}): if the tool really turns this much, {segment}; "
             f"else check the quaternion columns and {order}"
@@ -162,7 +168,7 @@ def check_orientation(log: RawLog, limits: Limits) -> Finding | None:
             f"{log.row_word[:-1]} {log.rows[i]}, read as {log.quat_order}); a search keeps it "
             f"within {math.degrees(limits.max_tilt_rad):.0f} deg"
         )
-    return Finding("orientation", message, _order_fix(log, limits))
+    return Finding("orientation", message, _order_fix(log, limits, kind))
 
 
 def check_wrench_sign(log: RawLog, limits: Limits) -> Finding | None:
