@@ -73,6 +73,22 @@ def panda_log(kind: str = "search", seed: int = 0) -> dict[str, np.ndarray]:
     return out
 
 
+def tilted_between_tasks(log: dict[str, np.ndarray], degrees: float = 60.0) -> dict:
+    """A ``"tasks"`` log whose tool tilts about the base x-axis during the transfers: 0 deg at
+    the first task, ``degrees`` / 2 at the second, ``degrees`` at the third (as a real Franka
+    log re-grasps between tasks), and wobbles by up to 2 deg within each search."""
+    from scipy.spatial.transform import Rotation
+
+    t = log["t"]
+    ramp = np.interp(t, [95.0, 140.0, 190.0, 235.0], [0.0, 0.5, 0.5, 1.0]) * degrees
+    angle = np.radians(ramp + 2.0 * np.sin(2.0 * np.pi * t / 7.0))
+    quat = log["quat"]
+    rot = Rotation.from_rotvec(np.outer(angle, [1.0, 0.0, 0.0]))
+    tool = Rotation.from_quat(quat[:, [1, 2, 3, 0]])
+    xyzw = (rot * tool).as_quat()
+    return {**log, "quat": xyzw[:, [3, 0, 1, 2]]}
+
+
 def write_log(
     path: Path,
     log: dict[str, np.ndarray],

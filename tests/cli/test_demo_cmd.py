@@ -16,6 +16,16 @@ from teachfit.demonstrations.dataset import read_dataset
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 runner = CliRunner()
+#: ``demo import`` of the example log (``--out`` to add)
+EXAMPLE_IMPORT = [
+    "demo",
+    "import",
+    "--task",
+    "peg2d",
+    EXAMPLES / "robot_log.csv",
+    "--columns",
+    EXAMPLES / "columns.toml",
+]
 
 
 def invoke(*args: object):
@@ -26,8 +36,15 @@ def import_log(tmp_path: Path, kind: str = "search", log=None, cmap=None, *extra
     csv = write_log(tmp_path / f"{kind}.csv", panda_log(kind), **(log or {}))
     the_map = write_map(tmp_path / f"{kind}.toml", **(cmap or {}))
     out = tmp_path / "demos.h5"
-    res = invoke("demo", "import", csv, "--columns", the_map, "--out", out, *extra)
+    res = invoke(
+        "demo", "import", "--task", "peg2d", csv, "--columns", the_map, "--out", out, *extra
+    )
     return res, csv, the_map, out
+
+
+def bag_import(bag: Path, *extra: object) -> list[object]:
+    """``demo import`` of ``bag``'s ``/tcp_pose`` topic as peg2d, then ``extra``."""
+    return ["demo", "import", "--task", "peg2d", bag, "--pose-topic", "/tcp_pose", *extra]
 
 
 def squeeze(text: str) -> str:
@@ -131,7 +148,9 @@ def test_truncated_last_line(tmp_path: Path) -> None:
     csv = write_log(tmp_path / "log.csv", panda_log("search"))
     csv.write_text(csv.read_text()[:-9])  # cut inside the last number, no newline at the end
     the_map = write_map(tmp_path / "log.toml")
-    res = invoke("demo", "import", csv, "--columns", the_map, "--out", tmp_path / "d.h5")
+    res = invoke(
+        "demo", "import", "--task", "peg2d", csv, "--columns", the_map, "--out", tmp_path / "d.h5"
+    )
     assert res.exit_code == 0, res.output
     assert shows(res, f"file {csv}, row 501: the last line is cut short")
     assert read_dataset(tmp_path / "d.h5")[0].n_samples == 499
@@ -139,7 +158,7 @@ def test_truncated_last_line(tmp_path: Path) -> None:
 
 def test_out_into_a_missing_folder_is_created(tmp_path: Path) -> None:
     out = tmp_path / "new" / "deeper" / "demos.h5"
-    args = ["demo", "import", EXAMPLES / "robot_log.csv", "--columns", EXAMPLES / "columns.toml"]
+    args = EXAMPLE_IMPORT
     res = invoke(*args, "--out", out)
     assert res.exit_code == 0, res.output
     assert h5py.is_hdf5(out)
@@ -151,34 +170,29 @@ def test_bag_import(tmp_path: Path) -> None:
     bag = tmp_path / "run.bag"
     write_bag(bag)
     out = tmp_path / "demos.h5"
-    res = invoke("demo", "import", bag, "--out", out)
+    res = invoke("demo", "import", "--task", "peg2d", bag, "--out", out)
     assert_refused(res, out, "is a bag: give --pose-topic")
-    res = invoke(
-        "demo",
-        "import",
-        bag,
-        "--pose-topic",
-        "/tcp_pose",
-        "--wrench-topic",
-        "/ft_sensor",
-        "--out",
-        out,
-    )
+    res = invoke("demo", "import", bag, "--pose-topic", "/tcp_pose", "--out", out)
+    assert_refused(res, out, f"give --task: which task {bag} demonstrates (one of ")
+    res = invoke(*bag_import(bag, "--wrench-topic", "/ft_sensor", "--out", out))
     assert res.exit_code == 0, res.output
     assert read_dataset(out)[0].meta["pose_topic"] == "/tcp_pose"
 
 
 def test_export_round_trip(tmp_path: Path) -> None:
     h5 = tmp_path / "demos.h5"
-    args = ["demo", "import", EXAMPLES / "robot_log.csv", "--columns", EXAMPLES / "columns.toml"]
+    args = EXAMPLE_IMPORT
     assert invoke(*args, "--out", h5).exit_code == 0
     out, the_map = tmp_path / "out" / "x.csv", tmp_path / "out" / "x.toml"
     res = invoke("demo", "export", f"{h5}:0", "--out", out, "--columns", the_map)
     assert res.exit_code == 0, res.output
-    res = invoke("demo", "import", out, "--columns", the_map, "--out", h5)
+    res = invoke("demo", "import", "--task", "peg2d", out, "--columns", the_map, "--out", h5)
     assert res.exit_code == 2 and shows(res, "pass --append to add to it")  # no silent pooling
     assert (
-        invoke("demo", "import", out, "--columns", the_map, "--out", h5, "--append").exit_code == 0
+        invoke(
+            "demo", "import", "--task", "peg2d", out, "--columns", the_map, "--out", h5, "--append"
+        ).exit_code
+        == 0
     )
     first, again = read_dataset(h5)
     for label in ("t", "pos", "quat", "wrench"):
@@ -204,5 +218,5 @@ def test_transform_option_and_options_for_the_other_kind(tmp_path: Path) -> None
     assert_refused(res, tmp_path / "none.h5", "--pose-topic is for ROS bags")
     bag = tmp_path / "run.bag"
     write_bag(bag)
-    res = invoke("demo", "import", bag, "--pose-topic", "/tcp_pose", "--rate", 20, "--out", out)
+    res = invoke(*bag_import(bag, "--rate", 20, "--out", out))
     assert_refused(res, tmp_path / "none.h5", "drop --rate")

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from panda_logs import panda_log
+from panda_logs import panda_log, tilted_between_tasks, write_log
 
 from teachfit.core.errors import DatasetError
 from teachfit.demonstrations.csv_import import ColumnMap, import_csv, read_csv_log
@@ -69,6 +69,7 @@ def test_orientation_jump(make_log, tmp_path: Path) -> None:
     message = refused(csv, cmap)
     assert "orientation jumps by" in message and "between rows 200 and 201" in message
     assert "check the quaternion columns" in message
+    assert "a column swapped or missing part way" in message and "--segment" not in message
 
 
 def test_milliseconds_read_as_seconds(make_log) -> None:
@@ -151,6 +152,29 @@ def test_segment_by_contact(make_log) -> None:
         assert demo.duration == pytest.approx(49.95, abs=0.1)
         assert np.ptp(demo.pos[:, :2], axis=0).max() < 0.03  # the 24 mm spiral, not the transfer
         assert np.all(np.linalg.norm(demo.wrench[:, :3], axis=1) > 2.5)  # above the off level
+
+
+def test_orientation_is_checked_per_segment(make_log, tmp_path: Path) -> None:
+    """A log whose tool tilts 62 deg between three tasks, at most 4 deg within each search."""
+    _, cmap = make_log("tasks")
+    csv = write_log(tmp_path / "tilted.csv", tilted_between_tasks(panda_log("tasks")))
+    message = refused(csv, cmap, accept=frozenset({"duration", "extent"}))
+    assert "implausible orientation: the tool axis tilts up to 62 deg" in message
+    assert "read as w,x,y,z the track would pass, but the tool would point up" in message
+    assert "the tool probably really turns, cut the log into demonstrations (--segment" in message
+    assert f'if the order is wrong after all, set quat_order = "w,x,y,z" in {cmap}' in message
+    demos = imported(csv, cmap, segmenter=Segmenter("contact", force_on_n=5.0))
+    assert [d.name for d in demos] == ["run-00", "run-01", "run-02"]
+    assert [d.meta["rate_hz"] for d in demos] == [20.0, 20.0, 20.0]
+
+
+def test_wrong_order_is_named_per_segment(make_log) -> None:
+    csv, cmap = make_log("search", cmap={"quat_order": None})  # x,y,z,w read as w,x,y,z
+    message = refused(csv, cmap, segmenter=Segmenter("contact", force_on_n=5.0))
+    assert message.startswith(f"file {csv}: demonstration run-00 (rows 102-501): implausible")
+    assert "read as w,x,y,z" in message
+    assert "the quaternion components are in x,y,z,w order" in message
+    assert f'set quat_order = "x,y,z,w" in {cmap}' in message
 
 
 def test_segment_pieces_still_checked(make_log) -> None:

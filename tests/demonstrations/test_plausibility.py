@@ -18,7 +18,7 @@ from teachfit.demonstrations.plausibility import (
     check_wrench_sign,
     enforce,
 )
-from teachfit.demonstrations.rawlog import RawLog
+from teachfit.demonstrations.rawlog import RawLog, sampling_rate
 
 
 def raw(fix_in: str | None = "map.toml", **changes) -> RawLog:
@@ -90,3 +90,34 @@ def test_enforce_accepts_by_name() -> None:
     assert len(enforce(findings, {"all"}, "log.csv")) == 2
     with pytest.raises(DatasetError, match="unknown check 'rates'"):
         enforce(findings, {"rates"}, "log.csv")
+
+
+def test_orientation_fix_names_the_order_that_fits() -> None:
+    yaw = np.radians(np.linspace(0.0, 278.0, 500))
+    truth = tool_down_quat(yaw)
+    as_xyzw = replace(raw(quat=truth[:, [3, 0, 1, 2]]), quat_order="x,y,z,w")  # wxyz read as xyzw
+    finding = check_orientation(as_xyzw, Limits())
+    assert finding is not None and "read as x,y,z,w" in finding.message
+    assert 'in w,x,y,z order (read so, the track fits): set quat_order = "w,x,y,z"' in finding.fix
+    bag = replace(raw(fix_in=None, quat=truth[:, [1, 2, 3, 0]]))  # fields filled x,y,z,w
+    assert "x,y,z,w order" in check_orientation(bag, Limits()).fix
+    assert "fix its publisher" in check_orientation(bag, Limits()).fix
+
+
+@pytest.mark.parametrize(
+    ("t", "rate"),
+    [
+        (np.arange(2000) * 0.05 + 64.0, 20.0),  # float steps of 0.050000000000011 s
+        (
+            (np.arange(500) * 50_000_000 + 1_718_023_402_000_000_000 - 1_718_023_402_000_000_000)
+            * 1e-9,
+            20.0,
+        ),
+        (np.arange(1000) / 999.97, 999.97),  # a rate that is not round stays as measured
+        (np.arange(1000) * 0.001 + np.random.default_rng(0).normal(0, 2e-7, 1000), 1000.0),
+        (np.arange(100) / 7.0 * 3.0, 2.33333),
+    ],
+)
+def test_sampling_rate_is_rounded_to_what_the_steps_support(t: np.ndarray, rate: float) -> None:
+    assert sampling_rate(t) == rate
+    assert abs(1.0 / sampling_rate(t) - np.median(np.diff(t))) <= 1e-5 * np.median(np.diff(t))

@@ -34,13 +34,13 @@ from teachfit.demonstrations.dataset import (
 )
 from teachfit.demonstrations.export import export_csv
 from teachfit.demonstrations.frames import FrameTransform
-from teachfit.demonstrations.importing import ImportOptions, build_demos
+from teachfit.demonstrations.importing import ImportOptions, ImportResult, build_demos
 from teachfit.demonstrations.plausibility import CHECKS
 from teachfit.demonstrations.rosbag_import import is_bag, read_bag
 from teachfit.demonstrations.segment import Segmenter
 from teachfit.execution.recording import is_run_log
 from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
-from teachfit.tasks.registry import load_task
+from teachfit.tasks.registry import TASKS, load_task
 
 T = TypeVar("T")
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)
@@ -133,7 +133,10 @@ def import_(
     log: Annotated[
         Path, typer.Argument(help="robot log: CSV, ROS 1 .bag, ROS 2 bag folder, .db3 or .mcap")
     ],
-    task: Annotated[str, o.task("the task the log demonstrates (teachfit tasks)")] = "peg2d",
+    task: Annotated[
+        str | None,
+        o.task("required: the task the log demonstrates (teachfit tasks, or a task .toml)"),
+    ] = None,
     columns: Annotated[
         Path, typer.Option(help="CSV column map (TOML) to read the log with")
     ] = Path("columns.toml"),
@@ -177,9 +180,10 @@ def import_(
 ) -> None:
     """Import a real robot log (CSV or ROS bag) as demonstrations into --out (an existing file
     needs --append or --overwrite)."""
-    load_task(task)
+    task = _import_task(task, log)
     if out.is_dir():
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
+    _not_an_input(out, log, columns)
     frame = None if transform is None else _option("--transform", FrameTransform.parse, transform)
     if is_bag(log):
         if pose_topic is None:
@@ -224,19 +228,24 @@ def import_(
         console.print(f"[yellow]note:[/] {escape(note)}")
     _check_target(out, append, overwrite)
     _store(out, list(result.demos), append, overwrite)
+    _print_import(result, log, out)
+
+
+def _print_import(result: ImportResult, log: Path, out: Path) -> None:
+    """The table of imported demonstrations and the closing line."""
     table = Table(
         title=f"{log} -> {out}", caption="start, duration: s; rate: Hz; extent: mm; |F|: N"
     )
     table.add_column("demonstration", no_wrap=True)
     for col in ("start", "duration", "samples", "rate", "x-y extent", "peak |F|"):
         table.add_column(col, justify="right", no_wrap=True)
-    for piece, demo in zip(result.pieces, result.demos, strict=True):
+    for piece in result.pieces:
         table.add_row(
             piece.name,
             f"{piece.start_s:.2f}",
             f"{piece.duration_s:.2f}",
             str(piece.samples),
-            f"{demo.rate_hz:.1f}",
+            f"{piece.rate_hz:g}",
             f"{piece.extent_mm[0]:.1f} x {piece.extent_mm[1]:.1f}",
             "-" if piece.peak_force_n is None else f"{piece.peak_force_n:.1f}",
         )
@@ -245,6 +254,29 @@ def import_(
         f"imported {len(result.demos)} demonstration(s) in frame {result.demos[0].frame!r} "
         f"from {log} -> {out}"
     )
+
+
+def _import_task(task: str | None, log: Path) -> str:
+    """The name of the task a log demonstrates: ``--task`` is required, a log does not say."""
+    if task is None:
+        raise TeachfitError(
+            f"give --task: which task {log} demonstrates (one of {', '.join(sorted(TASKS))}, "
+            "or a task .toml file); a real log does not say, and a demonstration of the wrong "
+            "task is refused by search run and learn"
+        )
+    return load_task(task).name
+
+
+def _not_an_input(out: Path, *inputs: Path) -> None:
+    """Refuse an ``--out`` that is one of the command's inputs (or inside a bag folder): with
+    --overwrite the log or its map would be replaced by the HDF5 file."""
+    for given in inputs:
+        inside = given.is_dir() and given.resolve() in out.resolve().parents
+        if inside or (out.exists() and given.exists() and out.samefile(given)):
+            raise TeachfitError(
+                f"--out {out} is {'inside ' if inside else ''}the input {given}: give another "
+                "file name, such as demos.h5"
+            )
 
 
 @app.command("export")

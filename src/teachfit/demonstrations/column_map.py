@@ -169,6 +169,12 @@ class ColumnMap:
             )
         if not isinstance(self.delimiter, str) or len(self.delimiter) != 1:
             raise DatasetError(f"must be one character, got {self.delimiter!r}", column="delimiter")
+        if self.delimiter.isalnum() or self.delimiter in ".+-\"'\r\n\x00":
+            raise DatasetError(
+                f"{self.delimiter!r} cannot separate cells (it is part of a number, a quote or a "
+                'line end): give the character between the cells, such as ",", ";" or "\\t"',
+                column="delimiter",
+            )
         if not isinstance(self.frame, str) or not self.frame:
             raise DatasetError(f"must be a non-empty string, got {self.frame!r}", column="frame")
         if self.wrench_sign not in (1, -1) or isinstance(self.wrench_sign, bool):
@@ -264,6 +270,12 @@ class ColumnMap:
         try:
             with path.open("rb") as f:
                 data = tomllib.load(f)
+        except FileNotFoundError as exc:
+            raise DatasetError(
+                "no such column map: write one naming the log's columns (examples/columns.toml "
+                "documents every key)",
+                path=str(path),
+            ) from exc
         except OSError as exc:
             raise DatasetError(f"cannot read ({exc.strerror})", path=str(path)) from exc
         except UnicodeDecodeError as exc:

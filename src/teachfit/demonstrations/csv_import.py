@@ -7,140 +7,30 @@ documents every key). The CSV file must have one header line; other columns are 
 Times are shifted so that the log starts at t = 0; the original first time stamp (s) is kept in
 ``meta["time_offset_s"]``. A log without a time column needs ``rate_hz``.
 
-A last line cut short while the log was being written (no newline at the end of the file and
-fewer cells than the header, or a last number with fewer digits than that column has in every
-other row) is dropped, with a note saying so.
+The file is read in bounded memory by :mod:`~teachfit.demonstrations.csv_table`, which also
+drops a last line cut short while the log was being written (with a note) and refuses what is not
+a CSV log (binary, UTF-16, NUL bytes, over-long lines, unclosed quotes, ragged rows).
 
 Errors name the file, the line (1-based, the header is line 1) and the CSV column.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-from collections import Counter
 from dataclasses import replace
 from decimal import Decimal, InvalidOperation
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from teachfit.core.errors import DatasetError
 from teachfit.demonstrations.column_map import ColumnMap
+from teachfit.demonstrations.csv_table import read_table
 from teachfit.demonstrations.dataset import MIN_SAMPLES, QUAT_NORM_TOL, Demonstration
 from teachfit.demonstrations.frames import to_wxyz
 from teachfit.demonstrations.importing import ImportOptions, build_demos
 from teachfit.demonstrations.rawlog import RawLog
 
 __all__ = ["ColumnMap", "import_csv", "read_csv_log"]
-
-
-def _decimals(cell: str) -> int | None:
-    """Digits after the decimal point of a plain number, or None if ``cell`` is not one."""
-    text = cell.strip()
-    if not _is_float(text) or "e" in text.lower():
-        return None
-    return len(text.partition(".")[2])
-
-
-def _is_float(cell: str) -> bool:
-    try:
-        float(cell)
-    except ValueError:
-        return False
-    return True
-
-
-def _truncated(rows: list[list[str]], header: list[str]) -> str | None:
-    """Why the last row looks cut short, or None (only called without a final newline)."""
-    last = rows[-1]
-    if len(last) < len(header):
-        return f"it has {len(last)} of {len(header)} cells"
-    col = len(last) - 1
-    digits = [_decimals(r[col]) for r in rows[:-1] if len(r) > col]
-    counts = Counter(d for d in digits if d is not None)
-    if not counts or len(digits) < 2:
-        return None
-    typical, count = counts.most_common(1)[0]
-    here = _decimals(last[col])
-    if count == len(digits) and (here is None or here < typical):
-        return (
-            f"its last number {last[col].strip()!r} has fewer decimals than the {typical} of "
-            f"every other row in column {header[col]!r}"
-        )
-    return None
-
-
-def _read_rows(csv_path: Path, delimiter: str) -> tuple[list[str], list[list[str]], list[int], str]:
-    """Header, non-blank data rows, their line numbers, and a note if the last row was cut."""
-    fail = partial(DatasetError, path=str(csv_path))
-    try:
-        text = csv_path.read_text(encoding="utf-8-sig")
-    except OSError as exc:
-        raise fail(f"cannot read ({exc.strerror})") from exc
-    except UnicodeDecodeError as exc:
-        raise fail(f"not a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
-    reader = csv.reader(io.StringIO(text, newline=""), delimiter=delimiter)
-    header = [h.strip() for h in next((row for row in reader if row), [])]
-    if not header:
-        raise fail("empty file, expected a header line", row=1)
-    rows: list[list[str]] = []
-    lines: list[int] = []
-    for row in reader:
-        if row and not (len(row) == 1 and not row[0].strip()):
-            rows.append(row)
-            lines.append(reader.line_num)
-    note = ""
-    if rows and not text.endswith(("\n", "\r")):
-        why = _truncated(rows, header)
-        if why is not None:
-            note = (
-                f"file {csv_path}, row {lines[-1]}: the last line is cut short (no newline at "
-                f"the end of the file and {why}); dropped it"
-            )
-            rows, lines = rows[:-1], lines[:-1]
-    return header, rows, lines, note
-
-
-def _parse(csv_path: Path, columns: ColumnMap) -> tuple[np.ndarray, list[int], list[str], dict]:
-    """Values (N, K) of the mapped numeric columns, their line numbers, the CSV column names
-    (K,) and extras: raw time cells, marker cells, note."""
-    names = list(columns.mapped().values())
-    fail = partial(DatasetError, path=str(csv_path))
-    header, rows, lines, note = _read_rows(csv_path, columns.delimiter)
-    wanted = names + ([columns.marker] if columns.marker else [])
-    for name in wanted:
-        if header.count(name) != 1:
-            problem = "appears more than once in" if name in header else "is not in"
-            raise fail(f"column {problem} the header {header}", row=1, column=name)
-    index = [header.index(name) for name in names]
-    values: list[list[float]] = []
-    for row, line in zip(rows, lines, strict=True):
-        try:
-            values.append([float(row[i]) for i in index])
-        except (ValueError, IndexError):
-            for i, name in zip(index, names, strict=True):
-                cell = row[i] if i < len(row) else None
-                if cell is None or not _is_float(cell):
-                    problem = (
-                        f"line has only {len(row)} cells"
-                        if cell is None
-                        else f"not a number: {cell!r}"
-                    )
-                    raise fail(problem, row=line, column=name) from None
-            raise
-    extras: dict = {"note": note, "times": None, "marker": None}
-    if columns.time is not None:
-        extras["times"] = [row[index[0]] for row in rows]
-    if columns.marker is not None:
-        m = header.index(columns.marker)
-        short = next((ln for r, ln in zip(rows, lines, strict=True) if len(r) <= m), None)
-        if short is not None:
-            raise fail("line has no marker cell", row=short, column=columns.marker)
-        extras["marker"] = tuple(r[m].strip() for r in rows)
-    data = np.array(values, dtype=np.float64).reshape(len(values), len(index))
-    return data, lines, names, extras
 
 
 def _offsets(times: list[str], fallback: np.ndarray) -> np.ndarray:
@@ -165,7 +55,11 @@ def read_csv_log(csv_path: str | Path, columns: ColumnMap) -> RawLog:
     """
     csv_path = Path(csv_path)
     where = str(csv_path)
-    data, lines, names, extras = _parse(csv_path, columns)
+    names = list(columns.mapped().values())
+    table = read_table(
+        csv_path, names, columns.delimiter, time=columns.time is not None, marker=columns.marker
+    )
+    data, lines = table.values, [int(v) for v in table.lines]
     n = data.shape[0]
     if n < MIN_SAMPLES:
         raise DatasetError(f"{n} data rows, need at least {MIN_SAMPLES}", path=where)
@@ -179,7 +73,7 @@ def read_csv_log(csv_path: str | Path, columns: ColumnMap) -> RawLog:
     k = 0
     step_units = None
     if columns.time is not None:
-        times = extras["times"]
+        times = table.times or []
         raw_t = _offsets(times, data[:, 0])
         steps = np.flatnonzero(np.diff(raw_t) <= 0)
         if steps.size:
@@ -226,8 +120,8 @@ def read_csv_log(csv_path: str | Path, columns: ColumnMap) -> RawLog:
         wrench=wrench,
         frame=columns.frame,
         rows=np.array(lines),
-        marker=extras["marker"],
-        notes=(extras["note"],) if extras["note"] else (),
+        marker=table.marker,
+        notes=(table.note,) if table.note else (),
         meta=meta,
         fix_in=columns.source,
         quat_order=columns.quat_order,

@@ -39,6 +39,15 @@ def to_wxyz(quat: np.ndarray, order: str) -> np.ndarray:
     return q if order == "w,x,y,z" else q[..., [3, 0, 1, 2]]
 
 
+def from_wxyz(quat: np.ndarray, order: str) -> np.ndarray:
+    """Quaternions (T, 4) w-x-y-z as their components in ``order`` (the inverse of
+    :func:`to_wxyz`)."""
+    if order not in QUAT_ORDERS:
+        raise DatasetError(f"must be one of {QUAT_ORDERS}, got {order!r}", column="quat_order")
+    q = np.asarray(quat, dtype=float)
+    return q if order == "w,x,y,z" else q[..., [1, 2, 3, 0]]
+
+
 @dataclass(frozen=True)
 class FrameTransform:
     """How an imported log is re-expressed before it is stored.

@@ -6,8 +6,9 @@ tool tumbles), the wrench of the robot stored as the wrench of the environment, 
 minutes of several tasks in one file. Each check returns a :class:`Finding` naming the fix;
 :func:`enforce` turns the findings that were not accepted into one clear error.
 
-Checks (names for ``--accept``): ``rate``, ``orientation`` and ``wrench_sign`` look at the whole
-log; ``duration``, ``extent`` and ``speed`` at each demonstration cut from it. All quantities
+Checks (names for ``--accept``): ``rate`` and ``wrench_sign`` look at the whole log;
+``orientation``, ``duration``, ``extent`` and ``speed`` at each demonstration cut from it (a long
+log may turn the tool between its demonstrations). All quantities
 are in the stored frame, which is assumed to have z up (the robot base or the world).
 """
 
@@ -21,8 +22,8 @@ import numpy as np
 
 from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import wxyz_to_rotation
-from teachfit.demonstrations.frames import to_wxyz
-from teachfit.demonstrations.rawlog import RawLog
+from teachfit.demonstrations.frames import QUAT_ORDERS, from_wxyz, to_wxyz
+from teachfit.demonstrations.rawlog import RawLog, sampling_rate
 
 CHECKS: tuple[str, ...] = ("rate", "orientation", "wrench_sign", "duration", "extent", "speed")
 SCALES: tuple[tuple[float, str], ...] = ((1e-3, "ms"), (1e-6, "us"), (1e-9, "ns"), (1.0, "s"))
@@ -56,7 +57,7 @@ class Finding:
 
 def check_rate(log: RawLog, limits: Limits) -> Finding | None:
     """Sampling rate from the median time step."""
-    rate = 1.0 / float(np.median(np.diff(log.t)))
+    rate = sampling_rate(log.t)
     if limits.min_rate_hz <= rate <= limits.max_rate_hz:
         return None
     message = (
@@ -83,34 +84,91 @@ def _tilt(quat: np.ndarray) -> np.ndarray:
     return np.arccos(np.clip(axes @ axes[0], -1.0, 1.0))
 
 
-def check_orientation(log: RawLog, limits: Limits) -> Finding | None:
-    """The orientation track is continuous and the tool axis stays near its first direction."""
-    dots = np.abs(np.einsum("ij,ij->i", log.quat[1:], log.quat[:-1]))
-    steps = 2.0 * np.arccos(np.clip(dots, 0.0, 1.0))
-    order = "quat_order" if log.fix_in is not None else "the quaternion fields"
+def _steps(quat: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad) between consecutive orientations."""
+    dots = np.abs(np.einsum("ij,ij->i", quat[1:], quat[:-1]))
+    return 2.0 * np.arccos(np.clip(dots, 0.0, 1.0))
+
+
+def _orientation_fault(quat: np.ndarray, limits: Limits) -> tuple[str, float, int] | None:
+    """``("jump", deg, i)`` for a jump between samples i and i + 1, ``("tilt", deg, i)`` for
+    a tool axis tilting beyond the limit (most at sample i), or None for a plausible track."""
+    steps = _steps(quat)
     if steps.size and steps.max() > limits.max_step_rad:
         i = int(np.argmax(steps))
-        message = (
-            f"the orientation jumps by {math.degrees(steps[i]):.0f} deg between {log.row_word} "
-            f"{log.rows[i]} and {log.rows[i + 1]}"
+        return "jump", math.degrees(steps[i]), i
+    tilt = _tilt(quat)
+    if tilt.max() > limits.max_tilt_rad:
+        i = int(np.argmax(tilt))
+        return "tilt", math.degrees(tilt[i]), i
+    return None
+
+
+def _fault_text(fault: tuple[str, float, int]) -> str:
+    kind, deg, _ = fault
+    return f"jumps by {deg:.0f} deg" if kind == "jump" else f"tilts up to {deg:.0f} deg"
+
+
+def _points_down(quat: np.ndarray) -> bool:
+    """Whether the tool z-axis mostly points down (-z), as a searching tool does."""
+    axes = wxyz_to_rotation(quat).apply([0.0, 0.0, 1.0])
+    return bool(np.median(axes[:, 2]) < -0.5)
+
+
+def _order_fix(log: RawLog, limits: Limits, kind: str) -> str:
+    """The fix for an implausible orientation (``kind`` "jump" or "tilt" as read): the
+    component order that fits, or why none does."""
+    raw = from_wxyz(log.quat, log.quat_order)  # the components as read from the file
+    others = {o: _orientation_fault(to_wxyz(raw, o), limits) for o in QUAT_ORDERS}
+    others.pop(log.quat_order)
+    fits = [o for o, fault in others.items() if fault is None]
+    segment = "cut the log into demonstrations (--segment contact, window or marker)"
+    if not fits:
+        tried = "; ".join(f"read as {o} the tool {_fault_text(f)}" for o, f in others.items() if f)
+        order = "quat_order" if log.fix_in is not None else "the quaternion fields"
+        if kind == "jump":  # no tool turns that far in one sample
+            return (
+                f"no component order fits ({tried}): check the quaternion columns and {order} "
+                "(a column swapped or missing part way, or samples of two sources interleaved)"
+            )
+        return (
+            f"no component order fits ({tried}): if the tool really turns this much, {segment}; "
+            f"else check the quaternion columns and {order}"
         )
-        return Finding("orientation", message, f"check the quaternion columns and {order}")
-    tilt = _tilt(log.quat)
-    if tilt.max() <= limits.max_tilt_rad:
-        return None
-    message = (
-        f"the tool axis tilts up to {math.degrees(tilt.max()):.0f} deg from its first direction "
-        f"(read as {log.quat_order}); a search keeps it within "
-        f"{math.degrees(limits.max_tilt_rad):.0f} deg"
+    where = (
+        log.hint("quat_order", f'"{fits[0]}"')
+        if log.fix_in
+        else "the bag's orientation fields are filled in another order: fix its publisher"
     )
-    other = "x,y,z,w" if log.quat_order == "w,x,y,z" else "w,x,y,z"
-    raw = log.quat if log.quat_order == "w,x,y,z" else log.quat[:, [1, 2, 3, 0]]
-    if _tilt(to_wxyz(raw, other)).max() <= limits.max_tilt_rad:
-        fix = "the quaternion columns are probably in the other order: " + (
-            log.hint("quat_order", f'"{other}"') if log.fix_in else "check the message fields"
+    if _points_down(log.quat) and not _points_down(to_wxyz(raw, fits[0])):
+        return (
+            f"read as {fits[0]} the track would pass, but the tool would point up, while read as "
+            f"{log.quat_order} it points down as a searching tool does: the tool probably really "
+            f"turns, {segment}; if the order is wrong after all, {where}"
         )
-        return Finding("orientation", message, fix)
-    return Finding("orientation", message, f"check the quaternion columns and {order}")
+    return f"the quaternion components are in {fits[0]} order (read so, the track fits): {where}"
+
+
+def check_orientation(log: RawLog, limits: Limits) -> Finding | None:
+    """The orientation track is continuous (no step over ``max_step_rad``) and the tool axis
+    stays within ``max_tilt_rad`` of its first direction; run on each demonstration cut from a
+    log. The fix names the quaternion component order that fits, if another does."""
+    fault = _orientation_fault(log.quat, limits)
+    if fault is None:
+        return None
+    kind, deg, i = fault
+    if kind == "jump":
+        message = (
+            f"the orientation jumps by {deg:.0f} deg between {log.row_word} {log.rows[i]} and "
+            f"{log.rows[i + 1]} (read as {log.quat_order}); a search turns the tool smoothly"
+        )
+    else:
+        message = (
+            f"the tool axis tilts up to {deg:.0f} deg from its first direction (at "
+            f"{log.row_word[:-1]} {log.rows[i]}, read as {log.quat_order}); a search keeps it "
+            f"within {math.degrees(limits.max_tilt_rad):.0f} deg"
+        )
+    return Finding("orientation", message, _order_fix(log, limits, kind))
 
 
 def check_wrench_sign(log: RawLog, limits: Limits) -> Finding | None:

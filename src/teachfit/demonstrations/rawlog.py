@@ -14,6 +14,24 @@ from typing import Any
 
 import numpy as np
 
+#: how closely a stated sampling rate reproduces the median time step (relative)
+RATE_TOL = 1e-5
+
+
+def sampling_rate(t: np.ndarray) -> float:
+    """Sampling rate (Hz) of time stamps ``t`` (T,) s: the median step, as the rate with the
+    fewest significant digits whose period is within :data:`RATE_TOL` of it (a 20 Hz log whose
+    float time stamps step by 0.050000000000011 s is 20.0 Hz, one at 999.97 Hz stays so)."""
+    period = float(np.median(np.diff(t)))
+    rate = 1.0 / period
+    if not np.isfinite(rate) or rate <= 0:
+        return rate
+    for digits in range(1, 16):
+        snapped = float(f"{rate:.{digits}g}")
+        if abs(1.0 / snapped - period) <= RATE_TOL * period:
+            return snapped
+    return rate
+
 
 @dataclass(frozen=True, eq=False)
 class RawLog:

@@ -14,6 +14,8 @@ rotated into the pose frame with the tool orientation at each sample (with a not
 
 from __future__ import annotations
 
+import sqlite3
+import struct
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,6 +51,24 @@ class _Stream:
     frames: tuple[str, ...]
 
 
+def _bag_errors() -> tuple[type[BaseException], ...]:
+    """What rosbags and its storage libraries raise on a damaged or truncated bag (a corrupt
+    header, record length, index, database page or message body)."""
+    from rosbags.rosbag1 import ReaderError as Reader1Error
+    from rosbags.rosbag2 import ReaderError as Reader2Error
+
+    errors: list[type[BaseException]] = [Reader1Error, Reader2Error, OSError, ValueError]
+    errors += [LookupError, AssertionError, ArithmeticError, MemoryError, EOFError]
+    errors += [struct.error, sqlite3.Error]
+    try:
+        import apsw  # the SQLite binding rosbags may use for ROS 2 .db3 files
+    except ImportError:
+        pass
+    else:
+        errors.append(apsw.Error)
+    return tuple(errors)
+
+
 def _ns(stamp: Any) -> int:
     return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
 
@@ -76,6 +96,12 @@ def _read_topic(
         listed = ", ".join(f"{c.topic} ({c.msgtype})" for c in reader.connections) or "none"
         raise DatasetError(f"no topic {topic!r} in the bag (topics: {listed})", path=where)
     msgtype = conns[0].msgtype
+    if child is not None and msgtype == "geometry_msgs/msg/PoseStamped":
+        raise DatasetError(
+            f"topic {topic!r} carries {msgtype}, which has no child frame: drop --child-frame "
+            "(it picks a transform on a tf or TransformStamped topic)",
+            path=where,
+        )
     if msgtype not in kinds:
         raise DatasetError(
             f"topic {topic!r} carries {msgtype}, expected one of {', '.join(kinds)}", path=where
@@ -173,8 +199,13 @@ def read_bag(
             if wrench_topic is not None:
                 wrenches = _read_topic(reader, wrench_topic, (WRENCH_TYPE,), where, None)
             generation = "ros2" if reader.is2 else "ros1"
-    except (AnyReaderError, OSError, ValueError, KeyError) as exc:
-        raise DatasetError(f"cannot read as a ROS bag ({exc})", path=where) from exc
+    except (AnyReaderError, *_bag_errors()) as exc:
+        text = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise DatasetError(
+            f"cannot read as a ROS bag ({text}): a bag cut short or damaged while recording can "
+            "often be repaired with 'rosbag reindex' (ROS 1) or 'ros2 bag reindex' (ROS 2)",
+            path=where,
+        ) from exc
     frames = sorted(set(poses.frames))
     if len(frames) != 1:
         raise DatasetError(f"{pose_topic} poses are in several frames {frames}", path=where)
