@@ -2,6 +2,9 @@
 
 import dataclasses
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -15,6 +18,10 @@ from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
 from teachfit.robot.floating import FloatingToolRobot
 from teachfit.skills import peg_in_hole
 from teachfit.skills.conditions import TimeAbove
+from teachfit.skills.graph import Node, Skill, Transition
+from teachfit.skills.params import SkillParams
+from teachfit.skills.percept import MPCommand, Percept
+from teachfit.skills.primitive import Primitive, PrimitiveRun
 from teachfit.tasks import Peg2D
 
 ORDER = ["approach", "contact", "lateral", "align", "insert"]
@@ -158,3 +165,58 @@ def test_the_fast_command_path_leaves_an_execution_unchanged(task, monkeypatch):
     assert fast.outcome == ref.outcome and fast.steps == ref.steps > 100
     for name in ("pos", "quat", "wrench", "setpoint_pos"):
         assert np.array_equal(getattr(fast.log, name), getattr(ref.log, name)), name
+
+
+@dataclass(frozen=True)
+class _Noting(Primitive):
+    """Holds the set-point; notes the skill time (s) in ``left`` whenever its node is left."""
+
+    left: list[float] = field(default_factory=list)
+    kind: ClassVar[str] = "noting"
+
+    def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
+        return _NotingRun(self.left)
+
+    def describe(self) -> str:
+        return "hold, note leaving"
+
+
+class _NotingRun(PrimitiveRun):
+    def __init__(self, left: list[float]) -> None:
+        self.left = left
+
+    def enter(self, pc: Percept) -> None:
+        pc.done = False
+
+    def command(self, pc: Percept, out: MPCommand) -> None:
+        out.stiffness[:] = (2000.0, 2000.0, 2000.0, 60.0, 60.0, 60.0)
+
+    def leave(self, pc: Percept) -> None:
+        self.left.append(pc.t)
+
+
+def test_a_chain_node_checks_its_transitions_on_entry_and_a_left_node_hears_of_it(task):
+    still = _Noting()
+    err = TimeAbove(2.0)
+    nodes = [Node("a", still, err), Node("b", still, err, chain=True), Node("c", still, err)]
+    nodes.append(Node("d", still, err))
+    skill = Skill(
+        "chain",
+        nodes,
+        (
+            Transition("a", "b", TimeAbove(0.05)),
+            Transition("b", "c", TimeAbove(0.0)),  # holds at once: left in the same command
+            Transition("c", "d", TimeAbove(0.0)),  # c is no chain node: checked a command on
+        ),
+        "a",
+        SkillParams(),
+        success=TimeAbove(0.2, scope="skill"),
+        error=TimeAbove(1.0, scope="skill"),
+    )
+    start = task.contact_pose(np.array([0.02, 0.0])).compose(Pose.from_xyz_rz(0, 0, 0.01, 0))
+    tr = execute(skill, FloatingToolRobot(task), start, Pose(np.zeros(3)), config=ExecConfig())
+    (a, b, c, d) = tr.visits
+    assert [v.node for v in tr.visits] == ["a", "b", "c", "d"]
+    assert b.t_enter == b.t_exit == c.t_enter  # the chain node was left as it was entered
+    assert d.t_enter == pytest.approx(c.t_enter + 0.01)  # one command later
+    assert still.left == [a.t_exit, b.t_exit, c.t_exit]  # each node left by a transition was told

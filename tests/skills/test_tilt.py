@@ -1,5 +1,5 @@
-"""The tilted search (``skills/tilt.py``): the phases on fed percepts, and a pass over a sharp
-hole that an upright peg misses."""
+"""The tilted search (``skills/tilt*.py``): its graph's phases on fed percepts, the node
+sequence of one execution, and a pass over a sharp hole that an upright peg misses."""
 
 import dataclasses
 from typing import Any
@@ -13,21 +13,12 @@ from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.follow import run_trajectory
 from teachfit.execution.search import task_follow_config
 from teachfit.robot.registry import make_robot
-from teachfit.skills.follow import FollowConfig, FollowSetpoints
+from teachfit.skills.follow import FollowConfig, FollowSetpoints, follow_skill
+from teachfit.skills.library import get_skill
 from teachfit.skills.percept import MPCommand, Percept
-from teachfit.skills.tilt import (
-    ALIGN,
-    LATERAL,
-    LEAD_TIME,
-    LIFT,
-    LIFT_SPEED,
-    SEARCH,
-    TiltConfig,
-    TiltState,
-    rim_lead,
-    tilted_drop,
-    wedge_lag,
-)
+from teachfit.skills.tilt import LEAD_TIME, LIFT_SPEED, TiltConfig, rim_lead, tilted_drop, wedge_lag
+from teachfit.skills.tilt_context import TiltContext, context_of
+from teachfit.skills.tilt_graph import NODES
 from teachfit.tasks import get_task
 
 
@@ -48,12 +39,40 @@ def test_wedge_lag_grows_with_friction_and_tilt():
     assert wedge_lag(0.25, 0.8, 6.0, 2500.0) > lag > wedge_lag(0.1, 0.5, 6.0, 2500.0)
 
 
-def _tick(run, pc, p, t):
-    pc.p[:] = p
-    pc.t_node = t
-    cmd = MPCommand()
-    run.command(pc, cmd)
-    return cmd
+class _Walk:
+    """A tilted search's graph fed percepts as the engine runs it each command: the active
+    node's transitions (a ``chain`` target's in turn), then the active node's command."""
+
+    def __init__(self, traj: SetpointTrajectory, tilt: TiltConfig, **follow: Any) -> None:
+        self.nodes = follow_skill(traj, FollowConfig(tilt=tilt, **follow)).compile()[0]
+        self.pc = Percept(Pose(np.zeros(3)), 0.01)
+        self.active = self.nodes[0]
+        self.active.run.enter(self.pc)
+
+    def __call__(self, p: Any, t: float) -> MPCommand:
+        pc = self.pc
+        pc.p[:] = p
+        pc.t = t
+        for _ in self.nodes:
+            fired = next((i for check, i, _ in self.active.transitions if check(pc)), None)
+            if fired is None:
+                break
+            self.active.run.leave(pc)
+            self.active = self.nodes[fired]
+            self.active.run.enter(pc)
+            if not self.active.chain:
+                break
+        cmd = MPCommand()
+        self.active.run.command(pc, cmd)
+        return cmd
+
+    @property
+    def node(self) -> str:
+        return self.active.name
+
+    @property
+    def ctx(self) -> TiltContext:
+        return context_of(self.pc)
 
 
 def test_phases_tilt_drop_slide_to_the_wall_and_align():
@@ -61,72 +80,66 @@ def test_phases_tilt_drop_slide_to_the_wall_and_align():
     pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])  # along +x: the rim leans +x
     traj = SetpointTrajectory.from_path(t, pos)
     tilt = TiltConfig(angle=0.2, drop_depth=5e-4, lateral_speed=0.005, stall_lag=0.002)
-    run = FollowSetpoints(traj, FollowConfig(tilt=tilt, hold_stiffness=200.0)).compile({})
-    pc = Percept(Pose(np.zeros(3)), 0.01)
-    run.enter(pc)
-    state = run.tilt
-    _tick(run, pc, (0.0, 0.0, 0.0008), 0.1)  # resting tilted: the TCP rose
+    walk = _Walk(traj, tilt, hold_stiffness=200.0)
+    pc = walk.pc
+    walk((0.0, 0.0, 0.0008), 0.1)  # resting tilted: the TCP rose
     rim = wxyz_to_rotation(pc.q_d).apply([1.0, 0.0, 0.0])
-    assert state.phase == SEARCH and rim[2] == pytest.approx(-np.sin(0.2))  # +x rim lowest
-    _tick(run, pc, (0.010, 0.0, 0.0002), 1.0)  # sank 0.6 mm: dropped, slide on along +x
-    assert state.phase == LATERAL
-    cmd = _tick(run, pc, (0.0102, 0.0, 0.0002), 1.1)
+    assert walk.node == "search" and rim[2] == pytest.approx(-np.sin(0.2))  # +x rim lowest
+    walk((0.010, 0.0, 0.0002), 1.0)  # sank 0.6 mm: dropped, slide on along +x
+    assert walk.node == "lateral"
+    cmd = walk((0.0102, 0.0, 0.0002), 1.1)
     assert pc.p_d[0] > 0.0102 and cmd.twist[0] == pytest.approx(0.005) and cmd.twist[1] == 0
-    _tick(run, pc, (0.0102, 0.0, 0.0002), 1.6)  # blocked while the set-point ran 2.5 mm on
-    assert state.phase == ALIGN
-    cmd = _tick(run, pc, (0.0102, 0.0, 0.0), 1.85)  # half way up, held where it is
+    walk((0.0102, 0.0, 0.0002), 1.6)  # blocked while the set-point ran 2.5 mm on
+    assert walk.node == "align"
+    cmd = walk((0.0102, 0.0, 0.0), 1.85)  # half way up, held where it is
     assert np.allclose(pc.p_d[:2], (0.0102, 0.0)) and np.all(cmd.twist[:2] == 0.0)
     assert wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.1)
     assert np.allclose(cmd.stiffness_full[:2, :2], 200.0 * np.eye(2))
-    _tick(run, pc, (0.0102, 0.0, 0.0), 2.2)
+    walk((0.0102, 0.0, 0.0), 2.2)
     assert np.allclose(pc.q_d, (1.0, 0.0, 0.0, 0.0))  # upright
-    _tick(run, pc, (0.0102, 0.0, 0.0), 2.5)  # upright 0.4 s, not sinking: still waiting
-    assert state.phase == ALIGN
-    _tick(run, pc, (0.0102, 0.0, 0.0), 2.7)  # on the edge: missed, search on, tilted
-    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.2)
+    walk((0.0102, 0.0, 0.0), 2.5)  # upright 0.4 s, not sinking: still waiting
+    assert walk.node == "align"
+    walk((0.0102, 0.0, 0.0), 2.7)  # on the edge: missed, search on, tilted
+    assert walk.node == "search" and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.2)
     assert np.allclose(pc.p_d[:2], (0.0102, 0.0))  # from where the part stands ...
-    run.command(pc, MPCommand())  # ... back to the trajectory where it was left (t = 1 s)
-    assert run.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
+    walk(pc.p.copy(), 2.7)  # ... back to the trajectory where it was left (t = 1 s)
+    assert walk.ctx.paused == pytest.approx(2.7 - 1.0) and pc.p_d[0] < 0.0102
 
 
-def _standing_still(tilt: TiltConfig) -> tuple[Any, Percept]:
-    """A tilted follower of a trajectory that stands at the origin, entered at t = 0."""
-    traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
-    run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
-    pc = Percept(Pose(np.zeros(3)), 0.01)
-    run.enter(pc)
-    return run, pc
+def _standing_still(tilt: TiltConfig) -> tuple[_Walk, Percept]:
+    """A tilted search of a trajectory that stands at the origin, entered at t = 0."""
+    walk = _Walk(SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3))), tilt)
+    return walk, walk.pc
 
 
 def test_in_the_lateral_phase_the_set_point_is_free_across_the_lean():
-    run, pc = _standing_still(
+    walk, pc = _standing_still(
         TiltConfig(angle=0.2, direction=0.0, drop_depth=5e-4, lateral_speed=0.005)
     )
-    _tick(run, pc, (0.0, 0.0, 0.0008), 0.5)  # resting tilted
-    _tick(run, pc, (0.0, 0.0, 0.0002), 0.6)  # dropped: slide along +x
-    assert run.tilt.phase == LATERAL
-    cmd = _tick(run, pc, (0.0005, 0.003, 0.0002), 0.8)  # the wall pushed the rim 3 mm across
-    assert run.tilt.phase == LATERAL
+    walk((0.0, 0.0, 0.0008), 0.5)  # resting tilted
+    walk((0.0, 0.0, 0.0002), 0.6)  # dropped: slide along +x
+    assert walk.node == "lateral"
+    cmd = walk((0.0005, 0.003, 0.0002), 0.8)  # the wall pushed the rim 3 mm across
+    assert walk.node == "lateral"
     assert pc.p_d[1] == pytest.approx(0.003)  # across: where the TCP is, no spring back
     assert pc.p_d[0] == pytest.approx(0.005 * 0.2)  # along: from the drop at the speed
     assert cmd.twist[0] == pytest.approx(0.005) and cmd.twist[1] == 0.0
 
 
 def test_after_a_missed_align_it_retries_at_the_other_tilt_and_feels_a_drop_at_once():
-    run, pc = _standing_still(
+    walk, pc = _standing_still(
         TiltConfig(angle=0.25, retry_angle=0.14, drop_depth=5e-4, stall_lag=0.002)
     )
-    state = run.tilt
     for t, z in ((0.5, 0.003), (0.6, 0.0024), (1.2, 0.0024), (1.5, 0.0), (2.4, 0.0)):
-        _tick(run, pc, (0.0, 0.0, z), t)  # rest, drop, blocked, align, upright on the edge
-    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.14)
-    _tick(run, pc, (0.0, 0.0, -6e-4), 2.5)  # still tilting, but below the edge it stood on
-    assert state.phase == LATERAL
+        walk((0.0, 0.0, z), t)  # rest, drop, blocked, align, upright on the edge
+    assert walk.node == "search" and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.14)
+    walk((0.0, 0.0, -6e-4), 2.5)  # still tilting, but below the edge it stood on
+    assert walk.node == "lateral"
     for t in (3.1, 3.4, 4.2):  # blocked, align, upright and not sinking: missed again
-        _tick(run, pc, (0.0, 0.0, -6e-4), t)
-    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.25)
-    state.reset(0.0)  # a new search starts at the first tilt
-    assert state.full == 0.25 and state.z_floor == -np.inf
+        walk((0.0, 0.0, -6e-4), t)
+    assert walk.node == "search" and wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.25)
+    again = _standing_still(TiltConfig(angle=0.25, retry_angle=0.14))[0]  # a new execution:
+    assert again.ctx.full == 0.25 and again.ctx.z_floor == -np.inf  # a new context
 
 
 def test_tilted_drop_is_the_deeper_of_rim_on_top_and_both_rims_inside():
@@ -144,37 +157,35 @@ def test_a_drop_deeper_than_a_hole_gives_lifts_back_over_the_top_and_goes_on_upr
     pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])  # along +x: the rim leans +x
     traj = SetpointTrajectory.from_path(t, pos)
     tilt = TiltConfig(angle=0.2, drop_depth=5e-4, stall_lag=0.01, off_depth=0.008)
-    run = FollowSetpoints(traj, FollowConfig(tilt=tilt)).compile({})
-    pc = Percept(Pose(np.zeros(3)), 0.01)
-    run.enter(pc)
-    state = run.tilt
-    _tick(run, pc, (0.0, 0.0, 0.003), 0.5)  # resting tilted
-    _tick(run, pc, (0.005, 0.0, 0.0024), 1.0)  # the low rim went over the top's edge
-    assert state.phase == LATERAL
-    _tick(run, pc, (0.007, 0.0, -0.002), 1.4)  # pivoting on it, sinking: a hole gives that
-    assert state.phase == LATERAL
-    cmd = _tick(run, pc, (0.018, 0.0, -0.0055), 1.8)  # 8.5 mm: deeper than any hole gives
-    assert state.phase == LIFT
+    walk = _Walk(traj, tilt)
+    pc = walk.pc
+    walk((0.0, 0.0, 0.003), 0.5)  # resting tilted
+    walk((0.005, 0.0, 0.0024), 1.0)  # the low rim went over the top's edge
+    assert walk.node == "lateral"
+    walk((0.007, 0.0, -0.002), 1.4)  # pivoting on it, sinking: a hole gives that
+    assert walk.node == "lateral"
+    cmd = walk((0.018, 0.0, -0.0055), 1.8)  # 8.5 mm: deeper than any hole gives
+    assert walk.node == "lift"
     assert cmd.wrench[2] == 0.0 and cmd.twist[2] == LIFT_SPEED  # no push: up, in place
     assert np.allclose(pc.p_d[:2], (0.018, 0.0))
-    _tick(run, pc, (0.018, 0.0, -0.03), 2.8)  # hanging below the set-point
-    assert state.phase == LIFT and pc.p_d[2] == pytest.approx(-0.0055 + LIFT_SPEED)
-    _tick(run, pc, (0.018, 0.0, 0.0042), 3.0)  # 1.2 mm above the top: over to the trajectory
+    walk((0.018, 0.0, -0.03), 2.8)  # hanging below the set-point
+    assert walk.node == "lift" and pc.p_d[2] == pytest.approx(-0.0055 + LIFT_SPEED)
+    walk((0.018, 0.0, 0.0042), 3.0)  # 1.2 mm above the top: over to the trajectory
     z_held = pc.p_d[2]
-    cmd = _tick(run, pc, (0.0179, 0.0, 0.0042), 3.02)  # where it was left at 1 s: x = 10 mm
+    cmd = walk((0.0179, 0.0, 0.0042), 3.02)  # where it was left at 1 s: x = 10 mm
     assert 0.01 < pc.p_d[0] < 0.018 and cmd.twist[0] == -LIFT_SPEED and pc.p_d[2] == z_held
-    _tick(run, pc, (0.011, 0.0, 0.0042), 3.2)
-    assert state.phase == LIFT and pc.p_d[0] == pytest.approx(0.01)  # there, TCP not yet
-    _tick(run, pc, (0.0105, 0.0, 0.0042), 3.3)
-    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == 0.0
-    assert run.paused == pytest.approx(3.3 - 1.0)
-    _tick(run, pc, (0.012, 0.0, 0.0), 3.5)  # upright on the top, lower: not a drop
-    assert state.phase == SEARCH and wxyz_to_rotation(pc.q_d).magnitude() == 0.0
-    _tick(run, pc, (0.031, 0.0, 0.0), 4.0)  # a reach from the edge: tilted again
+    walk((0.011, 0.0, 0.0042), 3.2)
+    assert walk.node == "back" and pc.p_d[0] == pytest.approx(0.01)  # there, TCP not yet
+    walk((0.0105, 0.0, 0.0042), 3.3)
+    assert walk.node == "upright" and wxyz_to_rotation(pc.q_d).magnitude() == 0.0
+    assert walk.ctx.paused == pytest.approx(3.3 - 1.0)
+    walk((0.012, 0.0, 0.0), 3.5)  # upright on the top, lower: not a drop
+    assert walk.node == "upright" and wxyz_to_rotation(pc.q_d).magnitude() == 0.0
+    walk((0.031, 0.0, 0.0), 4.0)  # a reach from the edge: tilted again
     assert wxyz_to_rotation(pc.q_d).magnitude() == pytest.approx(0.2)
-    _tick(run, pc, (0.031, 0.0, 0.002), 4.5)  # settled tilted, then a hole's drop
-    _tick(run, pc, (0.031, 0.0, 0.0014), 4.6)
-    assert state.phase == LATERAL
+    walk((0.031, 0.0, 0.002), 4.5)  # settled tilted, then a hole's drop
+    walk((0.031, 0.0, 0.0014), 4.6)
+    assert walk.node == "lateral"
 
 
 def test_with_a_lead_the_set_points_go_back_so_that_the_low_rim_follows_the_path():
@@ -184,18 +195,18 @@ def test_with_a_lead_the_set_points_go_back_so_that_the_low_rim_follows_the_path
     t = np.array([0.0, 10.0])
     pos = np.array([[0.0, 0.0, 0.0], [0.0, 0.1, 0.0]])  # along +y: the rim leans +y
     traj = SetpointTrajectory.from_path(t, pos)
-    run = FollowSetpoints(traj, FollowConfig(tilt=TiltConfig(lead=0.01))).compile({})
-    pc = Percept(Pose(np.zeros(3)), 0.01)
-    run.enter(pc)
-    _tick(run, pc, (0.0, 0.0, 0.0), 0.0)
+    walk = _Walk(traj, TiltConfig(lead=0.01))
+    pc = walk.pc
+    walk((0.0, 0.0, 0.0), 0.0)
     assert np.allclose(pc.p_d[:2], 0.0)  # from where the part is
-    _tick(run, pc, (0.0, 0.0, 0.0), 0.5 * LEAD_TIME)
+    walk((0.0, 0.0, 0.0), 0.5 * LEAD_TIME)
     assert np.allclose(pc.p_d[:2], (0.0, 0.005 * LEAD_TIME - 0.005))  # half way back
-    _tick(run, pc, (0.0, 0.0, 0.0), 2.0)
+    walk((0.0, 0.0, 0.0), 2.0)
     assert np.allclose(pc.p_d[:2], (0.0, 0.02 - 0.01))  # the low rim on the path
     upright = FollowSetpoints(traj, FollowConfig()).compile({})
     upright.enter(pc)
-    _tick(upright, pc, (0.0, 0.0, 0.0), 2.0)
+    pc.t_node = 2.0
+    upright.command(pc, MPCommand())
     assert np.allclose(pc.p_d[:2], (0.0, 0.02))
 
 
@@ -212,23 +223,35 @@ def test_peg2d_jam_free_tilt_is_where_the_high_rim_clears_the_near_edge():
 
 
 def test_no_drop_is_felt_while_the_part_still_tilts():
+    walk = _standing_still(TiltConfig())[0]
+    walk((0.0, 0.0, 0.003), 0.05)  # bounced up while tilting
+    walk((0.0, 0.0, 0.002), 0.25)
+    walk((0.0, 0.0, 0.002), 0.35)  # settled 1 mm lower: not a drop
+    assert walk.node == "search"
+    walk((0.0, 0.0, 0.0014), 0.5)
+    assert walk.node == "lateral"
+
+
+def test_the_phases_are_the_graph_s_nodes_and_a_tilted_follow_node_is_refused():
     traj = SetpointTrajectory.from_path(np.array([0.0, 10.0]), np.zeros((2, 3)))
-    run = FollowSetpoints(traj, FollowConfig(tilt=TiltConfig())).compile({})
-    pc = Percept(Pose(np.zeros(3)), 0.01)
-    run.enter(pc)
-    _tick(run, pc, (0.0, 0.0, 0.003), 0.05)  # bounced up while tilting
-    _tick(run, pc, (0.0, 0.0, 0.002), 0.25)
-    _tick(run, pc, (0.0, 0.0, 0.002), 0.35)  # settled 1 mm lower: not a drop
-    assert run.tilt.phase == SEARCH
-    _tick(run, pc, (0.0, 0.0, 0.0014), 0.5)
-    assert run.tilt.phase == LATERAL
-
-
-def test_state_reset_starts_a_new_search():
-    state = TiltState(TiltConfig(), np.zeros((2, 3)))
-    state.phase = ALIGN
-    state.reset(0.06)
-    assert state.phase == SEARCH and state.z_top == 0.06 and state.angle(5.0) == 0.15
+    skill = follow_skill(traj, FollowConfig(tilt=TiltConfig(off_depth=0.01)))
+    assert tuple(n.name for n in skill.nodes) == NODES
+    assert skill.start == "search" and skill.node("lateral").chain
+    edges = [(tr.source, tr.target) for tr in skill.transitions]
+    assert edges[:4] == [
+        ("search", "lateral"),
+        ("lateral", "lift"),  # checked first: off the top
+        ("lateral", "search"),
+        ("lateral", "align"),
+    ]
+    assert ("align", "search") in edges and ("upright", "search") in edges
+    assert tuple(n.name for n in get_skill("tilted-search").nodes) == NODES  # skill show
+    plain = follow_skill(traj, FollowConfig(tilt=TiltConfig()))  # no off_depth: no lift
+    assert [n.name for n in plain.nodes] == ["search", "lateral", "align"]
+    with pytest.raises(SkillError, match="follow_skill"):
+        FollowSetpoints(traj, FollowConfig(tilt=TiltConfig())).compile({})
+    with pytest.raises(SkillError, match="inside its graph"):
+        skill.node("lateral").primitive.compile({}).enter(Percept(Pose(np.zeros(3)), 0.01))
 
 
 @pytest.fixture(scope="module")
@@ -247,5 +270,9 @@ def test_a_tilted_pass_drops_in_where_an_upright_one_slides_over(sharp_pass):
     assert cfg.tilt is not None and cfg.tilt.angle == task.search_tilt == 0.25
     tilted = run_trajectory(robot, task, traj, start, cfg)
     assert tilted.success and tilted.ground_truth_inserted
+    assert [v.node for v in tilted.visits] == ["search", "lateral", "align"]  # the phases
+    assert tilted.visits[0].reason.startswith("-> lateral: sank drop_depth")
+    logged = [tilted.node_names[i] for i in dict.fromkeys(tilted.log.node.tolist())]
+    assert logged == ["search", "lateral", "align"]  # the run log shows the active phase
     upright = run_trajectory(robot, task, traj, start, dataclasses.replace(cfg, tilt=None))
     assert not upright.success and not upright.ground_truth_inserted

@@ -8,7 +8,8 @@ chosen by the :data:`~teachfit.core.control.ControllerSpec` given at reset) the 
 2. checks, in this order, the skill's success condition (stop, ``SUCCESS``), the global and the
    active node's error conditions (stop; ``TIMEOUT`` when only time conditions fired,
    ``FORCE_LIMIT`` when only force conditions did, else ``ERROR_CONDITION``; then the recovery
-   node runs), then the active node's transitions (first that holds wins, entered at once);
+   node runs), then the active node's transitions (first that holds wins: the node is left,
+   the target entered at once, and a ``chain`` target's transitions checked in turn);
 3. asks the active primitive for a twist, feed-forward wrench and stiffness (task frame), sends
    the set-point ``(p_d, q_d)`` with them to the robot (world frame) and integrates it,
    ``p_d += v dt``, ``q_d = exp(w dt) q_d``.
@@ -299,15 +300,20 @@ def execute(
             outcome, by_error = _classify(held), True
             reason = f"{'skill' if glob else active.name} error: {which}"
             break
-        for check, target, desc in active.transitions:
-            if check(pc):
-                visits.append(NodeVisit(active.name, t_enter, pc.t, f"-> {names[target]}: {desc}"))
-                idx, active, t_enter = target, nodes[target], pc.t
-                pc.t_node = 0.0
-                pc.goal[:] = math.nan
-                if active.reset_setpoint:
-                    pc.hold_here()
-                active.run.enter(pc)
+        for _ in names:  # a `chain` node entered checks its own transitions at once
+            fired = next(((t, d) for check, t, d in active.transitions if check(pc)), None)
+            if fired is None:
+                break
+            target, desc = fired
+            visits.append(NodeVisit(active.name, t_enter, pc.t, f"-> {names[target]}: {desc}"))
+            active.run.leave(pc)
+            idx, active, t_enter = target, nodes[target], pc.t
+            pc.t_node = 0.0
+            pc.goal[:] = math.nan
+            if active.reset_setpoint:
+                pc.hold_here()
+            active.run.enter(pc)
+            if not active.chain:
                 break
         if pc.t >= cfg.max_time:
             break

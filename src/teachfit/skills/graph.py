@@ -31,7 +31,8 @@ class Node:
 
     ``reset_setpoint``: the node starts from the measured pose (the set-point of the previous
     node may have run ahead of a constrained part); ``False`` continues from the commanded
-    set-point.
+    set-point. ``chain``: entered by a transition, its own transitions are checked at once,
+    in the same command period (a phase that may end as soon as it begins).
     """
 
     name: str
@@ -39,6 +40,7 @@ class Node:
     error: Condition | None = None
     doc: str = ""
     reset_setpoint: bool = True
+    chain: bool = False
 
     def refs(self) -> set[str]:
         return self.primitive.refs() | (self.error.refs() if self.error else set())
@@ -62,6 +64,7 @@ class CompiledNode:
     error: Check
     reset_setpoint: bool
     transitions: tuple[tuple[Check, int, str], ...]  # (check, target index, description)
+    chain: bool = False
 
 
 @dataclass(frozen=True)
@@ -208,7 +211,7 @@ class Skill:
                 if exc.node is not None:
                     raise
                 raise SkillError(str(exc), node=node.name) from exc
-            return CompiledNode(node.name, run, err, node.reset_setpoint, trs)
+            return CompiledNode(node.name, run, err, node.reset_setpoint, trs, node.chain)
 
         nodes = [build(n) for n in self.nodes]
         rec = build(self.recovery) if self.recovery is not None else None

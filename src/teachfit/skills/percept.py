@@ -33,6 +33,8 @@ class Percept:
     detected : whether the task's success detector holds for the measured pose (``False``
         when the execution has no detector).
     pos, quat : (3,), (4,) TCP pose in the world (m; w-x-y-z).
+    shared : per-execution state the nodes of one graph share, by name (e.g. ``"tilt"``:
+        a tilted search's :class:`~teachfit.skills.tilt_context.TiltContext`).
     """
 
     def __init__(self, task2world: Pose, dt: float) -> None:
@@ -58,6 +60,7 @@ class Percept:
         self.goal = np.full(3, np.nan)
         self.done = False
         self.detected = False
+        self.shared: dict[str, object] = {}
         self._tmp = np.zeros(3)
         self._mat = np.zeros(9)
 

@@ -56,6 +56,11 @@ class PrimitiveRun(ABC):
     def command(self, pc: Percept, out: MPCommand) -> None:
         """Fill ``out`` (task frame) for the command period starting at ``pc.t_node``."""
 
+    def leave(self, pc: Percept) -> None:
+        """Called when a transition leaves the node (before the next one is entered); by
+        default nothing happens."""
+        return None
+
 
 class Primitive(ABC):
     """A primitive spec (see the module docstring)."""

@@ -126,6 +126,10 @@ class LearnedSearch(Primitive):
         ex = recentred(self.model.exploration, resolve(self.scale, values))
         ang = None if self.model.angular_speed is None else self.model.angular_speed * speed
         planner = TshixPlanner(ex, self.model.speed * speed, ang)
+        if self.follow.tilt is not None:
+            raise SkillError(
+                "learned_search follows upright: a tilted search is a graph of its own"
+            )
         cfg = FollowConfig(**{**self.follow.__dict__, "push_force": push, "anchor": "frame"})
         rng = np.random.default_rng(int(resolve(self.seed, values)))
         return _SearchRun(self.model, planner, n, cfg, rng)

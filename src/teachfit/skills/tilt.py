@@ -1,5 +1,5 @@
 """Searching with a tilted part: tilt, feel the drop, slide to the wall, align (seed B's
-``tilt``, ``lateral`` and ``align`` primitives inside a search follower).
+``tilt``, ``lateral`` and ``align`` primitives as the nodes of a search graph).
 
 An upright sharp-edged peg drops into its hole only when its axis passes within the radial
 clearance of the hole's (0.1-0.25 mm in the peg2d variants). Tilted by ``angle`` about the
@@ -7,7 +7,10 @@ horizontal axis z x d, its lowest point is one rim point, ``d`` (a fixed task-fr
 by default from the trajectory's start toward its centroid, the part leaning toward where it
 searches) from the axis; that point drops as soon as it is over the hole, deep enough to
 feel near the hole's line along ``d`` (millimetres, not tenths; see *Lead* below).
-:class:`TiltState` then runs these phases:
+The search then runs these phases, each a node of a skill graph
+(:mod:`teachfit.skills.tilt_graph`: the primitives in :mod:`teachfit.skills.tilt_phases`, the
+conditions that move it on in :mod:`teachfit.skills.tilt_conditions`, what the phases share in
+:class:`~teachfit.skills.tilt_context.TiltContext`):
 
 1. *search*: the follower's set-points, the orientation tilted; the reference height is the
    highest the TCP has been since the tilt settled (the tilted part rests one
@@ -24,8 +27,8 @@ feel near the hole's line along ``d`` (millimetres, not tenths; see *Lead* below
    zero linearly over ``align_time`` while the push goes on: turning about the rim that
    rests on the far wall, the part swings over the hole and slides in. Upright and not
    sinking ``RETRY`` s later, it missed (it stands on the edge): the search goes on, tilted,
-   from where the trajectory was left (:class:`~teachfit.skills.follow.FollowSetpoints`
-   pauses the trajectory's clock outside the search phase and blends back to it);
+   from where the trajectory was left (the trajectory's clock stands still outside the
+   search nodes, and the set-point blends back to it);
 4. *lift*: a drop in the lateral phase deeper than ``off_depth`` (a tilted part enters a
    hole far less deep than the hole is) was the part leaving the top over its outer edge,
    the low rim first (Ø 30 mm, 0.5 mm, μ 0.5: a 58 mm "drop" 46 mm from the hole on a Ø 120
@@ -33,7 +36,8 @@ feel near the hole's line along ``d`` (millimetres, not tenths; see *Lead* below
    side for the whole reach, and then stood on the floor beside the block, pushed there,
    until the time ran out). Without the push, the set-point rises until the TCP is
    ``LIFT_CLEAR`` / 2 above the top's height, then moves at ``LIFT_SPEED`` back over the top
-   to where the trajectory was left, and the search goes on from there upright (upright,
+   to where the trajectory was left (``lift``, then ``back``), and the search goes on from
+   there upright (``upright``; upright,
    a part whose axis is over the top stays on it) until the TCP is ``lateral_reach`` from
    where the drop was felt; then tilted again (tilted there again, the low rim went over the
    same edge again: the same fall, lift and return, over and over).
@@ -74,8 +78,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from teachfit.core.errors import SkillError
-from teachfit.core.geometry import quat_mul_into
-from teachfit.skills.percept import Percept
 
 #: time (s) the lateral phase waits at its full reach before aligning anyway
 SETTLE = 0.5
@@ -92,8 +94,6 @@ LIFT_CLEAR = 0.002
 LIFT_SPEED = 0.05
 #: time (s) over which a search with a ``lead`` moves its set-point back by it at the start
 LEAD_TIME = 0.5
-#: phases of a tilted search
-SEARCH, LATERAL, ALIGN, LIFT = 0, 1, 2, 3
 
 
 @dataclass(frozen=True)
@@ -183,132 +183,3 @@ def wedge_lag(angle: float, friction: float, load: float, stiffness: float) -> f
     tan = math.tan(angle)
     denom = max(1e-3, 1.0 - friction * tan)
     return 2.0 * load * (tan + friction) / denom / stiffness
-
-
-class TiltState:
-    """One tilted search's phase and the set-points it overrides (see the module docstring);
-    ``path`` (N, 3; m): the followed trajectory's positions, for the default direction."""
-
-    def __init__(self, cfg: TiltConfig, path: np.ndarray) -> None:
-        self.cfg, self.d = cfg, cfg.unit(path)
-        self.reset(0.0)
-
-    def _tilt_to(self, angle: float) -> None:
-        """Search at ``angle`` (rad) from now on."""
-        self.full = angle
-        self.q_tilt = self._about_axis(angle)
-
-    def _about_axis(self, angle: float) -> np.ndarray:
-        """The rotation by ``angle`` (rad) about z x d = (-d_y, d_x, 0): lowers the +d rim."""
-        s = math.sin(0.5 * angle)
-        return np.array([math.cos(0.5 * angle), -self.d[1] * s, self.d[0] * s, 0.0])
-
-    def reset(self, z: float) -> None:
-        self.phase, self.z_top, self.t0, self.z_aligned = SEARCH, z, 0.0, z
-        self.origin = np.zeros(2)
-        self.lifted = self.arrived = False  # lifting: up high enough; set-point back over
-        self.z_fall, self.z_lift, self.t_lifted = z, z, 0.0  # m, m, s: the lift's course
-        self.xy_fall, self.xy_lifted, self.back = np.zeros(2), np.zeros(2), np.zeros(2)
-        self.edge: np.ndarray | None = None  # m, x-y of a drop that was the top's edge
-        self.z_floor = -math.inf  # m, where a missed align stood upright (on the edge)
-        self._tilt_to(self.cfg.angle)
-
-    def angle(self, t: float) -> float:
-        """The tilt (rad) at node time ``t``: full until aligning, then down to 0."""
-        if self.phase == SEARCH and self.edge is not None:
-            return 0.0
-        if self.phase != ALIGN:
-            return self.full
-        return self.full * max(0.0, 1.0 - (t - self.t0) / self.cfg.align_time)
-
-    def orient(self, out: np.ndarray, quat: np.ndarray, t: float) -> None:
-        """``out`` = ``quat`` tilted by the phase's angle about z x d (world-side product)."""
-        a = self.angle(t)
-        if a >= self.full:
-            quat_mul_into(out, self.q_tilt, quat)
-        elif a > 0.0:
-            quat_mul_into(out, self._about_axis(a), quat)
-        else:
-            out[:] = quat
-
-    def step(self, pc: Percept) -> bool:
-        """Advance the phase from the measured TCP; True when it should hold x-y (align)."""
-        z, t = float(pc.p[2]), pc.t_node
-        if self.phase == SEARCH and self.edge is not None:  # upright beside the edge
-            self.z_top = z
-            if float(np.hypot(*(pc.p[:2] - self.edge))) > self.cfg.lateral_reach:
-                self.edge, self.t0 = None, t  # away from it: tilt again
-        elif self.phase == SEARCH:
-            if t - self.t0 < TILT_SETTLE:  # still tilting: no resting height yet, but
-                self.z_top = max(z, self.z_floor)  # below the edge it stood on: a drop
-            self.z_top = max(self.z_top, z)
-            if self.z_top - z >= self.cfg.drop_depth:
-                self.phase, self.t0 = LATERAL, t
-                lead = float(np.dot(pc.p_d[:2] - pc.p[:2], self.d))  # the spring's pull on
-                self.origin[:] = pc.p[:2] + max(0.0, lead) * self.d  # the part, kept
-        if self.phase == LATERAL:
-            travel = float(np.dot(pc.p[:2] - self.origin, self.d))
-            lead = self.cfg.lateral_speed * (t - self.t0) - travel
-            stalled = lead > self.cfg.stall_lag
-            spent = travel >= self.cfg.lateral_reach or t - self.t0 > self.cfg.lateral_time
-            off = self.cfg.off_depth
-            if off is not None and self.z_top - z > off:  # deeper than any hole: off the top
-                self.phase, self.t0, self.lifted, self.arrived = LIFT, t, False, False
-                self.z_fall, self.xy_fall[:] = z, pc.p[:2]
-            elif self.z_top - z < 0.5 * self.cfg.drop_depth:  # back up: the rim rode out over
-                self.phase, self.t0 = SEARCH, t  # the edge (a shallow drop), search on
-            elif stalled or spent:
-                self.phase, self.t0 = ALIGN, t
-        elif self.phase == ALIGN:
-            since = t - self.t0 - self.cfg.align_time
-            if since <= 0.0:
-                self.z_aligned = z
-            elif since > RETRY and self.z_aligned - z < RETRY_SINK:
-                self.phase, self.t0 = SEARCH, t  # upright and not sinking: search on,
-                self.z_floor = z
-                other = self.cfg.retry_angle  # the other tilt next time
-                if other is not None:
-                    self._tilt_to(other if self.full == self.cfg.angle else self.cfg.angle)
-        elif self.phase == LIFT:
-            if not self.lifted and z >= self.z_top + 0.5 * LIFT_CLEAR:  # high enough:
-                self.lifted, self.t_lifted = True, t  # over the top from here
-                self.xy_lifted[:] = pc.p[:2]
-            near = float(np.hypot(*(pc.p[:2] - self.back))) < LIFT_CLEAR
-            if self.arrived and near:
-                self.phase, self.t0 = SEARCH, t  # back over the top: search on from here,
-                self.edge = self.origin.copy()  # upright until away from the edge
-        return self.phase == ALIGN
-
-    def lift(self, pc: Percept, twist: np.ndarray, target: np.ndarray) -> None:
-        """In the lift phase: the set-point rises from the TCP at ``LIFT_SPEED`` until the TCP
-        is ``LIFT_CLEAR`` / 2 above the top's height (the part's unsupported weight pulls it
-        below the set-point, by an amount that depends on the part and the stiffness, so the
-        set-point goes up until the TCP is there, and stays); then x-y moves at
-        ``LIFT_SPEED`` to ``target`` (2,; m: the trajectory's x-y where it was left).
-        ``twist`` (3,): the set-point's velocity."""
-        self.back[:] = target
-        twist[:] = 0.0
-        if not self.lifted:
-            self.z_lift = self.z_fall + LIFT_SPEED * (pc.t_node - self.t0)
-            pc.p_d[:2], pc.p_d[2], twist[2] = self.xy_fall, self.z_lift, LIFT_SPEED
-            return
-        pc.p_d[2] = self.z_lift
-        gap = target - self.xy_lifted
-        dist = float(np.hypot(gap[0], gap[1]))
-        s = LIFT_SPEED * (pc.t_node - self.t_lifted)
-        self.arrived = s >= dist
-        if self.arrived:
-            pc.p_d[:2] = target
-        else:
-            pc.p_d[:2] = self.xy_lifted + gap * (s / dist)
-            twist[:2] = LIFT_SPEED * gap / dist
-
-    def lateral(self, pc: Percept, twist: np.ndarray) -> None:
-        """In the lateral phase: the x-y set-point and velocity along ``d`` from the drop;
-        across ``d`` the set-point is where the TCP is (no spring across: see *Free across*)."""
-        pc.p_d[:2] = self.origin + self.cfg.lateral_speed * (pc.t_node - self.t0) * self.d
-        n0, n1 = -self.d[1], self.d[0]
-        across = (pc.p[0] - pc.p_d[0]) * n0 + (pc.p[1] - pc.p_d[1]) * n1
-        pc.p_d[0] += across * n0
-        pc.p_d[1] += across * n1
-        twist[:2] = self.cfg.lateral_speed * self.d
