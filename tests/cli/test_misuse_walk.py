@@ -41,6 +41,9 @@ ENUMS = {
 OUTPUTS_OF = {("demo", "export"): {"columns"}}
 #: a missing file is a valid new one
 NEW_OK = {"study"}
+#: options a command needs although typer does not require them (it refuses their absence in
+#: its own one line), given so that the walk reaches the command's other checks
+NEEDED = {("demo", "import"): ["--task", "peg2d"]}
 #: task TOML files with values of the wrong type
 WRONG_TASKS = {
     "str": 'clearance = "abc"', "list": "clearance = [1, 2]", "bool": "clearance = true",
@@ -126,6 +129,7 @@ def _cases(path: tuple[str, ...], cmd: Any) -> Iterator[tuple[list[str], str]]:
                 if p.name in OUTPUT_OPTIONS
                 else f"in/none{PATH_SUFFIX.get(p.name, '.toml')}",
             ]
+    base += NEEDED.get(path, [])
     argpos = [p for p in cmd.params if p.param_type_name == "argument"]
 
     def with_value(p: Any, value: str) -> list[str]:
