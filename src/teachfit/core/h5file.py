@@ -43,6 +43,12 @@ def one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split())
 
 
+def shown(value: object) -> str:
+    """A short repr of an attribute's value (numpy values as Python ones)."""
+    plain = value.tolist() if isinstance(value, np.ndarray | np.generic) else value
+    return reprlib.repr(plain)
+
+
 def _size(n: float) -> str:
     """A size in bytes, in words (binary units)."""
     for unit in ("bytes", "KiB", "MiB", "GiB"):
@@ -144,8 +150,7 @@ class H5Reader:
         version = version.item() if isinstance(version, np.generic) else version
         if type(version) is not int or version != supported:
             raise self.error(
-                f"unsupported format_version {reprlib.repr(version)} "
-                f"(this teachfit reads {supported})"
+                f"unsupported format_version {shown(version)} (this teachfit reads {supported})"
             )
 
     def group(self, parent: h5py.Group, name: str) -> h5py.Group:
@@ -213,11 +218,8 @@ class H5Reader:
                 pass
         elif isinstance(value, str):
             return value
-        shown = reprlib.repr(
-            value.tolist() if isinstance(value, np.ndarray | np.generic) else value
-        )
         raise self.error(
-            f"{obj.name}: attribute {label!r} is {shown} ({type(value).__name__}), "
+            f"{obj.name}: attribute {label!r} is {shown(value)} ({type(value).__name__}), "
             "not a text string",
             label,
         )

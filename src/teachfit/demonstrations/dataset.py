@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import json
 import re
-import reprlib
 from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -35,7 +34,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
-from teachfit.core.h5file import H5Reader, open_hdf5, write_hdf5
+from teachfit.core.h5file import H5Reader, open_hdf5, shown, write_hdf5
 
 SOURCES: tuple[str, ...] = (
     "simulated-teacher",
@@ -387,7 +386,7 @@ def _open(path: Path) -> Iterator[tuple[H5Reader, h5py.Group, list[str]]]:
         fmt = fmt.decode(errors="replace") if isinstance(fmt, bytes) else fmt
         if not isinstance(fmt, str) or fmt != FORMAT:
             raise DatasetError(
-                f"format attribute is {reprlib.repr(fmt)}, expected {FORMAT!r}", path=str(path)
+                f"format attribute is {shown(fmt)}, expected {FORMAT!r}", path=str(path)
             )
         reader.check_version(FORMAT_VERSION)
         group = reader.group(f, "demos")

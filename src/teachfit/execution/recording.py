@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import json
 import math
-import reprlib
 import shlex
 import sys
 from collections.abc import Iterable, Mapping
@@ -55,7 +54,7 @@ import numpy as np
 from teachfit import __version__
 from teachfit.core.errors import DatasetError, OutputError
 from teachfit.core.geometry import Pose
-from teachfit.core.h5file import H5Reader, one_line, open_hdf5, write_hdf5
+from teachfit.core.h5file import H5Reader, one_line, open_hdf5, shown, write_hdf5
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult
 from teachfit.execution.recording_io import (
@@ -281,7 +280,7 @@ def _read_info(reader: H5Reader) -> RunInfo:
         wrong = not isinstance(value, INFO_TYPES.get(key, object)) or isinstance(value, bool)
         if key in INFO_TYPES and wrong:
             raise reader.error(
-                f"attribute 'info': {key} is {reprlib.repr(value)}, not a "
+                f"attribute 'info': {key} is {shown(value)}, not a "
                 f"{getattr(INFO_TYPES[key], '__name__', 'number')}",
                 "info",
             )
