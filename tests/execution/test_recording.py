@@ -156,6 +156,7 @@ def _replace(name: str, value):
         (_replace("episodes/000/pos", h5py.ExternalLink("/etc/x.h5", "/")),
          "/episodes/000/pos is an external link to /etc/x.h5:/"),
         (_replace("episodes/000/t", h5py.SoftLink("/episodes/000/t")), "too many links"),
+        (_replace("episodes/000/visits/node", np.zeros(2)), "/node holds float64 values, not text"),
         (lambda f: f["episodes/000"].__delitem__("t") or f["episodes/000"].create_dataset(
             "t", shape=(400_000_000,), dtype="f8", chunks=(1 << 20,), compression="gzip"),
          r"/episodes/000/t declares \(400000000,\) values"),

@@ -179,7 +179,8 @@ class H5Reader:
             raise self.error(f"{where} is a {_kind_of(obj)}, not a dataset", name)
         text = kinds == "OSU" and h5py.check_string_dtype(obj.dtype) is not None
         if not text and obj.dtype.kind not in kinds:
-            raise self.error(f"{where} holds {obj.dtype} values, not real numbers", name)
+            want = "text" if kinds == "OSU" else "real numbers"
+            raise self.error(f"{where} holds {obj.dtype} values, not {want}", name)
         if obj.shape is None:
             raise self.error(f"{where} holds no values (an empty dataspace)", name)
         if obj.external or obj.is_virtual:

@@ -13,8 +13,10 @@ File layout (``format="teachfit-demos"``, ``format_version=1``)::
     /demos/000/wrench       (T, 6) float64, N and N*m (absent when not recorded)
     /demos/001 ...
 
-Files are written atomically (temporary file in the same directory, then ``os.replace``), so a
-failed write never leaves a half-written file behind.
+Files are built in memory and written atomically (temporary file in the same directory, then
+``os.replace``), so a failed write (a full disk, ``ulimit -f``) never leaves a half-written file
+behind. Reading refuses links to other files and checks each dataset's kind, value type and
+declared size before reading it (:mod:`teachfit.core.h5file`); text attributes must be text.
 """
 
 from __future__ import annotations

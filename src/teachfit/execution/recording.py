@@ -31,8 +31,10 @@ File layout (``format="teachfit-run"``, ``format_version=1``; world frame at the
                                                            (searches; absent otherwise)
     /episodes/001 ...
 
-Files are written atomically (a temporary file beside the target, then ``os.replace``; the
-temporary file is removed when the write fails or is interrupted). Read with :func:`read_run_log`;
+Files are built in memory and written atomically (a temporary file beside the target, then
+``os.replace``; the temporary file is removed when the write fails or is interrupted). Reading
+refuses links to other files and checks kinds, types and declared sizes before reading
+(:mod:`teachfit.core.h5file`). Read with :func:`read_run_log`;
 :func:`is_run_log` tells a run log from a demonstration file.
 """
 
