@@ -188,3 +188,18 @@ def test_a_soft_link_loop_is_a_damaged_file(tmp_path: Path) -> None:
     path = crafted(tmp_path, _a(h5py.SoftLink("/a")))
     with pytest.raises(DatasetError, match="damaged HDF5 file.*too many links"):
         read_all(path)
+
+
+def test_a_failing_fill_is_one_error_and_writes_nothing(tmp_path: Path) -> None:
+    dest = write_hdf5(tmp_path / "f.h5", fill_zeros(3), "test file")
+    old = dest.read_bytes()
+
+    def broken(f: h5py.File) -> None:
+        f.create_dataset("b", data=[1.0])
+        raise OSError(errno.EIO, "Input/output error")
+
+    with pytest.raises(OutputError, match=f"^cannot write test file {dest}: Input/output error$"):
+        write_hdf5(dest, broken, "test file", base=dest)
+    with pytest.raises(KeyboardInterrupt):
+        write_hdf5(dest, lambda f: (_ for _ in ()).throw(KeyboardInterrupt), "test file")
+    assert dest.read_bytes() == old and leftovers(tmp_path) == []

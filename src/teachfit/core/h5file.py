@@ -28,8 +28,8 @@ from typing import Any
 import h5py
 import numpy as np
 
-from teachfit.core.atomic import atomic_write_bytes
-from teachfit.core.errors import DatasetError
+from teachfit.core.atomic import atomic_write_bytes, write_error
+from teachfit.core.errors import DatasetError, OutputError
 
 #: the most bytes of data read from one HDF5 file (declared shape times value size, summed over
 #: what is read): about 1 GiB, 4.6 million run-log samples or 9.5 million demonstration samples
@@ -67,7 +67,8 @@ def write_hdf5(
     Raises
     ------
     OutputError
-        The folder cannot be made, or the write failed (full disk, file-size limit, ...).
+        The folder cannot be made, or the write failed (full disk, file-size limit, ...), or
+        ``fill`` raised an ``OSError``; ``dest`` is left as it was.
     DatasetError
         ``base`` is too large to be rewritten in memory.
     """
@@ -83,8 +84,13 @@ def write_hdf5(
             )
         image = base.read_bytes()
     buf = io.BytesIO(image)
-    with h5py.File(buf, "r+" if image else "w") as f:
-        fill(f)
+    try:
+        with h5py.File(buf, "r+" if image else "w") as f:
+            fill(f)
+    except OSError as exc:  # as inside atomic_path: one error naming the file
+        if isinstance(exc, OutputError):
+            raise
+        raise OutputError(f"cannot write {what} {dest}: {write_error(exc)}") from exc
     return atomic_write_bytes(dest, buf.getvalue(), what)
 
 
