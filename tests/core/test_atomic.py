@@ -27,10 +27,36 @@ def test_write_creates_the_folder_and_replaces(tmp_path: Path) -> None:
     atomic_write_text(dest, "one")
     atomic_write_text(dest, "two")
     assert dest.read_text() == "two"
-    assert dest.stat().st_mode & 0o777 == 0o644
+    assert dest.stat().st_mode & 0o777 == 0o666 & ~atomic.current_umask()
     atomic_append_text(dest, "+three")
     assert dest.read_text() == "two+three"
     assert leftovers(dest.parent) == []
+
+
+def mode(path: Path) -> int:
+    return path.stat().st_mode & 0o777
+
+
+@pytest.mark.parametrize("umask", [0o077, 0o022, 0o002])
+def test_new_files_follow_the_umask_and_old_files_keep_their_mode(
+    tmp_path: Path, umask: int
+) -> None:
+    old = os.umask(umask)
+    try:
+        assert atomic.current_umask() == umask
+        new = atomic_write_text(tmp_path / "new.txt", "x")
+        private = atomic_write_text(tmp_path / "private.txt", "a")
+        private.chmod(0o600)
+        atomic_append_text(private, "b")  # an append keeps the file's own mode
+        shared = atomic_write_text(tmp_path / "shared.txt", "a")
+        shared.chmod(0o664)
+        atomic_write_text(shared, "c")  # so does a replace
+    finally:
+        os.umask(old)
+    assert mode(new) == 0o666 & ~umask
+    assert (mode(private), private.read_text()) == (0o600, "ab")
+    assert (mode(shared), shared.read_text()) == (0o664, "c")
+    assert leftovers(tmp_path) == []
 
 
 def test_temporary_keeps_the_suffix(tmp_path: Path) -> None:

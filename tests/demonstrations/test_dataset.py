@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import h5py
@@ -342,3 +343,73 @@ def test_strings_complex_numbers_empty_and_damaged_files_are_refused(tmp_path: P
         except DatasetError:
             refused += 1
     assert refused > 5  # and nothing else escaped
+
+
+def test_umask_and_an_old_files_mode_are_kept(tmp_path: Path) -> None:
+    old = os.umask(0o077)
+    try:
+        private = write_dataset(tmp_path / "private.h5", [make_demo(1)])
+        shared = write_dataset(tmp_path / "shared.h5", [make_demo(1)])
+        shared.chmod(0o640)
+        append_dataset(shared, [make_demo(2)])
+    finally:
+        os.umask(old)
+    assert private.stat().st_mode & 0o777 == 0o600
+    assert shared.stat().st_mode & 0o777 == 0o640 and len(read_dataset(shared)) == 2
+
+
+def _linked_demos(f: h5py.File, target: Path) -> None:
+    del f["demos"]
+    f["demos"] = h5py.ExternalLink(str(target), "/demos")
+
+
+@pytest.mark.parametrize(
+    ("edit", "match", "column"),
+    [
+        (lambda f: f["demos"].__delitem__("001") or f["demos"].__setitem__("001", np.zeros(5)),
+         "/demos/001 is a dataset, not a group", None),
+        (lambda f: f["demos/001"].attrs.__setitem__("task", 7),
+         "/demos/001: attribute 'task' is 7 \\(int64\\), not a text string", "task"),
+        (lambda f: f["demos/001"].attrs.__setitem__("source", [b"synthetic"]),
+         "attribute 'source' is \\['synthetic'\\] \\(ndarray\\)", "source"),
+        (lambda f: f["demos/001"].__delitem__("t") or f["demos/001"].create_dataset(
+            "t", shape=(400_000_000,), dtype="f8", chunks=(1 << 20,), compression="gzip"),
+         r"/demos/001/t declares \(400000000,\) values \(3.0 GiB\) in a file of", "t"),
+        (lambda f: f["demos/001"].__delitem__("pos") or f["demos/001"].create_group("pos"),
+         "/demos/001/pos is a group, not a dataset", "pos"),
+    ],
+)  # fmt: skip
+def test_crafted_structures_are_refused_before_reading(
+    tmp_path: Path, edit, match: str, column: str | None
+) -> None:
+    path = write_dataset(tmp_path / "d.h5", [make_demo(1), make_demo(2)])
+    _edit(path, edit)
+    before = path.read_bytes()
+    for read in (read_dataset, lambda p: read_demo(f"{p}:1"), dataset_summary):
+        with pytest.raises(DatasetError, match=match) as info:
+            read(path)
+        assert info.value.path == str(path) and info.value.column == column
+    with pytest.raises(DatasetError, match=match):
+        append_dataset(path, [make_demo(3)])
+    assert path.read_bytes() == before and tmp_leftovers(tmp_path) == []
+
+
+def test_links_to_other_files_are_refused_and_never_written_through(tmp_path: Path) -> None:
+    target = write_dataset(tmp_path / "target.h5", [make_demo(1)])
+    linked = write_dataset(tmp_path / "linked.h5", [make_demo(2)])
+    _edit(linked, lambda f: _linked_demos(f, target))
+    data = tmp_path / "data.bin"
+    data.write_bytes(np.arange(25, dtype=np.float64).tobytes())
+    stored = write_dataset(tmp_path / "stored.h5", [make_demo(3)])
+    _edit(stored, lambda f: f["demos/000"].__delitem__("t") or f["demos/000"].create_dataset(
+        "t", shape=(25,), dtype="f8", external=[(str(data), 0, 200)]))  # fmt: skip
+    before = {p: p.read_bytes() for p in (target, linked, stored)}
+    message = f"/demos is an external link to {target}:/demos; teachfit follows no links"
+    for read in (read_dataset, read_demo, lambda p: append_dataset(p, [make_demo(4)])):
+        with pytest.raises(DatasetError, match=message):
+            read(linked)
+        with pytest.raises(DatasetError, match="/demos/000/t keeps its data in other files"):
+            read(stored)
+    with pytest.raises(DatasetError, match="external link"):
+        ds.check_appendable(linked)
+    assert {p: p.read_bytes() for p in before} == before and tmp_leftovers(tmp_path) == []

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import h5py
@@ -124,7 +125,7 @@ def test_reading_bad_files_names_them(tmp_path: Path) -> None:
     damaged = write_run_log(tmp_path / "run.h5", episodes, info)
     with h5py.File(damaged, "r+") as f:
         del f["episodes/001/wrench"]
-    with pytest.raises(DatasetError, match="damaged"):
+    with pytest.raises(DatasetError, match="/episodes/001 has no dataset 'wrench'"):
         read_run_log(damaged)
     with h5py.File(damaged, "r+") as f:
         f.attrs["format_version"] = 9
@@ -136,3 +137,53 @@ def test_run_info_here_is_json_safe() -> None:
     info = RunInfo.here("assemble", "tenon", "fr3", 5, "rrt", {"out": Path("a/b.h5"), "n": 3})
     assert info.options == {"out": "a/b.h5", "n": 3}
     assert info.task == "tenon" and math.isnan(info.entry_height) and info.command
+
+
+def _replace(name: str, value):
+    def edit(f: h5py.File) -> None:
+        del f[name]
+        f[name] = value
+
+    return edit
+
+
+@pytest.mark.parametrize(
+    ("edit", "match"),
+    [
+        (_replace("episodes/000", np.zeros(3)), "/episodes/000 is a dataset, not a group"),
+        (_replace("episodes", np.zeros(3)), "/episodes is a dataset, not a group"),
+        (_replace("episodes/000/visits", np.zeros(3)), "/visits is a dataset, not a group"),
+        (_replace("episodes/000/pos", h5py.ExternalLink("/etc/x.h5", "/")),
+         "/episodes/000/pos is an external link to /etc/x.h5:/"),
+        (_replace("episodes/000/t", h5py.SoftLink("/episodes/000/t")), "too many links"),
+        (_replace("episodes/000/visits/node", np.zeros(2)), "/node holds float64 values, not text"),
+        (lambda f: f["episodes/000"].__delitem__("t") or f["episodes/000"].create_dataset(
+            "t", shape=(400_000_000,), dtype="f8", chunks=(1 << 20,), compression="gzip"),
+         r"/episodes/000/t declares \(400000000,\) values"),
+        (lambda f: f["episodes/000"].attrs.__setitem__("outcome", 7),
+         "attribute 'outcome' is 7 \\(int64\\), not a text string"),
+        (lambda f: f.attrs.__setitem__("info", '{"kind": "search", "task": 7}'),
+         "attribute 'info': task is 7, not a str"),
+        (lambda f: f.attrs.__setitem__("info", "[1, 2]"), "'info' is not a run's description"),
+        (lambda f: f.attrs.__setitem__("info", '{"kind": "x"}'), "'info' is incomplete"),
+        (lambda f: f.attrs.__setitem__("format_version", [1]), r"format_version \[1\]"),
+    ],
+)  # fmt: skip
+def test_crafted_run_logs_are_refused_before_reading(tmp_path: Path, edit, match: str) -> None:
+    info = RunInfo("search", "peg2d", "floating", 0, "straight")
+    path = write_run_log(tmp_path / "run.h5", [hand_made()], info)
+    with h5py.File(path, "r+") as f:
+        edit(f)
+    with pytest.raises(DatasetError, match=match) as err:
+        read_run_log(path)
+    assert err.value.path == str(path) and "\n" not in str(err.value)
+
+
+def test_a_run_log_keeps_the_umask(tmp_path: Path) -> None:
+    info = RunInfo("search", "peg2d", "floating", 0, "straight")
+    old = os.umask(0o077)
+    try:
+        path = write_run_log(tmp_path / "run.h5", [hand_made()], info)
+    finally:
+        os.umask(old)
+    assert path.stat().st_mode & 0o777 == 0o600

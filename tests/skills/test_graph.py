@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from teachfit.core.atomic import current_umask
 from teachfit.core.errors import SkillError
 from teachfit.core.geometry import Pose
 from teachfit.core.params import ParamDomain
@@ -243,7 +244,7 @@ def test_written_params_read_back_exactly(tmp_path):
     back = read_params_toml(path, sk.params)
     assert {k: back[k] for k in values} == values  # floats round-trip to the last bit
     assert [p.name for p in path.parent.iterdir()] == ["best.toml"]  # no temporary left
-    assert path.stat().st_mode & 0o777 == 0o644
+    assert path.stat().st_mode & 0o777 == 0o666 & ~current_umask()  # the umask applies
 
 
 def test_a_failed_params_write_keeps_the_old_file_and_no_temporary(tmp_path, monkeypatch):

@@ -27,6 +27,7 @@ from teachfit.demonstrations.column_map import ColumnMap, bare
 from teachfit.demonstrations.csv_import import read_csv_log
 from teachfit.demonstrations.dataset import (
     append_dataset,
+    check_appendable,
     dataset_summary,
     read_dataset,
     read_demo,
@@ -102,6 +103,8 @@ def _check_target(out: Path, append: bool, overwrite: bool) -> None:
         raise TeachfitError(
             f"{out} exists: pass --append to add to it or --overwrite to replace it"
         )
+    if append:
+        check_appendable(out)
 
 
 def _store(out: Path, demos: list[Any], append: bool, overwrite: bool) -> None:

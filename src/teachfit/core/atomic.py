@@ -8,7 +8,11 @@ is left as it was.
 
 Policy for a missing output folder: it is created (with its parents), as ``mkdir -p`` would; a
 folder that cannot be created (a file in the way, no permission) is an :class:`OutputError`
-naming the file. Write errors (full disk, read-only file system) are :class:`OutputError` too.
+naming the file. Write errors (full disk, read-only file system) are :class:`OutputError` too;
+a full disk, a full quota and the file-size limit (``ulimit -f``) are said so in words.
+
+Permissions: a new file gets ``0o666 & ~umask`` (what ``open`` gives, so ``umask 077`` keeps
+outputs private); a replaced or appended file keeps its own permission bits.
 
 The standard library has the pieces (``os.replace``, ``os.fsync``) but no atomic-write helper;
 the one maintained package for it (``atomicwrites``) is archived, hence this module.
@@ -16,7 +20,9 @@ the one maintained package for it (``atomicwrites``) is archived, hence this mod
 
 from __future__ import annotations
 
+import errno
 import os
+import stat
 import uuid
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -29,6 +35,12 @@ TMP_MARK = ".tmp"
 #: a left-over temporary is swept only when its writer is gone and it is this old (s): a
 #: writer on another machine sharing the folder has no PID here, so age alone guards it
 STALE_AFTER = 600.0
+#: write errors that mean a limit was hit: what happened and the fix, in words
+LIMITS = {
+    errno.ENOSPC: ("the disk is full", "free space or write elsewhere"),
+    errno.EDQUOT: ("the disk quota is exceeded", "free space or write elsewhere"),
+    errno.EFBIG: ("the file-size limit was hit", "raise it (ulimit -f) or write less"),
+}
 
 
 def temporary_name(dest: Path) -> Path:
@@ -105,12 +117,46 @@ def _fsync(path: Path, directory: bool = False) -> None:
         os.close(fd)
 
 
+def current_umask() -> int:
+    """This process's umask (read from ``/proc``; elsewhere set and restored at once)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def output_mode(dest: Path) -> int:
+    """Permission bits for a file written to ``dest``: those of the regular file there (a
+    replace or an append keeps them), else ``0o666 & ~umask`` (a new file, as ``open`` makes)."""
+    try:
+        st = os.lstat(dest)
+    except OSError:
+        st = None
+    if st is not None and stat.S_ISREG(st.st_mode):
+        return stat.S_IMODE(st.st_mode) & 0o777
+    return 0o666 & ~current_umask()
+
+
+def write_error(exc: OSError) -> str:
+    """Why a write failed, in one line (a hit limit in words)."""
+    if exc.errno in LIMITS:
+        words, fix = LIMITS[exc.errno]
+        return f"{words} ({os.strerror(exc.errno)}): {fix}"
+    return " ".join((exc.strerror or str(exc)).split())
+
+
 @contextmanager
-def atomic_path(dest: str | Path, what: str = "file", mode: int = 0o644) -> Iterator[Path]:
+def atomic_path(dest: str | Path, what: str = "file", mode: int | None = None) -> Iterator[Path]:
     """Yield a temporary path to write; on success it replaces ``dest`` atomically.
 
     ``what`` names the file in error messages ("model file", "figure"). ``mode`` is the
-    permission bits of the result (the umask does not apply: a shared output is readable).
+    permission bits of the result; by default :func:`output_mode` (an existing file's own, a
+    new file's from the umask).
 
     Raises
     ------
@@ -125,7 +171,7 @@ def atomic_path(dest: str | Path, what: str = "file", mode: int = 0o644) -> Iter
         yield tmp
         if not tmp.is_file():
             raise OutputError(f"cannot write {what} {dest}: nothing was written")
-        os.chmod(tmp, mode)
+        os.chmod(tmp, output_mode(dest) if mode is None else mode)
         _fsync(tmp)
         os.replace(tmp, dest)
         _fsync(dest.parent, directory=True)
@@ -134,7 +180,7 @@ def atomic_path(dest: str | Path, what: str = "file", mode: int = 0o644) -> Iter
         tmp.unlink(missing_ok=True)
         if isinstance(exc, OutputError):
             raise
-        raise OutputError(f"cannot write {what} {dest}: {exc.strerror or exc}") from exc
+        raise OutputError(f"cannot write {what} {dest}: {write_error(exc)}") from exc
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

@@ -13,16 +13,17 @@ File layout (``format="teachfit-demos"``, ``format_version=1``)::
     /demos/000/wrench       (T, 6) float64, N and N*m (absent when not recorded)
     /demos/001 ...
 
-Files are written atomically (temporary file in the same directory, then ``os.replace``), so a
-failed write never leaves a half-written file behind.
+Files are built in memory and written atomically (temporary file in the same directory, then
+``os.replace``), so a failed write (a full disk, ``ulimit -f``) never leaves a half-written file
+behind. Reading refuses links to other files and checks each dataset's kind, value type and
+declared size before reading it (:mod:`teachfit.core.h5file`); text attributes must be text.
 """
 
 from __future__ import annotations
 
 import json
 import re
-import shutil
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -33,9 +34,9 @@ import h5py
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
+from teachfit.core.h5file import H5Reader, open_hdf5, shown, write_hdf5
 
 SOURCES: tuple[str, ...] = (
     "simulated-teacher",
@@ -49,6 +50,12 @@ QUAT_NORM_TOL = 1e-3
 FORMAT = "teachfit-demos"
 FORMAT_VERSION = 1
 UNITS: dict[str, str] = {"t": "s", "pos": "m", "quat": "1 (w,x,y,z)", "wrench": "N, N*m"}
+WHAT = "demonstration file"
+#: a demonstration group's text attributes and their defaults (None: required)
+TEXT_ATTRS: tuple[tuple[str, str | None], ...] = (
+    ("task", None), ("source", None), ("frame", "world"), ("child_frame", "tool"), ("name", ""),
+    ("meta", "{}"),
+)  # fmt: skip
 
 MetaValue = str | int | float | bool | list[float]
 
@@ -314,12 +321,6 @@ def _checked_demos(demos: Sequence[Demonstration], path: Path) -> list[Demonstra
     return items
 
 
-def _atomic(path: Path, fill: Callable[[Path], None]) -> None:
-    """Run ``fill(tmp)`` on a temporary path next to ``path`` and move it into place."""
-    with atomic_path(path, "demonstration file") as tmp:
-        fill(tmp)
-
-
 def write_dataset(
     path: str | Path, demos: Sequence[Demonstration], *, overwrite: bool = False
 ) -> Path:
@@ -339,17 +340,15 @@ def write_dataset(
             path=str(path),
         )
 
-    def fill(tmp: Path) -> None:
-        with h5py.File(tmp, "x") as f:
-            f.attrs["format"] = FORMAT
-            f.attrs["format_version"] = FORMAT_VERSION
-            f.attrs["units"] = json.dumps(UNITS)
-            group = f.create_group("demos")
-            for i, demo in enumerate(items):
-                _write_demo(group.create_group(f"{i:03d}"), demo)
+    def fill(f: h5py.File) -> None:
+        f.attrs["format"] = FORMAT
+        f.attrs["format_version"] = FORMAT_VERSION
+        f.attrs["units"] = json.dumps(UNITS)
+        group = f.create_group("demos")
+        for i, demo in enumerate(items):
+            _write_demo(group.create_group(f"{i:03d}"), demo)
 
-    _atomic(path, fill)
-    return path
+    return write_hdf5(path, fill, WHAT)
 
 
 def append_dataset(path: str | Path, demos: Sequence[Demonstration]) -> Path:
@@ -358,85 +357,69 @@ def append_dataset(path: str | Path, demos: Sequence[Demonstration]) -> Path:
     if not path.exists():
         return write_dataset(path, demos)
     items = _checked_demos(demos, path)
-    with _open(path) as (_, keys):
-        start = int(keys[-1]) + 1 if keys else 0
+    with _open(path) as (reader, group, keys):
+        for key in keys:  # the old demonstrations must be readable: no damage is carried on
+            _read_group(reader, group, key)
+        start = int(keys[-1]) + 1
 
-    def fill(tmp: Path) -> None:
-        shutil.copyfile(path, tmp)
-        with h5py.File(tmp, "r+") as f:
-            for i, demo in enumerate(items, start=start):
-                _write_demo(f["demos"].create_group(f"{i:03d}"), demo)
+    def fill(f: h5py.File) -> None:
+        for i, demo in enumerate(items, start=start):
+            _write_demo(f["demos"].create_group(f"{i:03d}"), demo)
 
-    _atomic(path, fill)
-    return path
+    return write_hdf5(path, fill, WHAT, base=path)
+
+
+def check_appendable(path: str | Path) -> None:
+    """Refuse, before any work, an existing file that demonstrations cannot be appended to
+    (not a demonstration file, links to other files, damaged); a missing file is fine."""
+    path = Path(path)
+    if path.exists():
+        read_dataset(path)
 
 
 @contextmanager
-def _open(path: Path) -> Iterator[tuple[h5py.Group, list[str]]]:
-    """Open and check a dataset file; yields its ``/demos`` group and the sorted demo keys."""
-    if not path.is_file():
-        raise DatasetError("no such file", path=str(path))
-    if not h5py.is_hdf5(path):
-        raise DatasetError("not an HDF5 file", path=str(path))
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise DatasetError(f"cannot open as HDF5 ({exc})", path=str(path)) from exc
-    try:
-        with f:
-            fmt = f.attrs.get("format")
-            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
-            if fmt != FORMAT:
-                raise DatasetError(
-                    f"format attribute is {fmt!r}, expected {FORMAT!r}", path=str(path)
-                )
-            version = f.attrs.get("format_version")
-            version = version.item() if isinstance(version, np.generic) else version
-            if not isinstance(version, int) or version != FORMAT_VERSION:
-                raise DatasetError(
-                    f"unsupported format_version {version!r} "
-                    f"(this teachfit reads {FORMAT_VERSION})",
-                    path=str(path),
-                )
-            group = f.get("demos")
-            if not isinstance(group, h5py.Group):
-                raise DatasetError("missing group /demos", path=str(path))
-            keys = sorted((k for k in group if re.fullmatch(r"\d+", k)), key=int)
-            if not keys:
-                raise DatasetError("the /demos group holds no demonstrations", path=str(path))
-            yield group, keys
-    except (OSError, RuntimeError, KeyError) as exc:  # h5py's errors on a damaged file
-        raise DatasetError(f"damaged HDF5 file, cannot read it ({exc})", path=str(path)) from exc
-
-
-def _attr(group: h5py.Group, label: str, path: Path, default: str | None = None) -> str:
-    value = group.attrs.get(label, default)
-    if value is None:
-        raise DatasetError(f"{group.name} has no attribute {label!r}", path=str(path), column=label)
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
-def _read_group(group: h5py.Group, path: Path) -> Demonstration:
-    arrays: dict[str, np.ndarray | None] = {}
-    for label in ("t", "pos", "quat", "wrench"):
-        ds = group.get(label)
-        if ds is None and label != "wrench":
+def _open(path: Path) -> Iterator[tuple[H5Reader, h5py.Group, list[str]]]:
+    """Open and check a dataset file (:func:`~teachfit.core.h5file.open_hdf5`: no links to
+    other files, sizes checked before reading); yields its reader, its ``/demos`` group and the
+    sorted demo keys."""
+    with open_hdf5(path) as reader:
+        f = reader.file
+        fmt = f.attrs.get("format")
+        fmt = fmt.decode(errors="replace") if isinstance(fmt, bytes) else fmt
+        if not isinstance(fmt, str) or fmt != FORMAT:
             raise DatasetError(
-                f"{group.name} has no dataset {label!r}", path=str(path), column=label
+                f"format attribute is {shown(fmt)}, expected {FORMAT!r}", path=str(path)
             )
-        arrays[label] = None if ds is None else ds[()]
+        reader.check_version(FORMAT_VERSION)
+        group = reader.group(f, "demos")
+        keys = sorted((k for k in group if re.fullmatch(r"\d+", k)), key=int)
+        if not keys:
+            raise DatasetError("the /demos group holds no demonstrations", path=str(path))
+        yield reader, group, keys
+
+
+def _read_group(reader: H5Reader, parent: h5py.Group, key: str) -> Demonstration:
+    """The demonstration in group ``key`` of ``parent`` (kinds, types and sizes checked before
+    anything is read)."""
+    path = reader.path
+    group = reader.group(parent, key)
+    arrays = {
+        label: reader.dataset(group, label, required=label != "wrench")
+        for label in ("t", "pos", "quat", "wrench")
+    }
+    labels = {label: reader.text(group, label, default) for label, default in TEXT_ATTRS}
     try:
-        meta = json.loads(_attr(group, "meta", path, "{}"))
+        meta = json.loads(labels["meta"])
         return Demonstration(
             t=arrays["t"],
             pos=arrays["pos"],
             quat=arrays["quat"],
             wrench=arrays["wrench"],
-            task=_attr(group, "task", path),
-            source=_attr(group, "source", path),
-            frame=_attr(group, "frame", path, "world"),
-            child_frame=_attr(group, "child_frame", path, "tool"),
-            name=_attr(group, "name", path, ""),
+            task=labels["task"],
+            source=labels["source"],
+            frame=labels["frame"],
+            child_frame=labels["child_frame"],
+            name=labels["name"],
             meta=meta,
         )
     except json.JSONDecodeError as exc:
@@ -457,8 +440,8 @@ def read_dataset(path: str | Path) -> list[Demonstration]:
         unsupported version, missing datasets or invalid data (NaN, bad quaternions, ...).
     """
     path = Path(path)
-    with _open(path) as (group, keys):
-        return [_read_group(group[k], path) for k in keys]
+    with _open(path) as (reader, group, keys):
+        return [_read_group(reader, group, k) for k in keys]
 
 
 def read_demo(spec: str | Path) -> Demonstration:
@@ -474,14 +457,14 @@ def read_demo(spec: str | Path) -> Demonstration:
     path = Path(match.group(1)) if match else Path(spec)
     if match:
         index = int(match.group(2))
-    with _open(path) as (group, keys):
+    with _open(path) as (reader, group, keys):
         if not 0 <= index < len(keys):
             raise DatasetError(
                 f"index {index} out of range: the file holds {len(keys)} demos"
                 + (f" (0..{len(keys) - 1})" if keys else ""),
                 path=str(path),
             )
-        return _read_group(group[keys[index]], path)
+        return _read_group(reader, group, keys[index])
 
 
 def read_demos(spec: str | Path) -> list[Demonstration]:

@@ -31,8 +31,10 @@ File layout (``format="teachfit-run"``, ``format_version=1``; world frame at the
                                                            (searches; absent otherwise)
     /episodes/001 ...
 
-Files are written atomically (a temporary file beside the target, then ``os.replace``; the
-temporary file is removed when the write fails or is interrupted). Read with :func:`read_run_log`;
+Files are built in memory and written atomically (a temporary file beside the target, then
+``os.replace``; the temporary file is removed when the write fails or is interrupted). Reading
+refuses links to other files and checks kinds, types and declared sizes before reading
+(:mod:`teachfit.core.h5file`). Read with :func:`read_run_log`;
 :func:`is_run_log` tells a run log from a demonstration file.
 """
 
@@ -52,9 +54,9 @@ import h5py
 import numpy as np
 
 from teachfit import __version__
-from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import DatasetError, OutputError
 from teachfit.core.geometry import Pose
+from teachfit.core.h5file import H5Reader, one_line, open_hdf5, shown, write_hdf5
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult
 from teachfit.execution.recording_io import (
@@ -213,17 +215,20 @@ def write_run_log(
     """
     path = check_run_log_target(path)
     items = RunLog.of(episodes, info, path).episodes
+
+    def fill(f: h5py.File) -> None:
+        f.attrs["format"] = FORMAT
+        f.attrs["format_version"] = FORMAT_VERSION
+        f.attrs["units"] = json.dumps(UNITS)
+        f.attrs["created"] = datetime.now(UTC).isoformat(timespec="seconds")
+        f.attrs["teachfit"] = __version__
+        f.attrs["info"] = json.dumps(asdict(info) | {"options": dict(info.options)})
+        group = f.create_group("episodes")
+        for i, ep in enumerate(items):
+            write_episode(group.create_group(f"{i:03d}"), ep)
+
     try:
-        with atomic_path(path, "run log") as tmp, h5py.File(tmp, "x") as f:
-            f.attrs["format"] = FORMAT
-            f.attrs["format_version"] = FORMAT_VERSION
-            f.attrs["units"] = json.dumps(UNITS)
-            f.attrs["created"] = datetime.now(UTC).isoformat(timespec="seconds")
-            f.attrs["teachfit"] = __version__
-            f.attrs["info"] = json.dumps(asdict(info) | {"options": dict(info.options)})
-            group = f.create_group("episodes")
-            for i, ep in enumerate(items):
-                write_episode(group.create_group(f"{i:03d}"), ep)
+        write_hdf5(path, fill, "run log")
     except OutputError as exc:
         raise DatasetError(str(exc), path=str(path)) from exc
     return path
@@ -242,23 +247,49 @@ def read_run_log(path: str | Path) -> RunLog:
     if not is_run_log(path):
         what = "no such file" if not path.is_file() else "not a teachfit run log"
         raise DatasetError(what, path=str(path))
-    with h5py.File(path, "r") as f:
-        version = f.attrs.get("format_version")
-        version = version.item() if isinstance(version, np.generic) else version
-        if version != FORMAT_VERSION:
-            raise DatasetError(
-                f"unsupported format_version {version!r} (this teachfit reads {FORMAT_VERSION})",
-                path=str(path),
-            )
+    with open_hdf5(path) as reader:
+        f = reader.file
+        reader.check_version(FORMAT_VERSION)
+        info = _read_info(reader)
+        group = reader.group(f, "episodes")
         try:
-            raw = json.loads(f.attrs["info"])
-            info = RunInfo(**raw)
-            group = f["episodes"]
             keys = sorted(group, key=int)
-            episodes = tuple(read_episode(group[k]) for k in keys)
+            episodes = tuple(read_episode(reader, group, k) for k in keys)
         except (KeyError, TypeError, ValueError) as exc:
-            raise DatasetError(f"incomplete or damaged run log ({exc})", path=str(path)) from exc
-        return RunLog(info, episodes, str(f.attrs.get("created", "")), str(f.attrs["teachfit"]))
+            raise DatasetError(
+                f"incomplete or damaged run log ({one_line(exc)})", path=str(path)
+            ) from exc
+        created, version_text = (reader.text(f, k, "") for k in ("created", "teachfit"))
+        return RunLog(info, episodes, created, version_text)
+
+
+#: RunInfo's fields and the JSON types they take
+INFO_TYPES: dict[str, type | tuple[type, ...]] = {
+    "kind": str, "task": str, "robot": str, "seed": int, "method": str, "command": str,
+    "options": dict, "entry_height": (int, float),
+}  # fmt: skip
+
+
+def _read_info(reader: H5Reader) -> RunInfo:
+    """The run's :class:`RunInfo` from the root's ``info`` attribute (JSON), types checked."""
+    try:
+        raw = json.loads(reader.text(reader.file, "info"))
+    except json.JSONDecodeError as exc:
+        raise reader.error(f"attribute 'info' is not JSON ({exc})", "info") from exc
+    if not isinstance(raw, dict):
+        raise reader.error("attribute 'info' is not a run's description", "info")
+    for key, value in raw.items():
+        wrong = not isinstance(value, INFO_TYPES.get(key, object)) or isinstance(value, bool)
+        if key in INFO_TYPES and wrong:
+            raise reader.error(
+                f"attribute 'info': {key} is {shown(value)}, not a "
+                f"{getattr(INFO_TYPES[key], '__name__', 'number')}",
+                "info",
+            )
+    try:
+        return RunInfo(**raw)
+    except TypeError as exc:
+        raise reader.error(f"attribute 'info' is incomplete ({exc})", "info") from exc
 
 
 def run_summary(run: RunLog) -> list[dict[str, Any]]:

@@ -11,6 +11,7 @@ import h5py
 import numpy as np
 
 from teachfit.core.geometry import Pose
+from teachfit.core.h5file import H5_ERRORS, H5Reader
 from teachfit.core.outcome import Outcome
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult, NodeVisit
@@ -48,7 +49,8 @@ UNITS: dict[str, str] = {
 
 def _format(f: h5py.File) -> str | None:
     fmt = f.attrs.get("format")
-    return fmt.decode() if isinstance(fmt, bytes) else fmt
+    fmt = fmt.decode(errors="replace") if isinstance(fmt, bytes) else fmt
+    return fmt if isinstance(fmt, str) else None
 
 
 def is_run_log(path: str | Path) -> bool:
@@ -59,7 +61,7 @@ def is_run_log(path: str | Path) -> bool:
     try:
         with h5py.File(path, "r") as f:
             return _format(f) == FORMAT
-    except OSError:
+    except H5_ERRORS:
         return False
 
 
@@ -108,32 +110,45 @@ def write_episode(group: h5py.Group, ep: Episode) -> None:
             _put(planned, label, getattr(ep.planned, label))
 
 
-def _text(values: h5py.Dataset) -> list[str]:
-    return [v.decode() if isinstance(v, bytes) else str(v) for v in values[()]]
+def _arrays(reader: H5Reader, group: h5py.Group, labels: tuple[str, ...]) -> list[np.ndarray]:
+    """Numeric datasets of ``group`` (each required; kinds and sizes checked first)."""
+    return [np.asarray(reader.dataset(group, label)) for label in labels]
 
 
-def read_episode(group: h5py.Group) -> Episode:
-    """The episode stored in ``group`` (KeyError for a missing dataset or attribute)."""
+def _texts(reader: H5Reader, group: h5py.Group, label: str) -> list[str]:
+    values = np.atleast_1d(np.asarray(reader.dataset(group, label, "OSU")))
+    return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
+
+
+def read_episode(reader: H5Reader, parent: h5py.Group, key: str) -> Episode:
+    """The episode stored in group ``key`` of ``parent`` (DatasetError for a group or dataset
+    of the wrong kind or size; KeyError, TypeError or ValueError for a missing or wrong
+    attribute)."""
     from teachfit.execution.recording import Episode
 
+    group = reader.group(parent, key)
     a = group.attrs
     log = ExecutionLog(
-        **{k: group[k][()].astype(int if k == "node" else float) for k in LOG_FIELDS}
+        **{
+            k: v.astype(int if k == "node" else float)
+            for k, v in zip(LOG_FIELDS, _arrays(reader, group, LOG_FIELDS), strict=True)
+        }
     )
-    vg = group["visits"]
+    vg = reader.group(group, "visits")
+    t_enter, t_exit = _arrays(reader, vg, ("t_enter", "t_exit"))
     visits = tuple(
         NodeVisit(n, float(t0), float(t1), why)
         for n, t0, t1, why in zip(
-            _text(vg["node"]), vg["t_enter"][()], vg["t_exit"][()], _text(vg["reason"]), strict=True
+            _texts(reader, vg, "node"), t_enter, t_exit, _texts(reader, vg, "reason"), strict=True
         )
     )
     result = ExecutionResult(
-        skill=str(a["skill"]),
-        outcome=Outcome(str(a["outcome"])),
-        reason=str(a["reason"]),
+        skill=reader.text(group, "skill"),
+        outcome=Outcome(reader.text(group, "outcome")),
+        reason=reader.text(group, "reason"),
         visits=visits,
         log=log,
-        node_names=tuple(json.loads(a["nodes"])),
+        node_names=tuple(json.loads(reader.text(group, "nodes"))),
         steps=int(a["steps"]),
         detected=_untri(a["detected"]),
         ground_truth_inserted=_untri(a["ground_truth_inserted"]),
@@ -145,8 +160,9 @@ def read_episode(group: h5py.Group) -> Episode:
         start = Pose(raw[:3], raw[3:])
     planned = None
     if "planned" in group:
-        p = group["planned"]
+        p = reader.group(group, "planned")
         planned = SetpointTrajectory(
-            *(p[k][()] for k in ("t", "pos", "quat", "wrench_ff")), name=str(p.attrs["name"])
+            *_arrays(reader, p, ("t", "pos", "quat", "wrench_ff")), name=reader.text(p, "name")
         )
-    return Episode(result, start, planned, json.loads(a["primitives"]), str(a["name"]))
+    primitives = json.loads(reader.text(group, "primitives"))
+    return Episode(result, start, planned, primitives, reader.text(group, "name"))
