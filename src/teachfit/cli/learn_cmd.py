@@ -61,7 +61,10 @@ def learn_skill(
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
     trials: Annotated[int, typer.Option(min=1, help="trials in all (restored trials count)")] = 130,
     study: Annotated[
-        str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")
+        str,
+        typer.Option(
+            help="study database: a file (SQLite) or a URL (postgresql://..., mysql://...)"
+        ),
     ] = "runs/study.db",
     resume: Annotated[bool, typer.Option(help="continue a stored study")] = False,
     workers: o.Workers = None,
