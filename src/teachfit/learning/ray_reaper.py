@@ -4,10 +4,10 @@ The kernel kills Ray's GCS server and raylet with the driver that started them, 
 the raylet starts (its agents, workers): after ``kill -9`` of the driver they wait a minute or
 more for the dead GCS server. :class:`Reaper` runs this file as a watchdog beside the driver,
 started before ``ray.init``: it notes every process the driver starts from then on (the
-driver's descendants, every :data:`SCAN_S` seconds) and, when the driver is done with Ray
-(:meth:`Reaper.stop`, after ``ray.shutdown()``) or dies (its end of a pipe closes), SIGKILLs
-those of them still running. A process is killed only if its start time is the one noted (a
-PID the system gave to another process since is left alone).
+driver's descendants, every :data:`SCAN_S` seconds and when asked, :meth:`Reaper.note`) and,
+when the driver is done with Ray (:meth:`Reaper.stop`, after ``ray.shutdown()``) or dies (its
+end of a pipe closes), SIGKILLs those of them still running. A process is killed only if its
+start time is the one noted (a PID the system gave to another process since is left alone).
 
 The watchdog uses the standard library only (it runs as ``python -I ray_reaper.py``), ignores
 Ctrl-C and SIGTERM sent to the driver's process group (the driver then stops Ray itself and
@@ -65,8 +65,11 @@ def _all_children() -> dict[int, list[int]]:
 
 
 def descendants(root: int) -> dict[int, int]:
-    """The live descendants of process ``root``: PID -> start time."""
+    """The live descendants of process ``root``: PID -> start time (none without ``/proc``:
+    there the watchdog watches nothing)."""
     me = os.getpid()
+    if not os.path.isdir(f"/proc/{me}"):
+        return {}
     if os.path.exists(f"/proc/{me}/task/{me}/children"):
         children = _children
     else:
@@ -106,8 +109,11 @@ def main() -> None:
     while True:
         readable, _, _ = select.select([sys.stdin], [], [], SCAN_S)
         seen.update((p, s) for p, s in descendants(driver).items() if p not in before)
-        if readable and not sys.stdin.readline():
-            break  # the driver closed its end: it is done with Ray, or dead
+        if readable:
+            if not sys.stdin.readline():
+                break  # the driver closed its end: it is done with Ray, or dead
+            sys.stdout.write("noted\n")  # asked by Reaper.note: all it started is noted
+            sys.stdout.flush()
     kill(seen)
 
 
@@ -122,12 +128,25 @@ class Reaper:
             stderr=subprocess.DEVNULL,
             text=True,
         )
-        assert self._proc.stdout is not None
-        ready = self._proc.stdout.readline().strip() == "ready"
-        self._proc.stdout.close()
-        if not ready:
+        if not self._ask("ready"):
             self.stop()
             raise OSError("the watchdog of the local Ray instance did not start")
+
+    def _ask(self, answer: str, question: str = "") -> bool:
+        assert self._proc.stdin is not None and self._proc.stdout is not None
+        try:
+            if question:
+                self._proc.stdin.write(question + "\n")
+                self._proc.stdin.flush()
+            return self._proc.stdout.readline().strip() == answer
+        except OSError:
+            return False
+
+    def note(self) -> None:
+        """Return once the watchdog has noted every process started so far (after
+        ``ray.init``: the instance's servers and agents)."""
+        if not self._ask("noted", "note"):
+            raise OSError("the watchdog of the local Ray instance is gone")
 
     def stop(self) -> None:
         """Let the watchdog kill what is left of the instance (after ``ray.shutdown()``)
@@ -142,6 +161,8 @@ class Reaper:
         except subprocess.TimeoutExpired:
             self._proc.kill()
             self._proc.wait()
+        if self._proc.stdout is not None:
+            self._proc.stdout.close()
 
 
 if __name__ == "__main__":

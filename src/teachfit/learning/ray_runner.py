@@ -110,6 +110,7 @@ def _start_local(ray: ModuleType, workers: int | None, kwargs: dict[str, Any]) -
                 _system_config={"worker_niceness": 0},
                 **kwargs,
             )
+        reaper.note()  # the instance's processes: from now on none outlives this one
         node = ray.util.get_node_ip_address()
         if node != LOOPBACK:
             raise LearningError(
