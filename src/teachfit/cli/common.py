@@ -6,6 +6,7 @@ import functools
 import math
 import os
 import signal
+import typing
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, ParamSpec, TypeVar
@@ -13,6 +14,7 @@ from typing import Annotated, Any, ParamSpec, TypeVar
 import typer
 from rich.console import Console
 
+from teachfit.cli.options import Within
 from teachfit.core.errors import OutputError, TeachfitError
 
 console = Console()
@@ -112,6 +114,17 @@ def exit_on_sigterm() -> None:
     signal.signal(signal.SIGTERM, terminate)
 
 
+def ranges(func: Callable[..., object]) -> dict[str, Within]:
+    """The :class:`~teachfit.cli.options.Within` ranges of a command's options, by name."""
+    hints = typing.get_type_hints(func, include_extras=True)
+    return {
+        name: meta
+        for name, hint in hints.items()
+        for meta in getattr(hint, "__metadata__", ())
+        if isinstance(meta, Within)
+    }
+
+
 P = ParamSpec("P")
 R = TypeVar("R")
 
@@ -122,6 +135,8 @@ def guarded(func: Callable[P, R]) -> Callable[P, R]:
     @functools.wraps(func)
     def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
         try:
+            for name, within in ranges(func).items():
+                within.check("--" + name.replace("_", "-"), kwargs.get(name))
             for name, value in kwargs.items():
                 check_finite(value, name)
             for name in OUTPUT_OPTIONS.intersection(kwargs):

@@ -40,6 +40,20 @@ def _worker_counts(workers: str) -> list[int]:
     return counts
 
 
+def _check_ray(ray: str | None, workers: int | None) -> None:
+    """Refuse a malformed ``--ray`` address, a missing Ray or ``--workers 0`` with it."""
+    if ray is None:
+        return
+    from teachfit.learning.ray_runner import check_ray
+
+    check_ray(ray)
+    if workers == 0:
+        raise LearningError(
+            "--workers 0 runs trials in this process, not on Ray: give --workers 1 or more "
+            "with --ray, or leave --workers out"
+        )
+
+
 @guarded
 def learn_skill(
     task: Annotated[str, o.task("puzzle, key, peg, ... (teachfit tasks)")] = "puzzle",
@@ -47,7 +61,10 @@ def learn_skill(
     method: Annotated[str, typer.Option(help="cmaes, pso, bo or lhs")] = "cmaes",
     trials: Annotated[int, typer.Option(min=1, help="trials in all (restored trials count)")] = 130,
     study: Annotated[
-        str, typer.Option(help="study database: file (SQLite) or SQLAlchemy URL")
+        str,
+        typer.Option(
+            help="study database: a file (SQLite) or a URL (postgresql://..., mysql://...)"
+        ),
     ] = "runs/study.db",
     resume: Annotated[bool, typer.Option(help="continue a stored study")] = False,
     workers: o.Workers = None,
@@ -79,9 +96,12 @@ def learn_skill(
     from teachfit.bench.learning import method_options
     from teachfit.learning.objective import SkillObjective
     from teachfit.learning.runner import Interrupts, run_study
+    from teachfit.learning.storage import check_storage, params_path
     from teachfit.learning.study import METHODS, Study, StudyMismatchError, stored_tags
     from teachfit.tasks.registry import get_task
 
+    check_storage(study)  # an unknown scheme or a missing driver: before any work
+    _check_ray(ray, workers)
     if trials < 1:
         raise LearningError(f"--trials must be >= 1, got {trials}")
     if method not in METHODS:
@@ -127,7 +147,7 @@ def learn_skill(
     where = f"Ray at {ray}" if ray else f"{'all cores' if workers is None else workers} worker(s)"
     console.print(
         f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
-        f"per trial) -> {st.url}; {st.n_restored} trial(s) restored; {where}"
+        f"per trial) -> {st.where}; {st.n_restored} trial(s) restored; {where}"
     )
     if st.n_finished >= trials:
         console.print(
@@ -166,8 +186,8 @@ def learn_skill(
                     f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
                     f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials"
                 )
-            if out is None and "://" not in study:
-                out = Path(study).with_suffix(".params.toml")
+            if out is None:
+                out = params_path(study)
             if st.n_finished:
                 _report_best(
                     st,
@@ -313,6 +333,7 @@ def bench_learning(
     from teachfit.learning.objective import SkillObjective
 
     _worker_counts(scaling_workers)  # refused before any work, with --scaling or not
+    _check_ray(ray, workers)
     if scaling:
         _bench_scaling(tasks, scaling_workers, scaling_trials, starts, seed, ray, markdown)
         return

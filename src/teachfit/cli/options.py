@@ -14,6 +14,7 @@ working: ``-n`` (now ``--points`` or ``--count``), ``--write`` (now ``--markdown
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -57,6 +58,27 @@ CANONICAL: dict[str, tuple[str, str]] = {
     "--skill": ("text", "skill: built-in name or skill .toml"),
     "--task-params": ("path", "task parameter overrides from a TOML file"),
 }
+
+
+@dataclass(frozen=True)
+class Within:
+    """The valid range of an integer option, as ``Annotated`` metadata beside its
+    ``typer.Option``: :func:`teachfit.cli.common.guarded` refuses a value outside it in one line
+    (exit 2), where typer's own ``min``/``max`` print a usage panel."""
+
+    low: int
+    high: int | None = None
+    note: str = ""
+
+    def check(self, flag: str, value: object) -> None:
+        """Raise a :class:`TeachfitError` naming ``flag`` and the range if ``value`` is out."""
+        if not isinstance(value, int) or (
+            self.low <= value and (self.high is None or value <= self.high)
+        ):
+            return
+        span = f">= {self.low}" if self.high is None else f"from {self.low} to {self.high}"
+        note = f" ({self.note})" if self.note else ""
+        raise TeachfitError(f"{flag} {value}: give an integer {span}{note}")
 
 
 def old(flag: str, new: str) -> Any:
@@ -159,7 +181,8 @@ Overwrite = Annotated[bool, typer.Option(help="replace an existing file")]
 Append = Annotated[bool, typer.Option(help="append to an existing file")]
 Workers = Annotated[
     int | None,
-    typer.Option(min=0, help="worker processes (default: all cores; 0: in this process)"),
+    typer.Option(help="worker processes (default: all cores; 0: in this process)"),
+    Within(0, note="0: trials in this process"),
 ]
 Fps = Annotated[int, typer.Option(min=1, max=240, help="video frames per second")]
 Width = Annotated[int, typer.Option(min=16, max=7680, help="video width (px)")]
@@ -187,6 +210,7 @@ __all__ = [
     "TaskParams",
     "View",
     "Width",
+    "Within",
     "Workers",
     "WriteOld",
     "old",

@@ -8,26 +8,37 @@ or a non-finite cost in the objective, or a worker process that dies, fails only
 trials finish; a second cancels them and raises ``KeyboardInterrupt``.
 
 ``address``: ``"local"`` starts a private local Ray instance (``workers`` CPUs, default all
-cores) and shuts it down afterwards; anything else (``"auto"``, ``"HOST:PORT"``,
-``"ray://HOST:10001"``) connects to a running cluster. If Ray is already initialised in this
-process it is used as it is. The objective must be picklable and importable on the workers
-(e.g. :class:`~teachfit.learning.objective.SkillObjective` with teachfit installed there).
+cores) and shuts it down afterwards. Its processes listen on 127.0.0.1 only (Ray would pick
+the address other machines reach this one at, and listen on all interfaces), and they end
+with this process even after ``kill -9`` (:mod:`teachfit.learning.ray_reaper`). Anything else
+(``"auto"``, ``"HOST:PORT"``, ``"ray://HOST:10001"``) connects to a running cluster. If Ray is
+already initialised in this process it is used as it is. The objective must be picklable and
+importable on the workers (e.g. :class:`~teachfit.learning.objective.SkillObjective` with
+teachfit installed there).
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import os
 import socket
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
 from teachfit.core.params import LearningError
 from teachfit.learning.base import Candidate, TrialResult
+from teachfit.learning.ray_reaper import Reaper
 from teachfit.learning.runner import POLL_S, Interrupts, Objective, RunReport, evaluate
 from teachfit.learning.study import Study, TrialRecord
+
+#: the address a local Ray instance listens on
+LOOPBACK = "127.0.0.1"
+
+_NO_RAY = "--ray needs the optional Ray extra: pip install 'teachfit[ray]' (or ray>=2.9)"
 
 
 def import_ray() -> ModuleType:
@@ -35,29 +46,90 @@ def import_ray() -> ModuleType:
     try:
         return importlib.import_module("ray")
     except ImportError as exc:
-        raise LearningError(
-            "--ray needs the optional Ray extra: pip install 'teachfit[ray]' (or ray>=2.9)"
-        ) from exc
+        raise LearningError(_NO_RAY) from exc
+
+
+def _host_port(address: str) -> tuple[str, int] | None:
+    """``(host, port)`` of a cluster address; ``None`` for ``local`` and ``auto``."""
+    if address in ("", "local", "auto"):
+        return None
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise LearningError(f"a Ray address is 'local', 'auto' or HOST:PORT, got {address!r}")
+    return host, int(port)
+
+
+def check_ray(address: str) -> None:
+    """Refuse, before any work, a malformed Ray ``address`` or a missing Ray (one line)."""
+    _host_port(address)
+    if importlib.util.find_spec("ray") is None:
+        raise LearningError(_NO_RAY)
 
 
 def _check_reachable(address: str, timeout: float = 5.0) -> None:
     """Fail fast on a ``HOST:PORT`` (or ``ray://HOST:PORT``) nobody listens on: Ray itself
     retries a missing head node for minutes."""
-    if address in ("", "local", "auto"):
+    where = _host_port(address)
+    if where is None:
         return
-    host, _, port = address.removeprefix("ray://").rpartition(":")
-    if not host or not port.isdigit():
-        raise LearningError(f"a Ray address is 'local', 'auto' or HOST:PORT, got {address!r}")
+    host, port = where
     try:
-        socket.create_connection((host, int(port)), timeout=timeout).close()
+        socket.create_connection((host, port), timeout=timeout).close()
     except OSError as exc:
         raise LearningError(f"no Ray cluster reachable at {address!r}: {exc}") from exc
 
 
-def _init(ray: ModuleType, address: str, workers: int | None) -> bool:
-    """Initialise Ray unless it is; True if this call started it (and must shut it down)."""
+@contextmanager
+def _loopback(ray: ModuleType) -> Iterator[None]:
+    """Within: Ray gives a node it starts the loopback address (as it does on macOS and
+    Windows), not the one other machines reach it at; its servers then listen on 127.0.0.1."""
+    consts = getattr(getattr(ray, "_private", None), "ray_constants", None)
+    was = getattr(consts, "ENABLE_RAY_CLUSTER", None)
+    if was is not None:
+        consts.ENABLE_RAY_CLUSTER = False
+    try:
+        yield
+    finally:
+        if was is not None:
+            consts.ENABLE_RAY_CLUSTER = was
+
+
+def _start_local(ray: ModuleType, workers: int | None, kwargs: dict[str, Any]) -> Reaper:
+    """Start a local instance on 127.0.0.1, watched by a :class:`Reaper` (returned)."""
+    reaper = Reaper()
+    try:
+        with _loopback(ray):
+            # trials are this instance's work: Ray starts its workers at nice 15, where beside
+            # any busy process at normal priority they get next to no CPU (the 12-trial test
+            # study beside three busy processes on 2 cores: 347 s, 160 s of it per worker
+            # start; at nice 0 27 s, 15 s alone); a cluster's own settings are left alone
+            ray.init(
+                num_cpus=workers or os.cpu_count() or 1,
+                _node_ip_address=LOOPBACK,
+                dashboard_host=LOOPBACK,
+                _system_config={"worker_niceness": 0},
+                **kwargs,
+            )
+        reaper.note()  # the instance's processes: from now on none outlives this one
+        node = ray.util.get_node_ip_address()
+        if node != LOOPBACK:
+            raise LearningError(
+                f"Ray {ray.__version__} gave the local instance the address {node}, not "
+                f"{LOOPBACK}: start a cluster on {LOOPBACK} (ray start --head "
+                f"--node-ip-address {LOOPBACK}) and give its address to --ray"
+            )
+    except BaseException:
+        ray.shutdown()
+        reaper.stop()
+        raise
+    return reaper
+
+
+def _init(ray: ModuleType, address: str, workers: int | None) -> tuple[bool, Reaper | None]:
+    """Initialise Ray unless it is: ``(started, reaper)``, ``started`` if this call started
+    or connected it (and must shut it down), ``reaper`` watching a local instance it started."""
     if ray.is_initialized():
-        return False
+        return False, None
     kwargs: dict[str, Any] = dict(
         include_dashboard=False, log_to_driver=False, configure_logging=False
     )
@@ -65,20 +137,13 @@ def _init(ray: ModuleType, address: str, workers: int | None) -> bool:
     _check_reachable(address)
     try:
         if address in ("", "local"):
-            # trials are this instance's work: Ray starts its workers at nice 15, where beside
-            # any busy process at normal priority they get next to no CPU (the 12-trial test
-            # study beside three busy processes on 2 cores: 347 s, 160 s of it per worker
-            # start; at nice 0 27 s, 15 s alone); a cluster's own settings are left alone
-            ray.init(
-                num_cpus=workers or os.cpu_count() or 1,
-                _system_config={"worker_niceness": 0},
-                **kwargs,
-            )
-        else:
-            ray.init(address=address, **kwargs)
+            return True, _start_local(ray, workers, kwargs)
+        ray.init(address=address, **kwargs)
+    except LearningError:
+        raise
     except Exception as exc:  # connection refused, bad address, ...
         raise LearningError(f"cannot start or reach Ray at {address!r}: {exc}") from exc
-    return True
+    return True, None
 
 
 def run_study_ray(
@@ -100,7 +165,7 @@ def run_study_ray(
         raise LearningError(f"workers must be >= 1 with Ray, got {workers}")
     ray = import_ray()
     t0 = time.perf_counter()
-    started = _init(ray, address, workers)
+    started, reaper = _init(ray, address, workers)
     restored, here, failed = study.n_finished, study.n_here, 0
     pending: dict[Any, Candidate] = {}
     try:
@@ -143,4 +208,6 @@ def run_study_ray(
     finally:
         if started:
             ray.shutdown()
+        if reaper is not None:
+            reaper.stop()  # what the shutdown left of the local instance is killed
     return RunReport(restored, study.n_here - here, failed, interrupted, time.perf_counter() - t0)

@@ -1,9 +1,10 @@
 """A learning study: every finished trial stored at once in an Optuna storage, resumable.
 
-The storage is any SQLAlchemy URL Optuna accepts, or a file path meaning
-``sqlite:///<path>``. A study is tagged (Optuna study user attributes) with the task and skill
-names, the method, its seed and options, the parameter space and the failure penalty; opening a
-stored study with other tags is a :class:`StudyMismatchError` naming what differs.
+The storage is a database URL (SQLite, PostgreSQL or MySQL) or a file path meaning an SQLite
+database at exactly that name (:mod:`teachfit.learning.storage`). A study is tagged (Optuna
+study user attributes) with the task and skill names, the method, its seed and options, the
+parameter space and the failure penalty; opening a stored study with other tags is a
+:class:`StudyMismatchError` naming what differs.
 
 Each finished trial is written with :meth:`optuna.study.Study.add_trial` the moment it is told
 (one committed transaction), with its physical parameters, cost, and as user attributes the
@@ -37,7 +38,6 @@ from optuna.distributions import FloatDistribution
 from optuna.exceptions import StorageInternalError
 from sqlalchemy.exc import DBAPIError
 
-from teachfit.core.atomic import ensure_folder
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
@@ -45,6 +45,7 @@ from teachfit.learning.claims import Claim, Claims, Verdict, engine_kwargs, seri
 from teachfit.learning.cmaes import CMAES
 from teachfit.learning.lhs import LatinHypercube
 from teachfit.learning.pso import PSO
+from teachfit.learning.storage import is_url, shown, storage_url
 
 METHODS = ("cmaes", "pso", "bo", "lhs")
 
@@ -101,34 +102,11 @@ def make_learner(
     raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
 
 
-def storage_url(storage: str | Path) -> str:
-    """An SQLAlchemy URL as is; anything else is a file path for an SQLite database."""
-    text = str(storage)
-    if "://" in text:
-        return text
-    path = Path(text).expanduser().resolve()
-    if path.is_dir():
-        raise LearningError(f"study file {text} is a folder; give a file name (e.g. runs/s.db)")
-    if path.is_file() and path.stat().st_size > 0:
-        try:
-            with path.open("rb") as fh:
-                header = fh.read(16)
-        except OSError as exc:
-            raise LearningError(f"cannot read study file {text}: {exc.strerror}") from exc
-        if header != b"SQLite format 3\x00":
-            raise LearningError(
-                f"study file {text} is not an SQLite database; give a new file name, an "
-                "existing study, or an SQLAlchemy URL"
-            )
-    ensure_folder(path.parent, f"the folder of study file {text}")
-    return f"sqlite:///{path}"
-
-
 def stored_tags(storage: str | Path, name: str = "teachfit") -> dict[str, Any] | None:
     """The tags of study ``name`` in ``storage`` (task, skill, method, options, ...), or
     ``None`` if there is no such study."""
     optuna.logging.set_verbosity(optuna.logging.WARNING)
-    if "://" not in str(storage) and not Path(storage).expanduser().exists():
+    if not is_url(storage) and not Path(storage).expanduser().exists():
         return None  # a file that does not exist yet holds no study: do not create it here
     try:
         study = _retry(
@@ -201,6 +179,8 @@ class Study:
         if not claim_timeout > 0:
             raise LearningError(f"claim_timeout must be > 0 s, got {claim_timeout}")
         self.url = storage_url(storage)
+        #: the storage as a person reads it (a file's path; a URL without its password)
+        self.where = shown(self.url)
         self.space = space
         self.penalty = float(penalty)
         tags: dict[str, Any] = {
@@ -217,7 +197,7 @@ class Study:
         self.tags = tags
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self.learner = make_learner(method, space, seed, options)
-        what = f"study database {storage}"
+        what = f"study database {self.where}"
         rdb = _retry(
             lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url)),
             what=what,
@@ -248,10 +228,10 @@ class Study:
         diff = [k for k in tags if stored.get(k) != tags[k]]
         if diff:
             what = "; ".join(f"{k}: stored {stored.get(k)!r}, asked {tags[k]!r}" for k in diff)
-            raise StudyMismatchError(f"study {name!r} in {self.url} differs: {what}")
+            raise StudyMismatchError(f"study {name!r} in {self.where} differs: {what}")
         if finished and not resume:
             raise LearningError(
-                f"study {name!r} in {self.url} already has {len(finished)} trials: resume it "
+                f"study {name!r} in {self.where} already has {len(finished)} trials: resume it "
                 "(--resume) or choose another study"
             )
         self.learner.restore([_finished(t) for t in finished])
