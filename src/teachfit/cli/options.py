@@ -174,9 +174,13 @@ ModelArgOld = Annotated[
 Render = Annotated[Path | None, typer.Option("--render", help="video (mp4) to write")]
 Markdown = Annotated[
     Path | None,
-    typer.Option("--markdown", help="append the results as markdown to this file (BENCHMARKS.md)"),
+    typer.Option(
+        "--markdown",
+        help="append the results as markdown to this file, with where they came from "
+        "(benchmarks/results/NAME.md feeds BENCHMARKS.md)",
+    ),
 ]
-WriteOld = Annotated[bool, old("--write", "--markdown BENCHMARKS.md")]
+WriteOld = Annotated[bool, old("--write", "--markdown benchmarks/results/NAME.md")]
 Overwrite = Annotated[bool, typer.Option(help="replace an existing file")]
 Append = Annotated[bool, typer.Option(help="append to an existing file")]
 Workers = Annotated[

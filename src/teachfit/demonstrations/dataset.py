@@ -37,6 +37,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from teachfit.core.errors import DatasetError
 from teachfit.core.geometry import Pose, rotation_to_wxyz, wxyz_to_rotation
 from teachfit.core.h5file import H5Reader, open_hdf5, shown, write_hdf5
+from teachfit.demonstrations.rawlog import sampling_rate
 
 SOURCES: tuple[str, ...] = (
     "simulated-teacher",
@@ -495,7 +496,9 @@ def read_demos(spec: str | Path) -> list[Demonstration]:
 
 def dataset_summary(path: str | Path) -> list[dict[str, Any]]:
     """One row per demonstration for a table: index, name, task, source, samples, duration (s),
-    rate (Hz)."""
+    rate (Hz: the stored ``meta["rate_hz"]`` of an import, else the nearest plain rate that
+    the time steps support, :func:`~teachfit.demonstrations.rawlog.sampling_rate`)."""
+
     return [
         {
             "index": i,
@@ -504,7 +507,7 @@ def dataset_summary(path: str | Path) -> list[dict[str, Any]]:
             "source": d.source,
             "samples": d.n_samples,
             "duration": d.duration,
-            "rate": d.rate_hz,
+            "rate": float(d.meta.get("rate_hz", sampling_rate(d.t))),
         }
         for i, d in enumerate(read_dataset(path))
     ]
