@@ -33,6 +33,7 @@ from teachfit.bench.learning_table import (
 )
 from teachfit.core.params import LearningError
 from teachfit.learning.curves import Band, band, best_so_far, first_feasible
+from teachfit.learning.launch import method_options
 from teachfit.learning.objective import SkillObjective
 from teachfit.learning.runner import run_study
 from teachfit.learning.study import METHODS, Study, TrialRecord
@@ -56,16 +57,6 @@ __all__ = [
 
 class BenchInterrupted(LearningError):
     """An experiment of the bench was interrupted (SIGINT / SIGTERM) before its budget."""
-
-
-def method_options(method: str, trials: int) -> dict[str, object]:
-    """Learner options the bench uses: LHS designs ``trials`` points, BO starts with
-    ``min(10, trials // 4)`` random trials (at least 2); CMA-ES and PSO keep their defaults."""
-    if method == "lhs":
-        return {"n": int(trials)}
-    if method == "bo":
-        return {"n_startup": max(2, min(10, trials // 4))}
-    return {}
 
 
 @dataclass(frozen=True)

@@ -1,10 +1,10 @@
-"""``teachfit learn skill`` and ``teachfit bench learning``: seed B's meta learning."""
+"""``teachfit learn skill`` and ``teachfit bench learning``: Johannsmeier et al.'s meta learning."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
@@ -21,6 +21,11 @@ from teachfit.cli.common import (
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_markdown, print_table
 from teachfit.core.params import LearningError
+
+if TYPE_CHECKING:
+    from teachfit.bench.learning import LearningBench
+    from teachfit.learning.launch import Launch
+    from teachfit.learning.study import TrialRecord
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
 _TASK_PARAM = o.TASK_PARAM
@@ -40,20 +45,7 @@ def _worker_counts(workers: str) -> list[int]:
     return counts
 
 
-def _check_ray(ray: str | None, workers: int | None) -> None:
-    """Refuse a malformed ``--ray`` address, a missing Ray or ``--workers 0`` with it."""
-    if ray is None:
-        return
-    from teachfit.learning.ray_runner import check_ray
-
-    check_ray(ray)
-    if workers == 0:
-        raise LearningError(
-            "--workers 0 runs trials in this process, not on Ray: give --workers 1 or more "
-            "with --ray, or leave --workers out"
-        )
-
-
+# long only by the declarations of its options: the body parses, calls and prints
 @guarded
 def learn_skill(
     task: Annotated[str, o.task("puzzle, key, peg, ... (teachfit tasks)")] = "puzzle",
@@ -93,58 +85,17 @@ def learn_skill(
     realtime: RealtimeOpt = True,
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
-    from teachfit.bench.learning import method_options
-    from teachfit.learning.objective import SkillObjective
-    from teachfit.learning.runner import Interrupts, run_study
-    from teachfit.learning.storage import check_storage, params_path
-    from teachfit.learning.study import METHODS, Study, StudyMismatchError, stored_tags
-    from teachfit.tasks.registry import get_task
+    from teachfit.learning.launch import LearnRequest, open_learning
 
-    check_storage(study)  # an unknown scheme or a missing driver: before any work
-    _check_ray(ray, workers)
-    if trials < 1:
-        raise LearningError(f"--trials must be >= 1, got {trials}")
-    if method not in METHODS:
-        raise LearningError(f"unknown learning method {method!r}; known: {list(METHODS)}")
-    get_task(task)  # an unknown task fails here, before any study file is created
-    from teachfit.robot.registry import ROBOTS
-
-    if robot in ROBOTS and not ROBOTS[robot].simulated:
-        if ray:
-            raise LearningError(f"--ray runs trials in parallel: not on the one real {robot}")
-        if workers != 0:
-            console.print(f"note: trials on the real {robot} run one at a time, in this process")
-        workers = 0  # one arm: trials cannot run in parallel worker processes
-    obj = SkillObjective(
-        task, skill, controller, seed, starts, _overrides(task_param), robot, host or "", realtime
-    )
-    tags = stored_tags(study)  # resuming keeps the stored options (e.g. the LHS design size)
-    same = tags is not None and tags.get("method") == method
-    options = tags.get("options", {}) if same else method_options(method, trials)
-    if same and method == "lhs" and int(options.get("n", trials)) < trials:
-        raise LearningError(
-            f"the stored Latin hypercube has {options.get('n')} points; --trials {trials} "
-            "cannot extend it (a new design needs a new --study)"
-        )
-    try:
-        st = Study(
-            study,
-            task=task,
-            skill=obj.trial().setup.skill.name,
-            space=obj.space,
-            method=method,
-            seed=seed,
-            options=options,
-            penalty=obj.penalty,
-            resume=resume,
-            context=obj.context(),
-        )
-    except StudyMismatchError as exc:
-        raise StudyMismatchError(
-            f"{exc} -- this database holds another study; choose "
-            "another --study or the same settings"
-        ) from exc
-    where = f"Ray at {ray}" if ray else f"{'all cores' if workers is None else workers} worker(s)"
+    req = LearnRequest(
+        task, skill, method, trials, study, resume, workers, ray, controller, seed, starts,
+        _overrides(task_param), robot, host or "", realtime,
+    )  # fmt: skip
+    launch = open_learning(req)
+    for note in launch.notes:
+        console.print(f"note: {note}")
+    st, obj, n_w = launch.study, launch.objective, launch.workers
+    where = f"Ray at {ray}" if ray else f"{'all cores' if n_w is None else n_w} worker(s)"
     console.print(
         f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
         f"per trial) -> {st.where}; {st.n_restored} trial(s) restored; {where}"
@@ -154,6 +105,21 @@ def learn_skill(
             f"[yellow]the study already holds {st.n_finished} trial(s) >= --trials "
             f"{trials}[/]: nothing to run; raise --trials to continue"
         )
+    title = f"{method} on {task}, seed {seed}, {starts} start(s) per trial"
+    figures = (plot, traces, best_plot)
+    _run_and_report(launch, out, figures, title)
+
+
+def _run_and_report(
+    launch: Launch, out: Path | None, figures: tuple[Path | None, ...], title: str
+) -> None:
+    """Run the trials with a progress bar, then report the best; Ctrl-C stops cleanly."""
+    from teachfit.learning.launch import run_learning
+    from teachfit.learning.runner import Interrupts
+    from teachfit.learning.storage import params_path
+
+    req, st = launch.request, launch.study
+    method, task, trials = req.method, req.task, req.trials
     # one guard for the run and the report: a second Ctrl-C while the report is written
     # (after a first one ended the run) still aborts with the clear line below
     with Interrupts():
@@ -163,19 +129,12 @@ def learn_skill(
                 done = min(st.n_finished, trials)
                 job = bar.add_task(f"{method} {task}", total=trials, completed=done)
 
-                def progress(rec: object) -> None:
-                    if rec.feasible:  # type: ignore[attr-defined]
-                        best[0] = min(best[0], rec.cost)  # type: ignore[attr-defined]
+                def progress(rec: TrialRecord) -> None:
+                    if rec.feasible:
+                        best[0] = min(best[0], rec.cost)
                     bar.update(job, advance=1, description=f"{method} {task} best {best[0]:.3f} s")
 
-                if ray:
-                    from teachfit.learning.ray_runner import run_study_ray
-
-                    rep = run_study_ray(
-                        st, obj, trials, address=ray, workers=workers, on_trial=progress
-                    )
-                else:
-                    rep = run_study(st, obj, trials, workers=workers, on_trial=progress)
+                rep = run_learning(launch, on_trial=progress)
             console.print(
                 f"{rep.finished} trial(s) in {rep.wall_s:.1f} s ({rep.trials_per_s:.2f} "
                 f"trials/s), {rep.failed} failed by crash/divergence; study holds "
@@ -184,20 +143,12 @@ def learn_skill(
             if not rep.interrupted and st.n_finished < trials:
                 console.print(
                     f"[yellow]the {method} learner has nothing more to ask[/] (e.g. a Latin "
-                    f"hypercube of {options.get('n', '?')} points) after {st.n_finished} trials"
+                    f"hypercube of {launch.options.get('n', '?')} points) after "
+                    f"{st.n_finished} trials"
                 )
-            if out is None:
-                out = params_path(study)
             if st.n_finished:
-                _report_best(
-                    st,
-                    obj,
-                    out,
-                    plot,
-                    traces,
-                    best_plot,
-                    f"{method} on {task}, seed {seed}, {starts} start(s) per trial",
-                )
+                path = params_path(req.study) if out is None else out
+                _report_best(st, launch.objective, path, *figures, title)
             if rep.interrupted:
                 console.print(
                     f"[yellow]stopped[/] after {st.n_finished} stored trial(s); continue "
@@ -264,6 +215,7 @@ def _report_best(
         console.print(f"best execution -> {path}")
 
 
+# long by the declarations of its options; the grid, target and speed-up are in bench/
 @guarded
 def bench_learning(
     tasks: Annotated[
@@ -324,16 +276,13 @@ def bench_learning(
         ),
     ] = Path("out/bench_learning/studies"),
 ) -> None:
-    """Seed B's Fig. 6 over tasks x methods x experiments, with timings."""
+    """Johannsmeier et al.'s Fig. 6 over tasks x methods x experiments, with timings."""
     import os
 
-    from teachfit.bench import learning as bl
-    from teachfit.bench import learning_scaling as ls
-    from teachfit.bench.learning_random import cpu_seconds
-    from teachfit.learning.objective import SkillObjective
+    from teachfit.learning.launch import check_ray_workers
 
     _worker_counts(scaling_workers)  # refused before any work, with --scaling or not
-    _check_ray(ray, workers)
+    check_ray_workers(ray, workers)
     if scaling:
         _bench_scaling(tasks, scaling_workers, scaling_trials, starts, seed, ray, markdown)
         return
@@ -342,78 +291,15 @@ def bench_learning(
     if random_rate:
         _bench_random(task_list, random_rate, experiments, starts, seed, task_param, workers)
         return
-    method_list = [m for m in methods.split(",") if m]
-    total = len(task_list) * len(method_list) * experiments * trials
-    ran = [0]
-    cpu0 = cpu_seconds()
-
-    def tick(label: str) -> None:
-        ran[0] += 1
-        bar.update(job, advance=1, description=label)
-
-    with progress_bar() as bar:
-        job = bar.add_task("learning", total=total)
-        res = bl.run_learning_bench(
-            task_list,
-            method_list,
-            experiments,
-            trials,
-            workers=workers,
-            n_starts=starts,
-            controller=controller,
-            seed=seed,
-            overrides=dict(_overrides(task_param)),
-            on_trial=lambda label, _r: tick(label),
-            robot=robot,
-            ray=ray,
-            studies=out,
-        )
-    cpu = cpu_seconds() - cpu0
-    extra = "".join(f" --task-param {p}" for p in task_param or [])
-    done = sum(len(e.costs) for e in res.experiments)
-    kept = (
-        f", {done - ran[0]} trials resumed from {out}: wall and trials/s count the others"
-        if done > ran[0]
-        else ""
-    )
-    execs = ran[0] * starts
-    text = (
-        f"`teachfit bench learning --tasks {tasks} --methods {methods} --experiments "
-        f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
-        f"{os.cpu_count()} cores, {res.wall_s:.0f} s wall and {cpu:.0f} CPU-s in all, "
-        f"{execs} executions: {execs / cpu if cpu > 0 else math.nan:.2f} per CPU-s, "
-        f"learners included{kept})\n\n" + bl.to_markdown(res)
-    )
+    res, text = _run_grid(
+        task_list, [m for m in methods.split(",") if m], experiments, trials, workers, starts,
+        controller, seed, task_param, robot, ray, out,
+    )  # fmt: skip
     n_w = workers or os.cpu_count() or 1
     if target:
-        done = [e for e in res.experiments if e.task == "puzzle" and e.method == "cmaes"]
-        if done and trials == 130 and starts == 4 and done[0].restored:
-            wall = math.nan  # resumed from --out: its wall time is not the whole run's
-        elif done and trials == 130 and starts == 4:
-            wall = done[0].wall_s
-        else:
-            with console.status("130-trial x 4-start CMA-ES on puzzle"):
-                wall = bl.run_experiment(
-                    SkillObjective("puzzle", seed=seed), "cmaes", 130, workers=workers
-                ).wall_s
-        verdict = "meets" if wall <= 300 else "misses"
-        text += (
-            f"\nCMA-ES, 130 trials x 4 starts on puzzle: {wall:.1f} s wall "
-            f"({130 / wall:.2f} trials/s, {n_w} workers) -- {verdict} the 5-minute target\n"
-            if math.isfinite(wall)
-            else "\nCMA-ES puzzle 5-minute target: not timed (its experiment was resumed)\n"
-        )
+        text += _target_text(res, trials, starts, seed, workers, n_w)
     if speedup_trials > 0 and n_w > 1:
-        with console.status(f"speed-up: {speedup_trials} trials with 1 and {n_w} workers"):
-            t1, tn, ratio = ls.speedup(
-                trials=speedup_trials, workers=n_w, seed=seed, n_starts=starts
-            )
-        text += (
-            f"\nspeed-up, {speedup_trials}-trial x {starts}-start CMA-ES puzzle study "
-            f"(fastest of 2 alternating runs each): 1 worker {t1:.1f} s, {n_w} workers "
-            f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
-            f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n"
-        )
+        text += _speedup_text(speedup_trials, n_w, seed, starts)
     print_markdown(text)  # tables drawn for the terminal; --markdown keeps the source
     if plot is not None:
         from teachfit.viz.learning_figures import plot_learning_curves
@@ -425,6 +311,88 @@ def bench_learning(
         console.print(f"learning curves -> {path}")
     if markdown is not None:
         console.print(f"markdown appended to {append_markdown(markdown, text)}")
+
+
+def _run_grid(
+    task_list: list[str], method_list: list[str], experiments: int, trials: int,
+    workers: int | None, starts: int, controller: str, seed: int, task_param: list[str] | None,
+    robot: str, ray: str | None, out: Path | None,
+) -> tuple[LearningBench, str]:  # fmt: skip
+    """The grid with a progress bar, and its table headed by the command and its costs."""
+    import os
+
+    from teachfit.bench import learning as bl
+    from teachfit.bench.learning_random import cpu_seconds
+
+    total = len(task_list) * len(method_list) * experiments * trials
+    ran = [0]
+    cpu0 = cpu_seconds()
+
+    def tick(label: str) -> None:
+        ran[0] += 1
+        bar.update(job, advance=1, description=label)
+
+    with progress_bar() as bar:
+        job = bar.add_task("learning", total=total)
+        res = bl.run_learning_bench(
+            task_list, method_list, experiments, trials, workers=workers, n_starts=starts,
+            controller=controller, seed=seed, overrides=dict(_overrides(task_param)),
+            on_trial=lambda label, _r: tick(label), robot=robot, ray=ray, studies=out,
+        )  # fmt: skip
+    cpu = cpu_seconds() - cpu0
+    extra = "".join(f" --task-param {p}" for p in task_param or [])
+    done = sum(len(e.costs) for e in res.experiments)
+    kept = f", {done - ran[0]} trials resumed from {out}: wall and trials/s count the others"
+    execs = ran[0] * starts
+    text = (
+        f"`teachfit bench learning --tasks {','.join(task_list)} --methods "
+        f"{','.join(method_list)} --experiments "
+        f"{experiments} --trials {trials} --starts {starts}{extra}` ({res.workers} workers, "
+        f"{os.cpu_count()} cores, {res.wall_s:.0f} s wall and {cpu:.0f} CPU-s in all, "
+        f"{execs} executions: {execs / cpu if cpu > 0 else math.nan:.2f} per CPU-s, "
+        f"learners included{kept if done > ran[0] else ''})\n\n" + bl.to_markdown(res)
+    )
+    return res, text
+
+
+def _target_text(
+    res: LearningBench, trials: int, starts: int, seed: int, workers: int | None, n_w: int
+) -> str:
+    """The 5-minute target of a 130-trial x 4-start CMA-ES puzzle experiment: the grid's own
+    when it ran one, else one timed here."""
+    from teachfit.bench import learning as bl
+    from teachfit.learning.objective import SkillObjective
+
+    done = [e for e in res.experiments if e.task == "puzzle" and e.method == "cmaes"]
+    if done and trials == 130 and starts == 4 and done[0].restored:
+        return "\nCMA-ES puzzle 5-minute target: not timed (its experiment was resumed)\n"
+    if done and trials == 130 and starts == 4:
+        wall = done[0].wall_s
+    else:
+        with console.status("130-trial x 4-start CMA-ES on puzzle"):
+            obj = SkillObjective("puzzle", seed=seed)
+            wall = bl.run_experiment(obj, "cmaes", 130, workers=workers).wall_s
+    verdict = "meets" if wall <= 300 else "misses"
+    return (
+        f"\nCMA-ES, 130 trials x 4 starts on puzzle: {wall:.1f} s wall "
+        f"({130 / wall:.2f} trials/s, {n_w} workers) -- {verdict} the 5-minute target\n"
+    )
+
+
+def _speedup_text(trials: int, n_w: int, seed: int, starts: int) -> str:
+    """The speed-up of a CMA-ES puzzle study from 1 to ``n_w`` workers."""
+    import os
+
+    from teachfit.bench import learning_scaling as ls
+
+    with console.status(f"speed-up: {trials} trials with 1 and {n_w} workers"):
+        t1, tn, ratio = ls.speedup(trials=trials, workers=n_w, seed=seed, n_starts=starts)
+    return (
+        f"\nspeed-up, {trials}-trial x {starts}-start CMA-ES puzzle study "
+        f"(fastest of 2 alternating runs each): 1 worker {t1:.1f} s, {n_w} workers "
+        f"{tn:.1f} s: x{ratio:.2f} (ideal x{n_w}; 1-min load average "
+        f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)\n"
+    )
 
 
 def _bench_scaling(
