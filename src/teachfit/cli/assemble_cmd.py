@@ -13,6 +13,7 @@ from rich.table import Table
 from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.run_end import exit_if_faulted, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
 
@@ -68,7 +69,9 @@ def assemble(
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
-    """Assemble over trials: taught hole -> approach -> skill -> learned search recovery."""
+    """Assemble over trials: taught hole -> approach -> skill -> learned search recovery.
+
+    Exit status 1 when the robot stopped a trial (each reason is printed; see ``run_end``)."""
     from teachfit.metrics.stats import summarize
     from teachfit.robot.registry import ROBOTS
 
@@ -132,6 +135,7 @@ def assemble(
     s = summarize([t.success for t in out], [t.time for t in out])
     searched = sum("search" in t.nodes for t in out)
     console.print(f"success {s}; the search ran in {searched}/{len(out)} trial(s)")
+    faulted = report_faults(((t.index, *t.reason.partition(": ")[::2]) for t in out), "trial")
     if log is not None or rrd is not None:
         info = ("assemble", task, robot, seed, f"{method} {skill} {controller}")
         opts = {
@@ -141,7 +145,7 @@ def assemble(
         }  # fmt: skip
         write_recordings(log, rrd, [t.result for t in out], info, opts)
     if plot is None and video is None:
-        return
+        return exit_if_faulted(faulted)
     pick = next((t for t in out if "search" in t.nodes and t.success), out[0])
     assert pick.result is not None
     if plot is not None:
@@ -156,6 +160,7 @@ def assemble(
         with console.status("rendering"):
             path = render_motion(get_task(task), log.t, log.pos, log.quat, video, robot=robot)
         console.print(f"video of trial {pick.index} -> {path}")
+    exit_if_faulted(faulted)
 
 
 @guarded
@@ -318,6 +323,8 @@ def _assemble_plan(
     console.print(
         f"success {s}; ground truth {truth}/{len(out)}; the paper's robot, open loop: {ok}/{n}"
     )
+    rows = ((t.index, t.result.outcome.value, t.result.reason) for t in out)
+    faulted = report_faults(rows, "trial")
     if rec[0] is not None or rec[1] is not None:
         info = ("assemble", part, "floating", seed, "plan in contact + seating")
         write_recordings(rec[0], rec[1], [t.result for t in out], info, rec[2])
@@ -334,3 +341,4 @@ def _assemble_plan(
         with console.status("rendering"):
             path_mp4 = render_motion(cell, log.t, log.pos, log.quat, video)
         console.print(f"video of trial 0 -> {path_mp4}")
+    exit_if_faulted(faulted)

@@ -1,11 +1,14 @@
-"""Many executions at once: the one seeding rule and the one order-preserving batch runner."""
+"""Many executions at once: the one seeding rule, the one order-preserving batch runner, and
+:class:`Finished`, what a sequence of executions keeps when something ends it early."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from typing import TypeVar
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -52,3 +55,54 @@ def run_batch(
             if progress:
                 progress()
         return results
+
+
+@dataclass
+class Finished(Generic[R]):
+    """The executions of a run that finished, in order, and what ended the run early.
+
+    ``items`` every finished execution (add each as it finishes: :meth:`add`), ``total`` how
+    many the run was to have (0: unknown), ``stop`` the exception that ended it early (a lost
+    connection, a fault, Ctrl-C's ``KeyboardInterrupt``, SIGTERM's ``SystemExit``, a bug);
+    ``None``: the run was not cut short.
+    """
+
+    items: list[R] = field(default_factory=list)
+    total: int = 0
+    stop: BaseException | None = None
+
+    def add(self, item: R) -> None:
+        """Keep one finished execution."""
+        self.items.append(item)
+
+    @property
+    def complete(self) -> bool:
+        """Nothing cut the run short."""
+        return self.stop is None
+
+
+@contextmanager
+def keeping(finished: Finished[R]) -> Iterator[Finished[R]]:
+    """Run the body; whatever exception ends it (``BaseException`` included) is stored in
+    ``finished.stop`` instead of propagating, so that the caller still reports and records the
+    executions that finished; the caller decides how the run ends (:attr:`Finished.stop`)."""
+    try:
+        yield finished
+    except BaseException as exc:  # noqa: BLE001 - kept for the caller, which re-raises or exits
+        finished.stop = exc
+
+
+def run_keeping(
+    fn: Callable[[J], R], jobs: Sequence[J], on_done: Callable[[R], None] | None = None
+) -> Finished[R]:
+    """``fn(job)`` for each job in order, in this process, until one raises: the results of
+    those that finished, and the exception that stopped the rest (:class:`Finished`);
+    ``on_done`` after each finished job."""
+    finished: Finished[R] = Finished(total=len(jobs))
+    with keeping(finished):
+        for job in jobs:
+            result = fn(job)
+            finished.add(result)
+            if on_done is not None:
+                on_done(result)
+    return finished
