@@ -174,3 +174,61 @@ def test_search_run_cut_short_keeps_its_finished_searches(monkeypatch, tmp_path)
     assert "execution 1 robot-fault: reason 1" in res.output
     assert "stopped after 2 of 5 execution(s): interrupted (Ctrl-C)" in res.output
     assert len(read_run_log(log).episodes) == 2
+
+
+def _trial(i: int, reason: str) -> object:
+    from teachfit.execution.assembly import AssemblyTrial
+
+    ok = reason.startswith("success")
+    return AssemblyTrial("skill", 0.003, i, ok, 1.0, None, (0.0, 0.0), (), reason, _result(i))
+
+
+def test_assemble_with_a_robot_fault_prints_its_reason_and_exits_1(monkeypatch) -> None:
+    from teachfit.execution import assembly
+
+    reasons = ["success: success condition", "robot-fault: ReflexFault: cartesian_reflex"]
+    monkeypatch.setattr(
+        assembly, "run_assembly_job", lambda job: _trial(job.index, reasons[job.index])
+    )
+    res = runner.invoke(app, ["assemble", "--trials", "2"])
+    assert res.exit_code == 1, res.output
+    assert "trial 1 robot-fault: ReflexFault: cartesian_reflex" in res.output
+    assert "trial 0 " not in res.output
+
+
+def test_assemble_ctrl_c_keeps_the_finished_trials_in_its_log(monkeypatch, tmp_path) -> None:
+    from teachfit.execution import assembly
+
+    def job(job: assembly.AssemblyJob) -> object:
+        if job.index == 2:
+            raise KeyboardInterrupt
+        return _trial(job.index, "timeout: hard cap")
+
+    monkeypatch.setattr(assembly, "run_assembly_job", job)
+    log = tmp_path / "a.h5"
+    res = runner.invoke(app, ["assemble", "--trials", "4", "--log", str(log)])
+    assert res.exit_code == 130, res.output
+    assert "stopped after 2 of 4 trial(s): interrupted (Ctrl-C)" in res.output
+    assert [ep.result.reason for ep in read_run_log(log).episodes] == ["reason 0", "reason 1"]
+
+
+def test_assemble_in_contact_ctrl_c_keeps_the_finished_trials(monkeypatch, tmp_path) -> None:
+    from types import SimpleNamespace
+
+    from teachfit.execution import plan_contact as pc
+
+    plan = SimpleNamespace(success=True, time_s=0.1, used_key_poses=2, candidates=3)
+
+    def run_plan_trials(part: str, path: object, trials: int, seed: int, on_trial, **kw):
+        for i in range(2):
+            on_trial(pc.PlanTrial("joined", i, False, None, 1.0, 0.001, 0.01, _result(i)))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pc, "plan_path", lambda *a: plan)
+    monkeypatch.setattr(pc, "timed_path", lambda *a: SimpleNamespace(duration=1.0))
+    monkeypatch.setattr(pc, "run_plan_trials", run_plan_trials)
+    log = tmp_path / "a.h5"
+    res = runner.invoke(app, ["assemble", "--task", "l-groove", "--trials", "5", "--log", str(log)])
+    assert res.exit_code == 130, res.output
+    assert "stopped after 2 of 5 trial(s): interrupted (Ctrl-C)" in res.output
+    assert len(read_run_log(log).episodes) == 2

@@ -47,7 +47,8 @@ def report_faults(rows: Iterable[tuple[int, str, str]], what: str = "execution")
     or its controller stopped (at most :data:`MAX_LINES`); whether any was a robot fault."""
     stopped = [row for row in rows if row[1] in STOPPED]
     for i, outcome, reason in stopped[:MAX_LINES]:
-        console.print(f"[red]{what} {i} {outcome}:[/] {escape(reason)}", highlight=False)
+        line = f"[red]{what} {i} {outcome}:[/] {escape(reason)}"
+        console.print(line, highlight=False, soft_wrap=True)  # one line at any width
     if len(stopped) > MAX_LINES:
         console.print(f"... and {len(stopped) - MAX_LINES} more (every reason is in --log)")
     return any(row[1] in FAULTED for row in stopped)

@@ -15,7 +15,7 @@ from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, writ
 from teachfit.cli.run_end import end_run, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.atomic import atomic_write_text
-from teachfit.execution.batch import run_keeping
+from teachfit.execution.batch import run_batch_keeping
 
 if TYPE_CHECKING:
     from teachfit.execution.engine import ExecutionResult
@@ -142,8 +142,8 @@ def run(
             f"off by ({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, yaw {est.rz:+.3f} rad"
         )
         with console.status(f"running {starts} execution(s)"):
-            finished = run_keeping(
-                lambda i: trial.run(learned, setup.starts[i], setup.frame(i)), range(starts)
+            finished = run_batch_keeping(
+                lambda i: trial.run(learned, setup.starts[i], setup.frame(i)), range(starts), 0
             )
         traces = finished.items
         faulted = _report(trial, traces)

@@ -31,6 +31,21 @@ def episode_rng(seed: int, i: int) -> np.random.Generator:
     return np.random.default_rng(episode_seed(seed, i))
 
 
+def _in_order(fn: Callable[[J], R], jobs: Sequence[J], workers: int | None) -> Iterator[R]:
+    """``fn(job)`` for each job, in order, as each finishes (see :func:`run_batch`); a job
+    that raises, or an interrupt, cancels the jobs not yet started."""
+    n = (os.cpu_count() or 1) if workers is None else int(workers)
+    if n <= 1 or len(jobs) <= 1:
+        for job in jobs:
+            yield fn(job)
+        return
+    pool = ProcessPoolExecutor(min(n, len(jobs)))
+    try:
+        yield from pool.map(fn, jobs, chunksize=1)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
 def run_batch(
     fn: Callable[[J], R],
     jobs: Sequence[J],
@@ -40,21 +55,29 @@ def run_batch(
     """``[fn(job) for job in jobs]`` in order, in ``workers`` processes (``None``: one per
     core; 0 or 1: in this process). ``fn`` and the jobs must be picklable for processes;
     ``progress`` is called after each finished job."""
-    n = (os.cpu_count() or 1) if workers is None else int(workers)
-    if n <= 1 or len(jobs) <= 1:
-        out = []
-        for job in jobs:
-            out.append(fn(job))
+    out = []
+    for result in _in_order(fn, jobs, workers):
+        out.append(result)
+        if progress:
+            progress()
+    return out
+
+
+def run_batch_keeping(
+    fn: Callable[[J], R],
+    jobs: Sequence[J],
+    workers: int | None = None,
+    progress: Callable[[], None] | None = None,
+) -> Finished[R]:
+    """:func:`run_batch` that keeps, when a job raises or the run is interrupted, the results
+    of the jobs before it and the exception that stopped the rest (:class:`Finished`)."""
+    finished: Finished[R] = Finished(total=len(jobs))
+    with keeping(finished):
+        for result in _in_order(fn, jobs, workers):
+            finished.add(result)
             if progress:
                 progress()
-        return out
-    with ProcessPoolExecutor(min(n, len(jobs))) as pool:
-        results = []
-        for res in pool.map(fn, jobs, chunksize=1):
-            results.append(res)
-            if progress:
-                progress()
-        return results
+    return finished
 
 
 @dataclass
@@ -90,19 +113,3 @@ def keeping(finished: Finished[R]) -> Iterator[Finished[R]]:
         yield finished
     except BaseException as exc:  # noqa: BLE001 - kept for the caller, which re-raises or exits
         finished.stop = exc
-
-
-def run_keeping(
-    fn: Callable[[J], R], jobs: Sequence[J], on_done: Callable[[R], None] | None = None
-) -> Finished[R]:
-    """``fn(job)`` for each job in order, in this process, until one raises: the results of
-    those that finished, and the exception that stopped the rest (:class:`Finished`);
-    ``on_done`` after each finished job."""
-    finished: Finished[R] = Finished(total=len(jobs))
-    with keeping(finished):
-        for job in jobs:
-            result = fn(job)
-            finished.add(result)
-            if on_done is not None:
-                on_done(result)
-    return finished
