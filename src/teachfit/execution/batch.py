@@ -55,12 +55,10 @@ def run_batch(
     """``[fn(job) for job in jobs]`` in order, in ``workers`` processes (``None``: one per
     core; 0 or 1: in this process). ``fn`` and the jobs must be picklable for processes;
     ``progress`` is called after each finished job."""
-    out = []
-    for result in _in_order(fn, jobs, workers):
-        out.append(result)
-        if progress:
-            progress()
-    return out
+    finished = run_batch_keeping(fn, jobs, workers, progress)
+    if finished.stop is not None:
+        raise finished.stop
+    return finished.items
 
 
 def run_batch_keeping(
