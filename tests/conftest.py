@@ -73,3 +73,16 @@ def pytest_unconfigure(config: pytest.Config) -> None:
 def no_teacher_cache(monkeypatch: pytest.MonkeyPatch) -> None:
     """Tests of the teacher itself record for real."""
     monkeypatch.delenv(_CACHE_ENV, raising=False)
+
+
+# the libfranka-protocol simulator and its port, for tests/robot and tests/cli alike: registered
+# here only (a second registration would start a second simulator, see franka_fixtures)
+from franka_fixtures import (  # noqa: E402, F401
+    ctrl_c,
+    expected_tcp,
+    franka_port,
+    franka_sim,
+    listener,
+    push_file,
+    robot_port,
+)

@@ -13,8 +13,10 @@ from rich.table import Table
 from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.run_end import end_run, exit_if_faulted, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
+from teachfit.execution.batch import Finished, keeping, run_batch_keeping
 
 _UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "deg": 0.017453292519943295, "rad": 1.0}
 
@@ -68,7 +70,10 @@ def assemble(
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
-    """Assemble over trials: taught hole -> approach -> skill -> learned search recovery."""
+    """Assemble over trials: taught hole -> approach -> skill -> learned search recovery.
+
+    Exit status 1 when the robot stopped a trial (each reason is printed); a run cut short
+    (Ctrl-C) prints and logs the trials that finished (see ``run_end``)."""
     from teachfit.metrics.stats import summarize
     from teachfit.robot.registry import ROBOTS
 
@@ -93,7 +98,7 @@ def assemble(
                "angle_error": angle_error, "trials": trials, "seed": seed})  # fmt: skip
         _assemble_plan(task, demo, err, ang, trials, seed, plot, video, rec)
         return
-    from teachfit.execution.assembly import assembly_jobs, run_assembly
+    from teachfit.execution.assembly import assembly_jobs, run_assembly_job
     from teachfit.models.search_model import SearchModel
     from teachfit.skills.library import get_skill
     from teachfit.skills.params import read_params_toml
@@ -121,7 +126,11 @@ def assemble(
     console.print(f"{task}: {what}; taught hole off by {err * 1e3:g} mm; {trials} trial(s)")
     with progress_bar() as bar:
         job = bar.add_task("assembling", total=len(jobs))
-        out = run_assembly(jobs, workers, lambda: bar.advance(job))
+        finished = run_batch_keeping(run_assembly_job, jobs, workers, lambda: bar.advance(job))
+    out = finished.items
+    if not out:
+        console.print("no trial finished")
+        return end_run(finished, what="trial")
     _print_trials(
         "taught offset (mm)",
         [
@@ -132,6 +141,7 @@ def assemble(
     s = summarize([t.success for t in out], [t.time for t in out])
     searched = sum("search" in t.nodes for t in out)
     console.print(f"success {s}; the search ran in {searched}/{len(out)} trial(s)")
+    faulted = report_faults(((t.index, *t.reason.partition(": ")[::2]) for t in out), "trial")
     if log is not None or rrd is not None:
         info = ("assemble", task, robot, seed, f"{method} {skill} {controller}")
         opts = {
@@ -140,8 +150,8 @@ def assemble(
             "controller": controller, "seed": seed, "robot": robot,
         }  # fmt: skip
         write_recordings(log, rrd, [t.result for t in out], info, opts)
-    if plot is None and video is None:
-        return
+    if (plot is None and video is None) or not finished.complete:
+        return end_run(finished, faulted, "trial")
     pick = next((t for t in out if "search" in t.nodes and t.success), out[0])
     assert pick.result is not None
     if plot is not None:
@@ -156,6 +166,7 @@ def assemble(
         with console.status("rendering"):
             path = render_motion(get_task(task), log.t, log.pos, log.quat, video, robot=robot)
         console.print(f"video of trial {pick.index} -> {path}")
+    exit_if_faulted(faulted)
 
 
 @guarded
@@ -266,6 +277,7 @@ def _assemble_plan(
 
     from teachfit.execution.plan_contact import (
         PAPER_ROBOT,
+        PlanTrial,
         plan_path,
         run_plan_trials,
         timed_path,
@@ -295,11 +307,19 @@ def _assemble_plan(
         f"path; capture error {lo_t * 1e3:g}-{err * 1e3:g} mm, "
         f"{np.degrees(lo_r):g}-{np.degrees(ang):g} deg"
     )
-    with progress_bar() as bar:
+    finished: Finished[PlanTrial] = Finished(total=trials)
+    with keeping(finished), progress_bar() as bar:
         job = bar.add_task("executing in contact", total=trials)
-        out = run_plan_trials(
-            part, path, trials, seed, on_trial=lambda _t: bar.advance(job), **ranges
-        )
+
+        def done(trial: PlanTrial) -> None:
+            finished.add(trial)
+            bar.advance(job)
+
+        run_plan_trials(part, path, trials, seed, on_trial=done, **ranges)
+    out = finished.items
+    if not out:
+        console.print("no trial finished")
+        return end_run(finished, what="trial")
     _print_trials(
         "error (mm, deg)",
         [
@@ -318,9 +338,13 @@ def _assemble_plan(
     console.print(
         f"success {s}; ground truth {truth}/{len(out)}; the paper's robot, open loop: {ok}/{n}"
     )
+    rows = ((t.index, t.result.outcome.value, t.result.reason) for t in out)
+    faulted = report_faults(rows, "trial")
     if rec[0] is not None or rec[1] is not None:
         info = ("assemble", part, "floating", seed, "plan in contact + seating")
         write_recordings(rec[0], rec[1], [t.result for t in out], info, rec[2])
+    if not finished.complete:
+        return end_run(finished, faulted, "trial")
     pick = out[0]
     if plot is not None:
         from teachfit.viz.assembly_figures import plot_phases
@@ -334,3 +358,4 @@ def _assemble_plan(
         with console.status("rendering"):
             path_mp4 = render_motion(cell, log.t, log.pos, log.quat, video)
         console.print(f"video of trial 0 -> {path_mp4}")
+    exit_if_faulted(faulted)

@@ -2,21 +2,29 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Annotated
 
 import typer
 from rich.markup import escape
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RobotOpt, console, guarded
+from teachfit.cli.common import HostOpt, RobotOpt, console, err_console, guarded
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
+from teachfit.robot.franka.connect import CONNECT_TIMEOUT
 
 robot_app = typer.Typer(
     help="The robots teachfit drives: list them, check one.", no_args_is_help=True
 )
 
 _REALTIME = typer.Option(help="real robot: require a real-time kernel (off for the simulator)")
+#: ``--connect-timeout S``: how long a connect may take (a Franka answers within milliseconds)
+ConnectTimeoutOpt = Annotated[
+    float,
+    typer.Option(min=0.1, max=600, help="seconds to wait for the robot to answer the connect"),
+]
 
 
 @robot_app.command("list")
@@ -51,11 +59,19 @@ def check(
         float, typer.Option(min=0, help="seconds of the 1 kHz control loop to time")
     ] = 1.0,
     realtime: Annotated[bool, _REALTIME] = True,
+    connect_timeout: ConnectTimeoutOpt = CONNECT_TIMEOUT,
 ) -> None:
-    """Connect, read the state, print the safety limits and the loop timing."""
+    """Connect, read the state, print the safety limits and the loop timing.
+
+    A robot that does not answer within --connect-timeout s is one line, exit status 2;
+    Ctrl-C ends the wait (exit status 130)."""
     from teachfit.robot.franka.check import check_robot
 
-    result = check_robot(_real(robot, host), seconds=seconds, realtime=realtime)
+    address = _real(robot, host)
+    with _interruptible(address):
+        result = check_robot(
+            address, seconds=seconds, realtime=realtime, connect_timeout=connect_timeout
+        )
     for line in result.lines():
         console.print(line, markup=False, highlight=False)
 
@@ -68,11 +84,31 @@ def bench_robot(
         float, typer.Option(min=0, help="seconds of the 1 kHz control loop to time")
     ] = 10.0,
     realtime: Annotated[bool, _REALTIME] = True,
+    connect_timeout: ConnectTimeoutOpt = CONNECT_TIMEOUT,
 ) -> None:
     """Tick compute time p50/p99/max and missed deadlines of the 1 kHz loop, through the
     robot's protocol."""
     from teachfit.robot.franka.check import bench_loop
+    from teachfit.robot.franka.driver import FrankaParams
 
     if not seconds > 0:
         raise TeachfitError(f"--seconds must be > 0, got {seconds}")
-    bench_loop(_real(robot, host), seconds=seconds, realtime=realtime, out=console.print)
+    address = _real(robot, host)
+    params = FrankaParams(connect_timeout=connect_timeout)
+    with _interruptible(address):
+        bench_loop(address, seconds=seconds, params=params, realtime=realtime, out=console.print)
+
+
+@contextmanager
+def _interruptible(host: str) -> Iterator[None]:
+    """Ctrl-C while talking to the robot at ``host``: one line and exit status 130 (SIGTERM:
+    one line, 143). The driver has already held the arm and finished its motion; a connect
+    is abandoned."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        err_console.print(f"interrupted (Ctrl-C) while talking to the robot at {host}")
+        raise typer.Exit(130) from None
+    except SystemExit:  # SIGTERM (teachfit's CLI): its status, 143
+        err_console.print(f"terminated while talking to the robot at {host}")
+        raise

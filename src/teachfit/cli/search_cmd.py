@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 import typer
@@ -13,9 +13,14 @@ from teachfit.cli import options as o
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.run_end import end_run, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
+from teachfit.execution.batch import Finished, keeping
+
+if TYPE_CHECKING:
+    from teachfit.execution.search import SearchRun
 
 search_app = typer.Typer(
     help="Plan and run search trajectories learned from blind demonstrations (Ehlers et al. 2019).",
@@ -161,10 +166,12 @@ def run(
     Table I's starts (Ehlers et al. 2019) lie in a 3 cm circle halfway between the
     demonstration's start and the hole: pass the demonstration the model was learned from
     with --demo.
+
+    Exit status: 0, or 1 when the robot stopped an execution (each reason is printed); a run
+    cut short (lost connection, Ctrl-C) prints and logs what finished (see ``run_end``).
     """
     points = o.pick(points, n)
     from teachfit.execution.search import run_protocol
-    from teachfit.metrics.stats import summarize
     from teachfit.models.search_model import SearchModel
     from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
@@ -188,24 +195,50 @@ def run(
             "the hole; without --demo a nominal demonstration start is assumed"
         )
     the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime))
-    try:
-        with progress_bar() as bar:
-            job = bar.add_task(f"{method} from {starts} starts", total=starts)
-            runs = run_protocol(
-                the_robot, the_task, model, method, points, starts, protocol, seed,
-                passes=passes, feedforward=feedforward, demo_start=demo_start,
-                on_done=lambda _run: bar.advance(job),
-            )  # fmt: skip
-    finally:
-        the_robot.close()
-    outcomes = [r.result for r in runs]
-    paths = [(o.log.pos, o.success) for o in outcomes]
-    s = summarize([o.success for o in outcomes], [o.time_to_success for o in outcomes])
+    finished: Finished[SearchRun] = Finished(total=starts)
+    with keeping(finished):
+        try:
+            with progress_bar() as bar:
+                job = bar.add_task(f"{method} from {starts} starts", total=starts)
+                run_protocol(
+                    the_robot, the_task, model, method, points, starts, protocol, seed,
+                    passes=passes, feedforward=feedforward, demo_start=demo_start,
+                    on_done=lambda run: (finished.add(run), bar.advance(job)),
+                )  # fmt: skip
+        finally:
+            the_robot.close()
+    runs = finished.items
     n_pts = f", N = {points}" if method == "tshix" else ""
-    table = Table(title=f"{method}{n_pts} on {the_task.name} ({protocol} starts, seed {seed})")
+    title = f"{method}{n_pts} on {the_task.name} ({protocol} starts, seed {seed})"
+    faulted = _print_runs(runs, title)
+    if runs:
+        write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method), ctx.params)
+    elif log is not None or rrd is not None:
+        console.print("no run log written")
+    if plot is not None and runs and finished.complete:
+        from teachfit.viz.figures import plot_executions
+
+        paths = [(r.result.log.pos, r.result.success) for r in runs]
+        title = f"{method}{n_pts}, seed {seed}, {protocol} starts"
+        plot_executions(paths, plot, the_task, title=title)
+        console.print(f"figure -> {plot}")
+    end_run(finished, faulted)
+
+
+def _print_runs(runs: list[SearchRun], title: str) -> bool:
+    """The success table of the finished searches and the reason of each the robot stopped;
+    whether the robot faulted in any."""
+    from teachfit.metrics.stats import summarize
+
+    if not runs:
+        console.print("no execution finished")
+        return False
+    outcomes = [r.result for r in runs]
+    s = summarize([o.success for o in outcomes], [o.time_to_success for o in outcomes])
+    table = Table(title=title)
     for col in ("starts", "successes", "rate [95 % CI]", "median time", "reasons"):
         table.add_column(col, justify="right")
-    reasons = {}
+    reasons: dict[str, int] = {}
     for res in outcomes:
         reasons[res.outcome.value] = reasons.get(res.outcome.value, 0) + 1
     t_med = "n/a" if np.isnan(s.median_time) else f"{s.median_time:.2f} s"
@@ -217,14 +250,7 @@ def run(
         ", ".join(f"{k} {v}" for k, v in reasons.items()),
     )
     print_table(table)
-    write_recordings(log, rrd, runs, ("search", the_task, robot, seed, method), ctx.params)
-    if plot is not None:
-        from teachfit.viz.figures import plot_executions
-
-        n = f", N = {points}" if method == "tshix" else ""
-        title = f"{method}{n}, seed {seed}, {protocol} starts"
-        plot_executions(paths, plot, the_task, title=title)
-        console.print(f"figure -> {plot}")
+    return report_faults((i, o.outcome.value, o.reason) for i, o in enumerate(outcomes))
 
 
 @search_app.command("figures")

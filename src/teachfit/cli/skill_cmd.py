@@ -3,16 +3,25 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
+import numpy as np
 import typer
 from rich.table import Table
 
 from teachfit.cli import options as o
 from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
+from teachfit.cli.run_end import end_run, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.atomic import atomic_write_text
+from teachfit.execution.batch import run_batch_keeping
+
+if TYPE_CHECKING:
+    from teachfit.execution.engine import ExecutionResult
+    from teachfit.execution.recording import Episode
+    from teachfit.execution.skill_trial import SkillSetup, SkillTrial
+    from teachfit.tasks.base import Task
 
 skill_app = typer.Typer(
     help="Manipulation skills (Johannsmeier et al. 2019): show a skill's graph, run it on a task.",
@@ -107,12 +116,14 @@ def run(
     rrd: RrdOpt = None,
 ) -> None:
     """Run a skill on a task from several start poses: one trial of the skill-learning paper
-    (Johannsmeier et al. 2019), its successes and cost."""
+    (Johannsmeier et al. 2019), its successes and cost.
+
+    Exit status: 0, or 1 when the robot stopped an execution (each reason is printed); a run
+    cut short (lost connection, Ctrl-C) prints and logs what finished (see ``run_end``)."""
     from teachfit.core.errors import SkillError
-    from teachfit.execution.recording import skill_episodes
+    from teachfit.execution.recording import Episode
     from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
     from teachfit.skills.library import get_skill
-    from teachfit.skills.params import read_params_toml
     from teachfit.tasks.registry import load_task
 
     if starts < 1:
@@ -122,32 +133,65 @@ def run(
     check_recording_targets(log, rrd)
     the_task = load_task(task)
     setup = peg_in_hole_setup(the_task, seed, starts, controller, get_skill(skill, controller))
-    learned = None
-    if params is not None:
-        learned = read_params_toml(params, setup.skill.params, setup.skill.users())
-        import tomllib
-
-        given = tomllib.loads(params.read_text(encoding="utf-8")).get("params", {})
-        if not (isinstance(given, dict) and given):
-            given = tomllib.loads(params.read_text(encoding="utf-8"))
-        missing = sorted(set(setup.skill.params.learned) - set(given))
-        if missing:
-            console.print(
-                f"[yellow]note:[/] {params} does not set {', '.join(missing)}: "
-                "their defaults are used"
-            )
+    learned = _learned(params, setup)
     trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host, realtime))
-    est = setup.task2world.inverse().compose(the_task.hole2world)
-    console.print(
-        f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate off by "
-        f"({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, yaw {est.rz:+.3f} rad"
-    )
-    with console.status(f"running {starts} execution(s)"):
-        out = trial(learned)
+    try:
+        est = setup.task2world.inverse().compose(the_task.hole2world)
+        console.print(
+            f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate "
+            f"off by ({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, yaw {est.rz:+.3f} rad"
+        )
+        with console.status(f"running {starts} execution(s)"):
+            finished = run_batch_keeping(
+                lambda i: trial.run(learned, setup.starts[i], setup.frame(i)), range(starts), 0
+            )
+        traces = finished.items
+        faulted = _report(trial, traces)
+        episodes = [
+            Episode.of_skill(tr, setup.skill, st)
+            for tr, st in zip(traces, setup.starts, strict=False)
+        ]
+        info = ("skill", the_task, robot, seed, f"{skill} {controller}")
+        _record(log, rrd, episodes, info, ctx.params)
+        if finished.complete:
+            figures = (plot, render, render_start, (fps, width, height))
+            _figures(trial, traces, figures, f"{controller} controller, seed {seed}")
+        end_run(finished, faulted)
+    finally:
+        trial.robot.close()
+
+
+def _learned(params: Path | None, setup: SkillSetup) -> dict[str, float] | None:
+    """The learned values of ``--params`` (``None``: defaults); notes the names it leaves out."""
+    if params is None:
+        return None
+    import tomllib
+
+    from teachfit.skills.params import read_params_toml
+
+    learned = read_params_toml(params, setup.skill.params, setup.skill.users())
+    given = tomllib.loads(params.read_text(encoding="utf-8")).get("params", {})
+    if not (isinstance(given, dict) and given):
+        given = tomllib.loads(params.read_text(encoding="utf-8"))
+    missing = sorted(set(setup.skill.params.learned) - set(given))
+    if missing:
+        console.print(
+            f"[yellow]note:[/] {params} does not set {', '.join(missing)}: their defaults are used"
+        )
+    return learned
+
+
+def _report(trial: SkillTrial, traces: list[ExecutionResult]) -> bool:
+    """Print the table of the finished executions, the trial's figures and the reason of
+    every execution the robot stopped; whether the robot faulted in any."""
+    if not traces:
+        console.print("no execution finished")
+        return False
+    scored = [trial.metric.evaluate(tr) for tr in traces]
     table = Table(title="executions", title_justify="left")
     for col in ("#", "outcome", "detected", "cost (s)", "contact (s)", "end (s)", "nodes"):
         table.add_column(col)
-    for i, (tr, ok, cost) in enumerate(zip(out.traces, out.successes, out.costs, strict=True)):
+    for i, (tr, (ok, cost)) in enumerate(zip(traces, scored, strict=True)):
         path = " > ".join(v.node for v in tr.visits)
         table.add_row(
             str(i),
@@ -159,33 +203,55 @@ def run(
             path,
         )
     print_table(table)
-    steps = sum(tr.steps for tr in out.traces)
-    wall = sum(tr.wall_s for tr in out.traces)
+    steps = sum(tr.steps for tr in traces)
+    wall = sum(tr.wall_s for tr in traces)
+    n_ok = sum(ok for ok, _ in scored)
     console.print(
-        f"trial: {sum(out.successes)}/{len(out.successes)} succeeded, cost {out.cost:.3f} s; "
-        f"{wall / len(out.traces):.3f} s wall per execution, {steps / wall:,.0f} sim steps/s"
+        f"trial: {n_ok}/{len(traces)} succeeded, cost {np.mean([c for _, c in scored]):.3f} s; "
+        f"{wall / len(traces):.3f} s wall per execution, {steps / max(wall, 1e-9):,.0f} sim "
+        "steps/s"
     )
-    episodes = skill_episodes(out, setup)
-    info = ("skill", the_task, robot, seed, f"{skill} {controller}")
-    write_recordings(log, rrd, episodes, info, ctx.params)
+    return report_faults((i, tr.outcome.value, tr.reason) for i, tr in enumerate(traces))
+
+
+def _record(
+    log: Path | None,
+    rrd: Path | None,
+    episodes: list[Episode],
+    info: tuple[str, Task, str, int, str],
+    options: dict[str, Any],
+) -> None:
+    """Write ``--log``/``--rrd`` of the finished executions (none finished: nothing written,
+    an older file at the path is kept)."""
+    if episodes:
+        write_recordings(log, rrd, episodes, info, options)
+    elif log is not None or rrd is not None:
+        console.print("no run log written")
+
+
+def _figures(trial: SkillTrial, traces: list[ExecutionResult], figures: tuple, title: str) -> None:
+    """``--plot`` (force and pose over time; joint torques on the FR3) and ``--render``."""
+    plot, render, render_start, (fps, width, height) = figures
+    setup = trial.setup
+    robot = trial.robot
+    title = f"{setup.skill.name} on {setup.task.name}, {title}"
     if plot is not None:
         from teachfit.viz.skill_figures import plot_traces
 
-        title = f"{setup.skill.name} on {the_task.name}, {controller} controller, seed {seed}"
-        console.print(f"traces -> {plot_traces(out.traces, plot, title)}")
-        if hasattr(trial.robot, "recent_torque_traces"):  # the FR3: joint torques over time
+        console.print(f"traces -> {plot_traces(traces, plot, title)}")
+        if hasattr(robot, "recent_torque_traces"):  # the FR3: joint torques over time
             from teachfit.viz.torque_figures import plot_joint_torques
 
-            torques = trial.robot.recent_torque_traces(len(out.traces))
+            torques = robot.recent_torque_traces(len(traces))
             image = plot.with_name(f"{plot.stem}-torques{plot.suffix}")
             console.print(f"joint torques -> {plot_joint_torques(torques, image)}")
     if render is not None:
         from teachfit.viz.video import render_motion
 
-        log = out.traces[render_start].log
+        log = traces[render_start].log
         with console.status("rendering"):
             path = render_motion(
-                the_task, log.t, log.pos, log.quat, render, fps=fps, width=width, height=height,
-                robot=robot,
+                setup.task, log.t, log.pos, log.quat, render, fps=fps, width=width,
+                height=height, robot=robot.name,
             )  # fmt: skip
         console.print(f"video -> {path}")

@@ -1,11 +1,14 @@
-"""Many executions at once: the one seeding rule and the one order-preserving batch runner."""
+"""Many executions at once: the one seeding rule, the one order-preserving batch runner, and
+:class:`Finished`, what a sequence of executions keeps when something ends it early."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from typing import TypeVar
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -28,6 +31,21 @@ def episode_rng(seed: int, i: int) -> np.random.Generator:
     return np.random.default_rng(episode_seed(seed, i))
 
 
+def _in_order(fn: Callable[[J], R], jobs: Sequence[J], workers: int | None) -> Iterator[R]:
+    """``fn(job)`` for each job, in order, as each finishes (see :func:`run_batch`); a job
+    that raises, or an interrupt, cancels the jobs not yet started."""
+    n = (os.cpu_count() or 1) if workers is None else int(workers)
+    if n <= 1 or len(jobs) <= 1:
+        for job in jobs:
+            yield fn(job)
+        return
+    pool = ProcessPoolExecutor(min(n, len(jobs)))
+    try:
+        yield from pool.map(fn, jobs, chunksize=1)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
 def run_batch(
     fn: Callable[[J], R],
     jobs: Sequence[J],
@@ -37,18 +55,59 @@ def run_batch(
     """``[fn(job) for job in jobs]`` in order, in ``workers`` processes (``None``: one per
     core; 0 or 1: in this process). ``fn`` and the jobs must be picklable for processes;
     ``progress`` is called after each finished job."""
-    n = (os.cpu_count() or 1) if workers is None else int(workers)
-    if n <= 1 or len(jobs) <= 1:
-        out = []
-        for job in jobs:
-            out.append(fn(job))
+    finished = run_batch_keeping(fn, jobs, workers, progress)
+    if finished.stop is not None:
+        raise finished.stop
+    return finished.items
+
+
+def run_batch_keeping(
+    fn: Callable[[J], R],
+    jobs: Sequence[J],
+    workers: int | None = None,
+    progress: Callable[[], None] | None = None,
+) -> Finished[R]:
+    """:func:`run_batch` that keeps, when a job raises or the run is interrupted, the results
+    of the jobs before it and the exception that stopped the rest (:class:`Finished`)."""
+    finished: Finished[R] = Finished(total=len(jobs))
+    with keeping(finished):
+        for result in _in_order(fn, jobs, workers):
+            finished.add(result)
             if progress:
                 progress()
-        return out
-    with ProcessPoolExecutor(min(n, len(jobs))) as pool:
-        results = []
-        for res in pool.map(fn, jobs, chunksize=1):
-            results.append(res)
-            if progress:
-                progress()
-        return results
+    return finished
+
+
+@dataclass
+class Finished(Generic[R]):
+    """The executions of a run that finished, in order, and what ended the run early.
+
+    ``items`` every finished execution (add each as it finishes: :meth:`add`), ``total`` how
+    many the run was to have (0: unknown), ``stop`` the exception that ended it early (a lost
+    connection, a fault, Ctrl-C's ``KeyboardInterrupt``, SIGTERM's ``SystemExit``, a bug);
+    ``None``: the run was not cut short.
+    """
+
+    items: list[R] = field(default_factory=list)
+    total: int = 0
+    stop: BaseException | None = None
+
+    def add(self, item: R) -> None:
+        """Keep one finished execution."""
+        self.items.append(item)
+
+    @property
+    def complete(self) -> bool:
+        """Nothing cut the run short."""
+        return self.stop is None
+
+
+@contextmanager
+def keeping(finished: Finished[R]) -> Iterator[Finished[R]]:
+    """Run the body; whatever exception ends it (``BaseException`` included) is stored in
+    ``finished.stop`` instead of propagating, so that the caller still reports and records the
+    executions that finished; the caller decides how the run ends (:attr:`Finished.stop`)."""
+    try:
+        yield finished
+    except BaseException as exc:  # noqa: BLE001 - kept for the caller, which re-raises or exits
+        finished.stop = exc

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from teachfit.robot.franka.connect import CONNECT_TIMEOUT
 from teachfit.robot.franka.driver import FrankaParams, FrankaRobot
 from teachfit.robot.franka.safety import FrankaLimits
 
@@ -114,9 +115,12 @@ def check_robot(
     limits: FrankaLimits | None = None,
     seconds: float = 1.0,
     realtime: bool = True,
+    connect_timeout: float = CONNECT_TIMEOUT,
 ) -> RobotCheck:
-    """Connect to the Franka at ``host``, read its state, and time ``seconds`` s of the loop."""
-    params = FrankaParams(limits=limits or FrankaLimits())
+    """Connect to the Franka at ``host`` (:class:`~teachfit.core.errors.ConnectionLost` when it
+    does not answer within ``connect_timeout`` s), read its state, and time ``seconds`` s of
+    the loop."""
+    params = FrankaParams(limits=limits or FrankaLimits(), connect_timeout=connect_timeout)
     with FrankaRobot(host, params=params, realtime=realtime) as robot:
         mode = robot.robot_mode
         ticks = int(round(seconds / robot.control_period))

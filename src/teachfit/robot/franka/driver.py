@@ -11,8 +11,10 @@ Faults: libfranka's ``ControlException`` becomes :class:`ReflexFault` (a reflex)
 :class:`LimitViolation` (a limit), ``NetworkException`` :class:`ConnectionLost` (so does a loop
 that stops ticking); the driver's own limits (:mod:`teachfit.robot.franka.safety`) raise
 :class:`LimitViolation`. After a fault no torque is commanded and every call but
-:meth:`reset` / :meth:`close` re-raises it. Ctrl-C (``KeyboardInterrupt``) during :meth:`step`
-holds the TCP where it is for ``stop_hold`` s, finishes the motion, and re-raises.
+:meth:`reset` / :meth:`close` re-raises it. Ctrl-C (``KeyboardInterrupt``; SIGTERM's
+``SystemExit`` in the CLI) during :meth:`step` holds the TCP where it is for ``stop_hold`` s,
+finishes the motion, and re-raises. Connecting is bounded by ``connect_timeout`` and can be
+interrupted (:mod:`teachfit.robot.franka.connect`).
 
 Why pylibfranka and not franky-control: teachfit's law must run in the 1 kHz torque loop;
 pylibfranka (Apache-2.0, Franka's own bindings) gives that loop, the model (Jacobian,
@@ -37,6 +39,7 @@ from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, R
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
+from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
 from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
 from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.safety import FrankaLimits
@@ -60,7 +63,9 @@ class FrankaParams:
     :meth:`FrankaRobot.reset`, ``reset_tolerance`` (m, rad) it must reach, ``settle_timeout``
     (s of robot time) it may take after the set-point arrived, ``bias_ticks`` how many ticks
     the wrench bias averages, ``stop_hold`` (s) the hold before the loop ends on Ctrl-C,
-    ``tick_timeout`` (s) without a tick after which the connection counts as lost.
+    ``tick_timeout`` (s) without a tick after which the connection counts as lost,
+    ``connect_timeout`` (s, wall clock) a connect may take before the robot counts as not
+    answering (:mod:`teachfit.robot.franka.connect`).
     """
 
     limits: FrankaLimits = field(default_factory=FrankaLimits)
@@ -72,6 +77,7 @@ class FrankaParams:
     bias_ticks: int = 50
     stop_hold: float = 0.2
     tick_timeout: float = 1.5
+    connect_timeout: float = CONNECT_TIMEOUT
 
 
 class FrankaRobot:
@@ -105,24 +111,29 @@ class FrankaRobot:
         import pylibfranka as pf
 
         self._pf = pf
-        # the control thread must get the GIL within a fraction of a tick when the caller's
-        # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
-        # delay a tick by up to 5 periods. Process-wide; restored by close().
-        self._switch_interval = sys.getswitchinterval()
-        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
         self.host = host
         self.params = params or FrankaParams()
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
         self._realtime = pf.RealtimeConfig.kEnforce if realtime else pf.RealtimeConfig.kIgnore
         self._robot = None
         self._connect()
+        # the control thread must get the GIL within a fraction of a tick when the caller's
+        # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
+        # delay a tick by up to 5 periods. Process-wide; restored by close().
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
         self._mass = np.asarray(self.params.apparent_mass, dtype=float)
         tick = TorqueTick(self.params.frames, self.params.limits, self.control_period)
-        self._loop = ControlLoop(tick, self.params.limits, self.control_period)
+        where = f"the Franka at {host}"
+        self._loop = ControlLoop(tick, self.params.limits, self.control_period, robot=where)
         #: completed resets (a reset restarts the clock)
         self.resets = 0
         self.robot_mode = "unknown"
-        self._start()
+        try:
+            self._start()
+        except BaseException:
+            self.close()
+            raise
 
     # ------------------------------------------------------------------ Robot protocol
     @property
@@ -155,7 +166,7 @@ class FrankaRobot:
         """Wait until ``n`` more control ticks have run; raise the latched fault if any."""
         try:
             self._loop.wait(n, self.params.tick_timeout)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM (teachfit's CLI)
             self.stop()
             raise
         return self.state()
@@ -296,6 +307,7 @@ class FrankaRobot:
 
     def _connect(self) -> None:
         pf = self._pf
+        probe(self.host, self.params.connect_timeout)  # bounded: the connect below is not
         try:
             self._robot = pf.Robot(self.host, self._realtime)
             self._model = self._robot.load_model()
@@ -311,7 +323,7 @@ class FrankaRobot:
             try:
                 self._robot.automatic_error_recovery()  # type: ignore[union-attr]
             except Exception as exc:  # noqa: BLE001 - any failure here is a robot fault
-                raise fault_from(exc) from exc
+                raise fault_from(exc, self._loop.robot) from exc
         self._start()
 
     def _start(self) -> None:
@@ -319,7 +331,7 @@ class FrankaRobot:
         try:
             first = self._robot.read_once()  # type: ignore[union-attr]
         except Exception as exc:  # noqa: BLE001
-            raise fault_from(exc) from exc
+            raise fault_from(exc, self._loop.robot) from exc
         self.robot_mode = str(first.robot_mode).split(".")[-1]
         tick = self._loop.tick
         tick.kinematics(first, self._model)

@@ -32,15 +32,19 @@ from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
 
 
-def fault_from(exc: BaseException) -> RobotFault:
-    """The typed fault for a pylibfranka exception (or any other loop failure)."""
+def fault_from(exc: BaseException, robot: str = "the robot") -> RobotFault:
+    """The typed fault for a pylibfranka exception (or any other loop failure); ``robot``
+    names the robot in a lost connection's message (``"the Franka at 192.168.1.2"``)."""
     import pylibfranka as pf
 
     if isinstance(exc, RobotFault):
         return exc
     msg = f"{type(exc).__name__}: {exc}"
     if isinstance(exc, pf.NetworkException):
-        return ConnectionLost(msg)
+        return ConnectionLost(
+            f"lost the connection to {robot} ({msg}): check that it is on and reachable "
+            "(the simulator still running), then run again"
+        )
     if isinstance(exc, (pf.ControlException, pf.CommandException)):
         text = str(exc).lower()
         if "reflex" in text:
@@ -62,11 +66,19 @@ class ControlLoop:
         Control period (s).
     buffer : int
         Ticks of timing kept (ring buffers ``compute_times`` and ``read_gaps``, s).
+    robot : str
+        The robot, as faults name it (``"the Franka at 192.168.1.2"``).
     """
 
     def __init__(
-        self, tick: TorqueTick, limits: FrankaLimits, period: float, buffer: int = 20000
+        self,
+        tick: TorqueTick,
+        limits: FrankaLimits,
+        period: float,
+        buffer: int = 20000,
+        robot: str = "the robot",
     ) -> None:
+        self.robot = robot
         self.tick = tick
         self.limits = limits
         self.period = period
@@ -109,7 +121,7 @@ class ControlLoop:
         try:
             control = robot.start_torque_control()
         except Exception as exc:  # noqa: BLE001 - any refusal is a robot fault
-            raise fault_from(exc) from exc
+            raise fault_from(exc, self.robot) from exc
         self._thread = threading.Thread(
             target=self._run, args=(control, model, pf), name="franka-control", daemon=True
         )
@@ -138,7 +150,7 @@ class ControlLoop:
                 before = self.ticks
                 if not self.cond.wait(timeout=timeout) and self.ticks == before:
                     self.fault = ConnectionLost(
-                        f"no control tick for {timeout} s: the robot stopped answering"
+                        f"no control tick for {timeout} s: {self.robot} stopped answering"
                     )
         if self.fault is not None:
             raise self.fault
@@ -190,7 +202,7 @@ class ControlLoop:
                 control.writeOnce(pf.Torques(tau.tolist()))
         except BaseException as exc:  # noqa: BLE001 - every loop failure is latched as a fault
             with self.cond:
-                self.fault = fault_from(exc)
+                self.fault = fault_from(exc, self.robot)
                 self.cond.notify_all()
 
     def _adopt(self) -> None:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import contextlib
 import ipaddress
 import os
 import signal
@@ -36,6 +37,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import NoReturn
 
 from teachfit.core.errors import ConnectionLost
 
@@ -104,26 +106,46 @@ def _install_push(sim: object, robot: object, path: Path) -> None:
     del robot
 
 
+#: why the simulator cannot start while something else listens on the robot's port
+PORT_TAKEN = (
+    f"{HOST}:{ROBOT_PORT} is taken (another Franka simulator or server listens there; "
+    "libfranka's port cannot be changed): stop it, then start the simulator again"
+)
+
+
+def _refuse(why: str) -> NoReturn:
+    """One line on stderr naming the port and the fix; exit status 2."""
+    print(f"error: teachfit.robot.franka.sim: {why}", file=sys.stderr, flush=True)
+    raise SystemExit(2)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Run franky-sim (MuJoCo, one FR3) on 127.0.0.1 until SIGTERM/SIGINT."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--push-file", type=Path, default=None)
     args = parser.parse_args(argv)
+    if not _port_free(HOST, ROBOT_PORT):
+        _refuse(PORT_TAKEN)
     confine_to_loopback()
     import franky_sim
     from franky_sim.mujoco_simulator import MujocoSimulator
 
     signal.signal(signal.SIGTERM, lambda *_: (_ for _ in ()).throw(KeyboardInterrupt()))
-    with MujocoSimulator(enable_visualization=False) as sim:
+    with MujocoSimulator(enable_visualization=False) as sim, contextlib.ExitStack() as stack:
         robot = sim.add_robot()
-        with franky_sim.SimulationServer(sim, hostname_candidates=[HOST]) as server:
-            if args.push_file is not None:
-                _install_push(sim, robot, args.push_file)
-            print(f"{READY} {robot.hostname}", flush=True)  # listening since the init
-            try:
-                server.run_forever()
-            except KeyboardInterrupt:
-                pass
+        try:
+            server = stack.enter_context(
+                franky_sim.SimulationServer(sim, hostname_candidates=[HOST])
+            )
+        except OSError as exc:  # taken since the check above, or another bind failure
+            _refuse(PORT_TAKEN if not _port_free(HOST, ROBOT_PORT) else f"cannot listen: {exc}")
+        if args.push_file is not None:
+            _install_push(sim, robot, args.push_file)
+        print(f"{READY} {robot.hostname}", flush=True)  # listening since the init
+        try:
+            server.run_forever()
+        except KeyboardInterrupt:
+            pass
 
 
 class SimServer:
