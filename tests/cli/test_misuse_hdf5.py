@@ -156,7 +156,7 @@ def _commands(name: str, kind: str) -> list[list[str]]:
     """The command lines that read ``in/NAME.h5`` (a copy ``o/NAME.h5`` is an append target)."""
     if kind == "run":
         return [["demo", "show", f"in/{name}.h5"]]
-    csv = ["in/good.csv", "--columns", "in/good_columns.toml"]
+    csv = ["in/good.csv", "--columns", "in/good_columns.toml", "--task", "peg2d"]
     return [
         ["demo", "show", f"in/{name}.h5"],
         ["demo", "export", f"in/{name}.h5:0", "--out", "o/demo.csv"],
@@ -213,7 +213,7 @@ def test_a_file_size_limit_is_one_line_naming_the_output(root: Path, tmp_path: P
     shutil.copytree(root / "in", tmp_path / "in")
     runner.invoke(app, ["demo", "record", "--count", "1", "--out", str(tmp_path / "warm.h5")])
     old = (tmp_path / "in" / "good.h5").read_bytes()
-    csv = ["in/good.csv", "--columns", "in/good_columns.toml"]
+    csv = ["in/good.csv", "--columns", "in/good_columns.toml", "--task", "peg2d"]
     cases = [
         (["demo", "record", "--count", "1", "--out", "o/rec.h5"], "o/rec.h5"),
         (["demo", "import", *csv, "--append", "--out", "in/good.h5"], "in/good.h5"),
@@ -232,7 +232,13 @@ def test_a_file_size_limit_is_one_line_naming_the_output(root: Path, tmp_path: P
 
 
 def test_outputs_follow_the_umask_and_an_append_keeps_the_mode(root: Path, tmp_path: Path) -> None:
-    csv = [str(root / "in" / "good.csv"), "--columns", str(root / "in" / "good_columns.toml")]
+    csv = [
+        str(root / "in" / "good.csv"),
+        "--columns",
+        str(root / "in" / "good_columns.toml"),
+        "--task",
+        "peg2d",
+    ]
     shared = tmp_path / "shared.h5"
     shutil.copyfile(root / "in" / "good.h5", shared)
     shared.chmod(0o640)

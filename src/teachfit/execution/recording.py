@@ -55,10 +55,9 @@ import numpy as np
 
 from teachfit import __version__
 from teachfit.core.errors import DatasetError, OutputError
-from teachfit.core.geometry import Pose
 from teachfit.core.h5file import H5Reader, one_line, open_hdf5, shown, write_hdf5
-from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult
+from teachfit.execution.episode import Episode
 from teachfit.execution.recording_io import (
     FORMAT,
     FORMAT_VERSION,
@@ -68,7 +67,6 @@ from teachfit.execution.recording_io import (
     write_episode,
 )
 from teachfit.execution.skill_trial import SkillSetup, TrialOutcome
-from teachfit.skills.graph import Skill
 from teachfit.tasks.base import Task
 
 if TYPE_CHECKING:
@@ -107,25 +105,6 @@ class RunInfo:
         safe = json.loads(json.dumps(dict(options or {}), default=str))
         name, entry = (task, math.nan) if isinstance(task, str) else (task.name, task.entry_height)
         return cls(kind, name, robot, int(seed), method, shlex.join(argv), safe, float(entry))
-
-
-@dataclass(frozen=True)
-class Episode:
-    """One execution of a run: the engine's ``result``, where it started (``start``, world
-    frame), the planned set-points (``planned``, searches) and ``primitives`` (node name ->
-    what the node's primitive does, skills)."""
-
-    result: ExecutionResult
-    start: Pose | None = None
-    planned: SetpointTrajectory | None = None
-    primitives: Mapping[str, str] = field(default_factory=dict)
-    name: str = ""
-
-    @classmethod
-    def of_skill(cls, result: ExecutionResult, skill: Skill, start: Pose | None = None):
-        """An episode of ``skill`` (its nodes' primitives recorded, the recovery node too)."""
-        nodes = skill.nodes + ((skill.recovery,) if skill.recovery is not None else ())
-        return cls(result, start, primitives={n.name: n.primitive.describe() for n in nodes})
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import h5py
 import numpy as np
@@ -15,10 +15,8 @@ from teachfit.core.h5file import H5_ERRORS, H5Reader
 from teachfit.core.outcome import Outcome
 from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.execution.engine import ExecutionResult, NodeVisit
+from teachfit.execution.episode import Episode
 from teachfit.execution.log import ExecutionLog
-
-if TYPE_CHECKING:
-    from teachfit.execution.recording import Episode
 
 #: the ExecutionLog arrays, in the order of its fields
 LOG_FIELDS: tuple[str, ...] = tuple(ExecutionLog.__dataclass_fields__)
@@ -124,8 +122,6 @@ def read_episode(reader: H5Reader, parent: h5py.Group, key: str) -> Episode:
     """The episode stored in group ``key`` of ``parent`` (DatasetError for a group or dataset
     of the wrong kind or size; KeyError, TypeError or ValueError for a missing or wrong
     attribute)."""
-    from teachfit.execution.recording import Episode
-
     group = reader.group(parent, key)
     a = group.attrs
     log = ExecutionLog(
