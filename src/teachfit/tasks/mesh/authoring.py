@@ -15,7 +15,7 @@ import numpy as np
 
 from teachfit.core.errors import TaskError
 from teachfit.tasks.mesh.cell import MeshCell, build_cell, grasp_of
-from teachfit.tasks.mesh.loading import load_mesh, write_atomic
+from teachfit.tasks.mesh.loading import load_parts, write_atomic
 from teachfit.tasks.mesh.sections import infer_hole
 from teachfit.tasks.mesh.spec import SEARCH_DIMS, UNITS, MeshTaskSpec, spec_to_toml
 from teachfit.tasks.mesh.task import MeshTask, remember_cell
@@ -60,8 +60,7 @@ def new_task_file(
     )
     if hole_pos is None:
         scale = UNITS[units]
-        h = load_mesh(spec.held_mesh, scale, "held", out)
-        f = load_mesh(spec.fixed_mesh, scale, "fixed", out)
+        h, f = load_parts(spec.held_mesh, spec.fixed_mesh, units, out)
         if not np.allclose(insertion_axis, (0.0, 0.0, -1.0)):
             raise TaskError("the hole frame is inferred along -z only; give --hole-pos")
         held_tcp = h.copy()

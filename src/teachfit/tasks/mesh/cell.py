@@ -20,7 +20,7 @@ from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
 from teachfit.tasks.mesh.decompose import CACHE_DIR, CoacdSettings, Decomposition, decompose
 from teachfit.tasks.mesh.fidelity import Fidelity, decomposition_fidelity, require_fidelity
-from teachfit.tasks.mesh.loading import load_mesh
+from teachfit.tasks.mesh.loading import load_parts
 from teachfit.tasks.mesh.sections import HoleFit, check_entry, fit_of, hole_depth_of, infer_hole
 from teachfit.tasks.mesh.spec import MeshTaskSpec
 
@@ -109,8 +109,7 @@ def _moved(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
 def build_cell(spec: MeshTaskSpec) -> MeshCell:
     """Load, check, place and decompose the parts of ``spec``; see the module docstring."""
     where = str(spec.path)
-    held_raw = load_mesh(spec.held_mesh, spec.scale, "held", spec.path)
-    fixed_raw = load_mesh(spec.fixed_mesh, spec.scale, "fixed", spec.path)
+    held_raw, fixed_raw = load_parts(spec.held_mesh, spec.fixed_mesh, spec.units, spec.path)
     part2tcp = grasp_of(spec, held_raw)
     held = _moved(held_raw, part2tcp)
     if held.vertices[:, 2].min() < -1e-6:
