@@ -84,11 +84,13 @@ def assemble(
         raise TeachfitError(f"--demo {demo}: only l-groove and tenon plan from a demonstration")
     task_name = task
     if task not in ("l-groove", "tenon"):
+        from teachfit.cli.geometry_progress import geometry_progress
         from teachfit.tasks.registry import load_task
 
         # a bad task (file) before any output; its name is what a model learned on it records
         # (a task file of a built-in kind is that kind): matched as search run matches it
-        task_name = load_task(task).name
+        with geometry_progress(f"loading task {task}"):
+            task_name = load_task(task).name
     check_recording_targets(log, rrd)
     if task in ("l-groove", "tenon"):
         ang = parse_quantity(angle_error, "deg", "--angle-error")

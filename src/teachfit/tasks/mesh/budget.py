@@ -19,8 +19,6 @@ from teachfit.core.errors import TaskError
 MAX_TRIANGLES = 400_000
 #: bytes a text mesh takes per triangle at most in practice (ASCII STL: ~250; OBJ, PLY: < 100)
 TEXT_BYTES_PER_TRIANGLE = 400
-#: the largest mesh file read (bytes)
-MAX_FILE_BYTES = 84 + MAX_TRIANGLES * TEXT_BYTES_PER_TRIANGLE
 #: how to get under the bound
 DECIMATE = (
     "decimate it (e.g. MeshLab's Quadric Edge Collapse Decimation, Blender's Decimate "
@@ -44,16 +42,16 @@ def check_triangle_count(n: int, path: Path, where: str) -> None:
 
 
 def check_mesh_file(path: Path, where: str) -> None:
-    """Refuse the mesh file ``path`` before reading it: empty, larger than
-    :data:`MAX_FILE_BYTES`, a header counting too many triangles, or a binary STL whose size
-    does not match its header. ``where`` starts the messages."""
+    """Refuse the mesh file ``path`` before reading it: empty, larger than a text mesh of
+    :data:`MAX_TRIANGLES` triangles takes, a header counting too many triangles, or a binary
+    STL whose size does not match its header. ``where`` starts the messages."""
     try:
         size = path.stat().st_size
     except OSError as exc:
         raise TaskError(f"{where}: cannot read {path} ({exc.strerror or exc})") from exc
     if size == 0:
         raise TaskError(f"{where}: {path} is empty; export the part as a mesh")
-    if size > MAX_FILE_BYTES:
+    if size > 84 + MAX_TRIANGLES * TEXT_BYTES_PER_TRIANGLE:
         raise TaskError(
             f"{where}: {path} is {size / 1e6:,.0f} MB, more than a mesh of {MAX_TRIANGLES:,} "
             f"triangles (the most a part may have) takes; {DECIMATE}"

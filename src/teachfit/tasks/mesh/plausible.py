@@ -68,11 +68,15 @@ def check_sizes(parts: Sequence[PartSize], units: str, task_file: Path) -> None:
         problem = part.problem(scale)
         if problem is None:
             continue
-        dims = " x ".join(f"{1e3 * e * scale:.4g}" for e in part.extents)
+        dims = " x ".join(_mm(1e3 * e * scale) for e in part.extents)
         raise TaskError(
             f'{task_file} [{part.role}] mesh: {part.path} is {dims} mm at units = "{units}", '
             f"{problem}; {_hint(part, parts)}"
         )
+
+
+def _mm(value: float) -> str:
+    return f"{value:.0f}" if value >= 100 else f"{value:.3g}"
 
 
 def _hint(part: PartSize, parts: Sequence[PartSize]) -> str:
