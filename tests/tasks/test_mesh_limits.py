@@ -180,3 +180,15 @@ def test_a_sparse_file_named_in_a_task_costs_nothing(tmp_path: Path, no_reading:
     with pytest.raises(TaskError, match="peg.stl is 3,000 MB"):
         load_parts(held, fixed, "mm", tmp_path / "t.toml")
     assert os.stat(held).st_blocks * 512 < 10**6  # still sparse: nothing was written
+
+
+def test_building_a_cell_reports_its_stages(mesh_examples: dict[str, str]) -> None:
+    from teachfit.tasks.mesh.cell import build_cell
+    from teachfit.tasks.mesh.spec import read_spec
+
+    seen: list[tuple[str, int, int]] = []
+    with reporting(lambda what, done, total: seen.append((what, done, total))):
+        build_cell(read_spec(mesh_examples["usb"]))
+    stages = [(done, total) for what, done, total in seen if what.startswith("building")]
+    assert stages == [(0, 4), (1, 4), (2, 4), (3, 4), (4, 4)]
+    assert ("self-intersection check usb_plug.stl", 1, 1) in seen

@@ -7,6 +7,7 @@ from contextlib import contextmanager
 
 from rich.progress import TaskID
 
+from teachfit.cli.common import console
 from teachfit.cli.progress import progress_bar
 from teachfit.tasks.mesh.progress import reporting
 
@@ -14,7 +15,11 @@ from teachfit.tasks.mesh.progress import reporting
 @contextmanager
 def geometry_progress(what: str) -> Iterator[None]:
     """Show ``what`` with a spinner-like bar, and a bar for each step of geometry work that
-    the mesh code reports inside the ``with`` block (transient: gone once done)."""
+    the mesh code reports inside the ``with`` block (transient: gone once done; nothing when
+    the output is not a terminal)."""
+    if not console.is_terminal:
+        yield
+        return
     with progress_bar() as bar:
         bar.add_task(what, total=None)
         steps: dict[str, TaskID] = {}

@@ -130,12 +130,20 @@ def _hole(
     return hole2fixed, fixed_h, float(depth)
 
 
-def build_cell(spec: MeshTaskSpec) -> MeshCell:
-    """Load, check, place and decompose the parts of ``spec``; see the module docstring."""
+def build_cell(
+    spec: MeshTaskSpec, parts: tuple[trimesh.Trimesh, trimesh.Trimesh] | None = None
+) -> MeshCell:
+    """Load, check, place and decompose the parts of ``spec``; see the module docstring.
+
+    ``parts``: the held and fixed meshes as :func:`load_parts` gave them for ``spec``
+    (default: loaded here).
+    """
     where = str(spec.path)
     stage = f"building the cell of {spec.path.name}"
     report(stage, 0, 4)
-    held_raw, fixed_raw = load_parts(spec.held_mesh, spec.fixed_mesh, spec.units, spec.path)
+    if parts is None:
+        parts = load_parts(spec.held_mesh, spec.fixed_mesh, spec.units, spec.path)
+    held_raw, fixed_raw = parts
     report(stage, 1, 4)
     part2tcp = grasp_of(spec, held_raw)
     held = _moved(held_raw, part2tcp)
