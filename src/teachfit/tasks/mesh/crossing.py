@@ -8,8 +8,11 @@ neighbours no longer touch, so coal's BVH traversal (the broad phase) reports on
 triangle against itself and the pairs that truly cross. Pairs that share a vertex are
 dropped as before (a crossing confined to a shared vertex's neighbourhood is not a fold).
 The work runs in slabs of :data:`CHUNK` triangles (sorted along the part's longest axis)
-against the whole mesh, reported to
-:func:`teachfit.tasks.mesh.progress.report`.
+against the whole mesh, reported to :func:`teachfit.tasks.mesh.progress.report`. Measured
+(CPU time, icospheres): 20 k triangles 0.5 s, 82 k 1.4 s, 328 k 5.7 s (the contacts of
+every touching pair took 0.9, 6.2 and 58 s). A crossing confined to the outer 1 % of a
+triangle is not seen. Long slivers fanning out of one vertex still overlap each other's
+bounding volumes: a cylinder whose caps are fans of 8,000 triangles takes ~20 s.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ import trimesh
 from teachfit.tasks.mesh.progress import report
 
 #: fraction of its size each triangle shrinks by towards its centroid
-SHRINK = 1e-3
+SHRINK = 1e-2
 #: GJK tolerance in coordinates scaled to the part's size (well below the shrunk gaps)
 GJK_TOLERANCE = 1e-10
 #: triangles collided against the whole mesh per step
