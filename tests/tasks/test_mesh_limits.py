@@ -92,6 +92,14 @@ def test_text_meshes_are_bounded_by_size_and_by_count_once_read(
         budget.check_mesh_file(ply, WHERE)  # the header's count
 
 
+def test_an_ascii_stl_named_in_utf8_is_text_not_a_truncated_binary(tmp_path: Path) -> None:
+    text = trimesh.creation.box((0.01, 0.01, 0.01)).export(file_type="stl_ascii")
+    path = tmp_path / "teil.stl"
+    path.write_bytes(text.replace("solid", "solid Bauteil_ü", 1).encode())
+    budget.check_mesh_file(path, WHERE)
+    assert len(loading.read_mesh(path, WHERE).faces) == 12
+
+
 @pytest.mark.parametrize(
     ("scale", "units", "words", "fits"),
     [

@@ -79,7 +79,7 @@ def _stl_count(path: Path, size: int, where: str) -> int | None:
     if len(head) >= 84 and 84 + 50 * n == size:
         return n
     start = head[:1024]
-    if start.lstrip().lower().startswith(b"solid") and start.isascii() and b"\0" not in start:
+    if start.lstrip().lower().startswith(b"solid") and b"\0" not in start:
         return None  # ASCII STL: bounded by its size
     raise TaskError(
         f"{where}: {path} is not a whole binary STL (its header counts {n:,} triangles, "
