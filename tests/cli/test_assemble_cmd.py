@@ -56,6 +56,23 @@ def test_assemble_bad_input_is_one_line_and_exit_2(peg_model):
     assert "Traceback" not in res.output
 
 
+def test_assemble_matches_a_model_to_a_task_file_as_search_run_does(tmp_path, peg_model):
+    # a model learned on peg2d records 'peg2d'; a task file of kind peg2d is that task, so
+    # assemble accepts the model as search run does (it once asked for the file's name)
+    task_file = tmp_path / "mypeg.toml"
+    task_file.write_text('task = "peg2d"\n', encoding="utf-8")
+    res = invoke(
+        "assemble", "--task", task_file, "--search", peg_model, "--hole-error", "0mm",
+        "--trials", 1,
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "success 1/1" in res.output
+    other = tmp_path / "mysocket.toml"
+    other.write_text('task = "socket3d"\n', encoding="utf-8")
+    res = invoke("assemble", "--task", other, "--search", peg_model, "--trials", 1)
+    assert res.exit_code == 2 and "learned for task 'peg2d', not 'socket3d'" in res.output
+
+
 def test_assemble_l_groove_with_a_missing_demo_is_one_line(tmp_path):
     res = invoke("assemble", "--task", "l-groove", "--demo", tmp_path / "none.h5", "--trials", 1)
     assert res.exit_code == 2 and "none.h5" in res.output and "Traceback" not in res.output

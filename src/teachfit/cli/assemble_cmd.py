@@ -87,10 +87,15 @@ def assemble(
 
         _load_demo(str(demo))  # a bad file is named first
         raise TeachfitError(f"--demo {demo}: only l-groove and tenon plan from a demonstration")
+    task_name = task
     if task not in ("l-groove", "tenon"):
+        from teachfit.cli.geometry_progress import geometry_progress
         from teachfit.tasks.registry import load_task
 
-        load_task(task)  # a bad task (file) before any output
+        # a bad task (file) before any output; its name is what a model learned on it records
+        # (a task file of a built-in kind is that kind): matched as search run matches it
+        with geometry_progress(f"loading task {task}"):
+            task_name = load_task(task).name
     check_recording_targets(log, rrd)
     if task in ("l-groove", "tenon"):
         ang = parse_quantity(angle_error, "deg", "--angle-error")
@@ -105,7 +110,7 @@ def assemble(
 
     if trials < 1:
         raise TeachfitError(f"--trials must be >= 1, got {trials}")
-    model = SearchModel.load(search, task=task) if search is not None else None
+    model = SearchModel.load(search, task=task_name) if search is not None else None
     if model is not None and skill != "peg-in-hole":
         raise TeachfitError(f"the learned search recovers the peg-in-hole skill, not {skill!r}")
     method = "joined" if model is not None else "skill"

@@ -28,9 +28,12 @@ def _list(xml: str | None) -> None:
     from teachfit.tasks.registry import TASKS, load_task
 
     if xml is not None:
+        from teachfit.cli.geometry_progress import geometry_progress
         from teachfit.robot.floating import build_scene
 
-        console.print(build_scene(load_task(xml)), markup=False, highlight=False)
+        with geometry_progress(f"loading task {xml}"):
+            task = load_task(xml)
+        console.print(build_scene(task), markup=False, highlight=False)
         return
     for name, cls in TASKS.items():
         task = cls()
@@ -91,10 +94,11 @@ def tasks_new(
     overwrite: Annotated[bool, typer.Option(help="replace an existing task file")] = False,
 ) -> None:
     """Write a task file for your own two meshes (hole frame inferred unless given)."""
+    from teachfit.cli.geometry_progress import geometry_progress
     from teachfit.tasks.mesh.authoring import new_task_file
 
     axis = _vec(insertion_axis, "--insertion-axis")
-    with console.status("checking and decomposing the parts"):
+    with geometry_progress("checking and decomposing the parts"):
         path, cell = new_task_file(
             out,
             held,
@@ -121,11 +125,12 @@ def tasks_show(
 ) -> None:
     """Describe a mesh task's cell, run its checks and optionally plot it; exit 1 if a
     check fails."""
+    from teachfit.cli.geometry_progress import geometry_progress
     from teachfit.tasks.mesh.authoring import describe
     from teachfit.tasks.mesh.task import MeshTask
     from teachfit.tasks.registry import load_task
 
-    with console.status("loading and decomposing the parts"):
+    with geometry_progress("loading and decomposing the parts"):
         task = load_task(task_file)
     if not isinstance(task, MeshTask):
         raise TaskError(f'{task_file} is not a mesh task (task = "mesh")')

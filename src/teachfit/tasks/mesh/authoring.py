@@ -15,7 +15,7 @@ import numpy as np
 
 from teachfit.core.errors import TaskError
 from teachfit.tasks.mesh.cell import MeshCell, build_cell, grasp_of
-from teachfit.tasks.mesh.loading import load_mesh, write_atomic
+from teachfit.tasks.mesh.loading import load_parts, write_atomic
 from teachfit.tasks.mesh.sections import infer_hole
 from teachfit.tasks.mesh.spec import SEARCH_DIMS, UNITS, MeshTaskSpec, spec_to_toml
 from teachfit.tasks.mesh.task import MeshTask, remember_cell
@@ -58,17 +58,17 @@ def new_task_file(
         success_depth=success_depth,
         rz_period_deg=rz_period_deg,
     )
+    parts = load_parts(spec.held_mesh, spec.fixed_mesh, units, out)
     if hole_pos is None:
         scale = UNITS[units]
-        h = load_mesh(spec.held_mesh, scale, "held", out)
-        f = load_mesh(spec.fixed_mesh, scale, "fixed", out)
+        h, f = parts
         if not np.allclose(insertion_axis, (0.0, 0.0, -1.0)):
             raise TaskError("the hole frame is inferred along -z only; give --hole-pos")
         held_tcp = h.copy()
         held_tcp.apply_transform(grasp_of(spec, h))
         pos = infer_hole(f, held_tcp) / scale
         spec = dataclasses.replace(spec, hole_pos=tuple(float(round(v, 6)) + 0.0 for v in pos))
-    cell = build_cell(spec)
+    cell = build_cell(spec, parts)
     write_atomic(out, spec_to_toml(spec).encode())
     remember_cell(out, cell)
     return out, cell

@@ -20,7 +20,8 @@ from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
 from teachfit.tasks.mesh.decompose import CACHE_DIR, CoacdSettings, Decomposition, decompose
 from teachfit.tasks.mesh.fidelity import Fidelity, decomposition_fidelity, require_fidelity
-from teachfit.tasks.mesh.loading import load_mesh
+from teachfit.tasks.mesh.loading import load_parts
+from teachfit.tasks.mesh.progress import report
 from teachfit.tasks.mesh.sections import HoleFit, check_entry, fit_of, hole_depth_of, infer_hole
 from teachfit.tasks.mesh.spec import MeshTaskSpec
 
@@ -106,22 +107,19 @@ def _moved(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
     return out
 
 
-def build_cell(spec: MeshTaskSpec) -> MeshCell:
-    """Load, check, place and decompose the parts of ``spec``; see the module docstring."""
+def _hole(
+    spec: MeshTaskSpec, fixed: trimesh.Trimesh, held: trimesh.Trimesh
+) -> tuple[np.ndarray, trimesh.Trimesh, float]:
+    """The hole frame in the fixed mesh (given or inferred), the fixed mesh in that frame and
+    the success depth (m)."""
     where = str(spec.path)
-    held_raw = load_mesh(spec.held_mesh, spec.scale, "held", spec.path)
-    fixed_raw = load_mesh(spec.fixed_mesh, spec.scale, "fixed", spec.path)
-    part2tcp = grasp_of(spec, held_raw)
-    held = _moved(held_raw, part2tcp)
-    if held.vertices[:, 2].min() < -1e-6:
-        raise TaskError(f"{where}: the grasp puts part of the held mesh below the TCP (tip)")
     if spec.hole_pos is None:
-        pos = infer_hole(fixed_raw, held)
+        pos = infer_hole(fixed, held)
     else:
         pos = np.asarray(spec.hole_pos) * spec.scale
     x_hint = None if spec.hole_x_axis is None else np.asarray(spec.hole_x_axis)
     hole2fixed = hole_frame(pos, np.asarray(spec.insertion_axis), x_hint, where)
-    fixed_h = _moved(fixed_raw, np.linalg.inv(hole2fixed))
+    fixed_h = _moved(fixed, np.linalg.inv(hole2fixed))
     check_entry(fixed_h, where)
     if spec.success_depth is None:
         depth = 0.6 * min(hole_depth_of(fixed_h), held.vertices[:, 2].max())
@@ -129,19 +127,45 @@ def build_cell(spec: MeshTaskSpec) -> MeshCell:
         depth = spec.success_depth * spec.scale
     if depth <= 0:
         raise TaskError(f"{where}: success_depth must be > 0")
+    return hole2fixed, fixed_h, float(depth)
+
+
+def build_cell(
+    spec: MeshTaskSpec, parts: tuple[trimesh.Trimesh, trimesh.Trimesh] | None = None
+) -> MeshCell:
+    """Load, check, place and decompose the parts of ``spec``; see the module docstring.
+
+    ``parts``: the held and fixed meshes as :func:`load_parts` gave them for ``spec``
+    (default: loaded here).
+    """
+    where = str(spec.path)
+    stage = f"building the cell of {spec.path.name}"
+    report(stage, 0, 4)
+    if parts is None:
+        parts = load_parts(spec.held_mesh, spec.fixed_mesh, spec.units, spec.path)
+    held_raw, fixed_raw = parts
+    report(stage, 1, 4)
+    part2tcp = grasp_of(spec, held_raw)
+    held = _moved(held_raw, part2tcp)
+    if held.vertices[:, 2].min() < -1e-6:
+        raise TaskError(f"{where}: the grasp puts part of the held mesh below the TCP (tip)")
+    hole2fixed, fixed_h, depth = _hole(spec, fixed_raw, held)
     fit = fit_of(fixed_h, held, depth, where)
     z_entry = -float(fixed_h.vertices[:, 2].min())
     hole2world = Pose(np.array([0.0, 0.0, z_entry]))
     fixed2world = hole2world.matrix @ np.linalg.inv(hole2fixed)
     settings = _settings(spec)
     cache = spec.path.parent / CACHE_DIR
+    report(stage, 2, 4)
     held_pieces = decompose(held_raw, settings, cache, Path(spec.held_mesh).stem)
     fixed_pieces = decompose(fixed_raw, settings, cache, Path(spec.fixed_mesh).stem)
+    report(stage, 3, 4)
     in_hole = [v - [0.0, 0.0, z_entry] for v in fixed_pieces.moved(fixed2world)]
     fid = decomposition_fidelity(
         fixed_h, in_hole, held_pieces.moved(part2tcp), depth, fit.clearance
     )
     require_fidelity(fid, where)
+    report(stage, 4, 4)
     return MeshCell(
         spec=spec,
         held=held,

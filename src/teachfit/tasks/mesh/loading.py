@@ -1,69 +1,77 @@
-"""Loading a user's part mesh (STL, OBJ, PLY through ``trimesh``) and rejecting bad ones.
+"""Loading a user's part meshes (STL, OBJ, PLY through ``trimesh``) and rejecting bad ones.
 
-A mesh must be a closed solid a collision check can trust: readable, non-empty, watertight,
-consistently wound, of positive volume, not made of shells that overlap each other (the
-usual self-intersection of CAD exports: bodies exported without their union) and of a size
-that fits its declared units (a 20 m peg is a mm mesh declared as m). Each failure is one
-:class:`~teachfit.core.errors.TaskError` line naming the file and the fix.
+A mesh must be a closed solid a collision check can trust: within the size and triangle
+bounds (:mod:`.budget`, checked before it is read), readable, non-empty, of a size that fits
+its declared units (:mod:`.plausible`: a 20 m peg is a mm mesh declared as m; checked before
+the solid checks, so a unit mistake is named as such), watertight, consistently wound, of
+positive volume, not made of shells that overlap each other (the usual self-intersection of
+CAD exports: bodies exported without their union) nor of one shell folding through itself
+(:mod:`.crossing`). Each failure is one :class:`~teachfit.core.errors.TaskError` line naming
+the file and the fix.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import coal
 import manifold3d
 import numpy as np
 import trimesh
 
 from teachfit.core.atomic import atomic_write_bytes
 from teachfit.core.errors import TaskError
+from teachfit.tasks.mesh.budget import check_mesh_file, check_triangle_count
+from teachfit.tasks.mesh.crossing import crossing_triangles
+from teachfit.tasks.mesh.plausible import PartSize, check_sizes
+from teachfit.tasks.mesh.progress import report
+from teachfit.tasks.mesh.spec import UNITS
 
 #: file types accepted for part meshes
 MESH_SUFFIXES = (".stl", ".obj", ".ply")
-#: a part larger than this (m) along any axis is taken for a unit mistake
-MAX_EXTENT = 1.0
-#: a part smaller than this (m) along every axis is taken for a unit mistake
-MIN_EXTENT = 0.001
 
 
-def load_mesh(path: Path, scale: float, role: str, task_file: Path) -> trimesh.Trimesh:
-    """The mesh at ``path`` with coordinates multiplied by ``scale`` (metres per unit).
-
-    ``role`` (``"held"`` or ``"fixed"``) and ``task_file`` only word the errors.
-    """
-    where = f"{task_file} [{role}] mesh"
+def read_mesh(path: Path, where: str) -> trimesh.Trimesh:
+    """The mesh at ``path`` in its own numbers (file units), within the :mod:`.budget`
+    bounds; ``where`` starts the error messages."""
     if not path.is_file():
         raise TaskError(f"{where}: {path} does not exist; fix the path (relative to the task file)")
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise TaskError(f"{where}: {path} is not an STL, OBJ or PLY file")
+    check_mesh_file(path, where)
     try:
         loaded = trimesh.load(path, force="mesh", process=True)
     except Exception as exc:  # trimesh raises many types for broken files
         raise TaskError(f"{where}: cannot read {path} ({type(exc).__name__}: {exc})") from exc
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise TaskError(f"{where}: {path} holds no triangles; export the part as a mesh")
-    mesh = loaded.copy()
-    mesh.apply_scale(scale)
-    check_solid(mesh, f"{where} {path}")
-    extent = float(np.ptp(mesh.vertices, axis=0).max())
-    if extent > MAX_EXTENT:
-        raise TaskError(
-            f"{where}: {path} is {extent:.1f} m across at the declared units; a part that large "
-            'is a unit mistake: set units ("mm" for a CAD mesh in millimetres)'
-        )
-    if extent < MIN_EXTENT:
-        raise TaskError(
-            f"{where}: {path} is {1e3 * extent:.3f} mm across at the declared units; set units "
-            '("m" for a mesh in metres)'
-        )
-    return mesh
+    check_triangle_count(len(loaded.faces), path, where)
+    if not np.all(np.isfinite(loaded.vertices)):
+        raise TaskError(f"{where} {path}: non-finite vertex coordinates; re-export the part")
+    return loaded.copy()
 
 
-def check_solid(mesh: trimesh.Trimesh, where: str) -> None:
+def load_parts(
+    held: Path, fixed: Path, units: str, task_file: Path
+) -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
+    """The held and the fixed part's meshes (m; coordinates times the ``units``' scale),
+    read, checked for plausible sizes at ``units`` and then as solids (see the module
+    docstring). ``task_file`` words the errors."""
+    where = {role: f"{task_file} [{role}] mesh" for role in ("held", "fixed")}
+    meshes = {"held": read_mesh(held, where["held"]), "fixed": read_mesh(fixed, where["fixed"])}
+    paths = {"held": held, "fixed": fixed}
+    sizes = [PartSize(r, paths[r], np.ptp(m.vertices, axis=0)) for r, m in meshes.items()]
+    check_sizes(sizes, units, task_file)
+    for role, mesh in meshes.items():
+        mesh.apply_scale(UNITS[units])
+        check_solid(mesh, f"{where[role]} {paths[role]}", paths[role].name)
+    return meshes["held"], meshes["fixed"]
+
+
+def check_solid(mesh: trimesh.Trimesh, where: str, name: str = "") -> None:
     """Raise :class:`TaskError` unless ``mesh`` is a closed, non-self-overlapping solid.
 
-    Inverted meshes (all normals inward) are turned outward in place.
+    Inverted meshes (all normals inward) are turned outward in place. ``name`` names the
+    mesh in the progress reports.
     """
     if not np.all(np.isfinite(mesh.vertices)):
         raise TaskError(f"{where}: non-finite vertex coordinates; re-export the part")
@@ -81,17 +89,19 @@ def check_solid(mesh: trimesh.Trimesh, where: str) -> None:
         raise TaskError(f"{where}: zero volume; export the part as a solid")
     bodies = mesh.split(only_watertight=False) if mesh.body_count > 1 else [mesh]
     if len(bodies) > 1:
+        report(f"shell overlap check {name}".strip(), 0, 1)
         total = sum(abs(b.volume) for b in bodies)
         union = manifold3d.Manifold.batch_boolean(
             [to_manifold(b) for b in bodies], manifold3d.OpType.Add
         )
+        report(f"shell overlap check {name}".strip(), 1, 1)
         if union.volume() < total * (1 - 1e-6):
             raise TaskError(
                 f"{where}: self-intersecting ({len(bodies)} shells overlap by "
                 f"{1e9 * (total - union.volume()):.1f} mm^3); export the union of the bodies"
             )
     for body in bodies:
-        crossing = crossing_triangles(body)
+        crossing = crossing_triangles(body, name)
         if crossing is not None:
             n, at = crossing
             raise TaskError(
@@ -99,39 +109,6 @@ def check_solid(mesh: trimesh.Trimesh, where: str) -> None:
                 f"other, e.g. at ({', '.join(f'{1e3 * v:.2f}' for v in at)}) mm); repair the "
                 "fold in CAD and re-export the part"
             )
-
-
-def crossing_triangles(mesh: trimesh.Trimesh) -> tuple[int, np.ndarray] | None:
-    """Pairs of triangles of ``mesh`` that meet without sharing a vertex (a shell folding
-    through itself), their number and one contact point (m); None when there are none.
-
-    coal collides the mesh's BVH with itself (manifold3d accepts such a mesh as manifold:
-    its check is topological); every triangle touches itself and its neighbours, so the
-    contact budget covers those and the pairs that share a vertex are dropped.
-    """
-    model = coal.BVHModelOBBRSS()
-    faces = np.asarray(mesh.faces, dtype=np.int64)
-    model.beginModel(len(faces), len(mesh.vertices))
-    verts = coal.StdVec_Vec3s()
-    verts.extend(list(np.asarray(mesh.vertices, dtype=float)))
-    tris = coal.StdVec_Triangle()
-    tris.extend([coal.Triangle(int(a), int(b), int(c)) for a, b, c in faces])
-    model.addSubModel(verts, tris)
-    model.endModel()
-    degree = np.bincount(faces.ravel(), minlength=len(mesh.vertices))
-    request = coal.CollisionRequest()
-    request.num_max_contacts = int(2 * degree[faces].sum() + 2 * len(faces) + 1000)
-    result = coal.CollisionResult()
-    eye = coal.Transform3s()
-    coal.collide(model, eye, model, eye, request, result)
-    contacts = result.getContacts()
-    pairs = np.array([(c.b1, c.b2) for c in contacts], dtype=np.int64).reshape(-1, 2)
-    a, b = faces[pairs[:, 0]], faces[pairs[:, 1]]
-    crossing = ~(a[:, :, None] == b[:, None, :]).any(axis=(1, 2))
-    if not crossing.any():
-        return None
-    first = int(np.flatnonzero(crossing)[0])
-    return int(crossing.sum()) // 2, np.asarray(contacts[first].pos, dtype=float)
 
 
 def to_manifold(mesh: trimesh.Trimesh) -> manifold3d.Manifold:

@@ -8,7 +8,9 @@ rectilinear, and for those an exact decomposition is simple: the planes of the f
 bounding box into a grid of cells, each wholly inside or outside the part (tested on the
 part's cross-section at the cell's mid-height, :func:`teachfit.tasks.mesh.sections.section`),
 and the inside cells merge greedily into as few boxes as that finds. The boxes' union is the
-part exactly. Parts with slanted or curved faces return None and go to ``coacd``.
+part exactly. Parts with slanted or curved faces return None and go to ``coacd``. The planes
+are the faces' own (the inner vertices of a finely tessellated face add none), and a grid of
+more than :data:`MAX_CELLS` cells goes to ``coacd`` too instead of filling memory.
 """
 
 from __future__ import annotations
@@ -21,6 +23,8 @@ from teachfit.tasks.mesh.sections import section
 
 #: coordinates closer than this fraction of the part's size are one grid plane
 MERGE_TOL = 1e-7
+#: most grid cells the exact decomposition tries
+MAX_CELLS = 2_000_000
 
 
 def _planes(coords: np.ndarray, tol: float) -> np.ndarray:
@@ -72,7 +76,11 @@ def box_pieces(mesh: trimesh.Trimesh, max_pieces: int) -> list[trimesh.Trimesh] 
     if not is_rectilinear(mesh):
         return None
     tol = MERGE_TOL * float(np.ptp(mesh.vertices, axis=0).max())
-    xs, ys, zs = (_planes(mesh.vertices[:, a], tol) for a in range(3))
+    axis = np.abs(mesh.face_normals).argmax(axis=1)
+    centres = mesh.triangles_center
+    xs, ys, zs = (_planes(centres[axis == a, a], tol) for a in range(3))
+    if min(len(xs), len(ys), len(zs)) < 2 or len(xs) * len(ys) * len(zs) > MAX_CELLS:
+        return None
     boxes = _greedy_boxes(_occupancy(mesh, xs, ys, zs))
     if not boxes or len(boxes) > max_pieces:
         return None
