@@ -19,8 +19,8 @@ import cv2
 import numpy as np
 
 from teachfit.capture.geometry import rotation_angle_deg
-from teachfit.capture.markers import read_markers
-from teachfit.capture.rig import read_rig
+from teachfit.capture.markers import MarkerSet, read_markers
+from teachfit.capture.rig import Rig, read_rig
 from teachfit.capture.sources import VideoSet
 from teachfit.capture.synth import SynthConfig, write_synth_capture
 from teachfit.capture.track import Track, TrackConfig, Tracker, track_frames
@@ -107,44 +107,12 @@ def run_capture_bench(
     truth = read_demo(paths["truth"])
     videos = [paths[f"video{i}"] for i in range(len(rig))]
     track_cfg = track_cfg or TrackConfig()
-    rows = []
-    runs = [(n, track_cfg) for n in range(1, len(rig) + 1)]
-    if track_cfg.filter is not None:  # the temporal filter's share: all cameras without it
-        runs.append((len(rig), replace(track_cfg, filter=None)))
-    for n, tcfg in runs:
-        sub = rig.subset(range(n))
-        label = f"{n} cam" + ("" if tcfg.filter is not None else ", no filter")
-
-        def tick(d: int, lb: str = label) -> None:
-            if progress is not None:
-                progress(lb, d, truth.n_samples)
-
-        track = track_frames(VideoSet(videos[:n], sub), sub, markers, tcfg, progress=tick)
-        rows.append(_row(n, tcfg.filter is not None, track, truth))
+    rows = _accuracy_rows(rig, markers, videos, truth, track_cfg, progress)
     # speed: the first 1080p stream (else the largest), one OpenCV thread, decoding included
     sizes = [(c.width * c.height, i) for i, c in enumerate(rig.cameras)]
     hd = [i for i, c in enumerate(rig.cameras) if (c.width, c.height) == (1920, 1080)]
     idx = hd[0] if hd else max(sizes)[1]
-    threads = cv2.getNumThreads()
-    cv2.setNumThreads(1)
-    try:
-        sub = rig.subset([idx])
-        tracker = Tracker(sub, markers, track_cfg)
-        t_dec = t_trk = 0.0
-        n = 0
-        frames = iter(VideoSet([videos[idx]], sub, threads=1))
-        while True:
-            t0 = time.perf_counter()
-            item = next(frames, None)
-            t1 = time.perf_counter()
-            if item is None:
-                break
-            tracker.step(*item)
-            t_dec += t1 - t0
-            t_trk += time.perf_counter() - t1
-            n += 1
-    finally:
-        cv2.setNumThreads(threads)
+    n, t_dec, t_trk = _time_one_stream(rig.subset([idx]), markers, videos[idx], track_cfg)
     cam = rig.cameras[idx]
     setup = (
         f"{len(rig)} cameras ({', '.join(f'{c.width}x{c.height}' for c in rig.cameras)}), "
@@ -159,6 +127,60 @@ def run_capture_bench(
         stream=f"{cam.name} {cam.width}x{cam.height}",
         setup=setup,
     )
+
+
+def _accuracy_rows(
+    rig: Rig,
+    markers: MarkerSet,
+    videos: list[Path],
+    truth: Demonstration,
+    track_cfg: TrackConfig,
+    progress: Callable[[str, int, int], None] | None,
+) -> list[AccuracyRow]:
+    """Track ``videos`` with the first 1, 2, ... cameras of ``rig`` and score each against
+    ``truth``; with a temporal filter, all cameras once more without it (the filter's share)."""
+    rows = []
+    runs = [(n, track_cfg) for n in range(1, len(rig) + 1)]
+    if track_cfg.filter is not None:  # the temporal filter's share: all cameras without it
+        runs.append((len(rig), replace(track_cfg, filter=None)))
+    for n, tcfg in runs:
+        sub = rig.subset(range(n))
+        label = f"{n} cam" + ("" if tcfg.filter is not None else ", no filter")
+
+        def tick(d: int, lb: str = label) -> None:
+            if progress is not None:
+                progress(lb, d, truth.n_samples)
+
+        track = track_frames(VideoSet(videos[:n], sub), sub, markers, tcfg, progress=tick)
+        rows.append(_row(n, tcfg.filter is not None, track, truth))
+    return rows
+
+
+def _time_one_stream(
+    sub: Rig, markers: MarkerSet, video: Path, track_cfg: TrackConfig
+) -> tuple[int, float, float]:
+    """Decode and track ``video`` (one camera, ``sub``) with one OpenCV thread: the number of
+    frames and the wall time (s) spent decoding and tracking them."""
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        tracker = Tracker(sub, markers, track_cfg)
+        t_dec = t_trk = 0.0
+        n = 0
+        frames = iter(VideoSet([video], sub, threads=1))
+        while True:
+            t0 = time.perf_counter()
+            item = next(frames, None)
+            t1 = time.perf_counter()
+            if item is None:
+                break
+            tracker.step(*item)
+            t_dec += t1 - t0
+            t_trk += time.perf_counter() - t1
+            n += 1
+    finally:
+        cv2.setNumThreads(threads)
+    return n, t_dec, t_trk
 
 
 def to_markdown(b: CaptureBench, command: str = "teachfit bench capture") -> str:

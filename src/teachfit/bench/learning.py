@@ -209,20 +209,7 @@ def run_experiment(
     if method not in METHODS:
         raise LearningError(f"unknown method {method!r}; known: {list(METHODS)}")
     with tempfile.TemporaryDirectory(prefix="teachfit-bench-", dir=_ram_dir()) as tmp:
-        db = storage or Path(tmp) / "study.db"
-        study = Study(
-            db,
-            task=objective.task,
-            skill=objective.skill,
-            space=objective.space,
-            method=method,
-            seed=objective.seed,
-            options=method_options(method, trials),
-            penalty=objective.penalty,
-            resume=storage is not None,
-            context=objective.context(),
-            name=f"{objective.task}-{method}-{objective.seed}",
-        )
+        study = _open_study(objective, method, trials, storage or Path(tmp) / "study.db", storage)
         t0 = time.perf_counter()
         if ray is not None:
             from teachfit.learning.ray_runner import run_study_ray
@@ -248,13 +235,7 @@ def run_experiment(
         wall = time.perf_counter() - t0
         study.close()
         if report.interrupted:  # the rest of a grid must not run on (nor count it whole)
-            kept = (
-                f"its {study.n_finished} finished trials are in {storage}: the same command resumes"
-                if storage is not None
-                else "its trials are discarded (keep studies to resume)"
-            )
-            what = f"{objective.task}/{method} seed {objective.seed}"
-            raise BenchInterrupted(f"{what} interrupted; {kept}")
+            raise _interrupted(objective, method, study, storage)
         return Experiment.from_records(
             objective.task,
             method,
@@ -264,6 +245,42 @@ def run_experiment(
             objective.n_starts,
             study.n_restored,
         )
+
+
+def _interrupted(
+    objective: SkillObjective, method: str, study: Study, storage: str | Path | None
+) -> BenchInterrupted:
+    """The error of an interrupted experiment, saying where its trials are kept, if anywhere."""
+    kept = (
+        f"its {study.n_finished} finished trials are in {storage}: the same command resumes"
+        if storage is not None
+        else "its trials are discarded (keep studies to resume)"
+    )
+    what = f"{objective.task}/{method} seed {objective.seed}"
+    return BenchInterrupted(f"{what} interrupted; {kept}")
+
+
+def _open_study(
+    objective: SkillObjective,
+    method: str,
+    trials: int,
+    db: str | Path,
+    storage: str | Path | None,
+) -> Study:
+    """The study of one experiment in ``db``, resumed when the caller keeps it (``storage``)."""
+    return Study(
+        db,
+        task=objective.task,
+        skill=objective.skill,
+        space=objective.space,
+        method=method,
+        seed=objective.seed,
+        options=method_options(method, trials),
+        penalty=objective.penalty,
+        resume=storage is not None,
+        context=objective.context(),
+        name=f"{objective.task}-{method}-{objective.seed}",
+    )
 
 
 def study_path(folder: str | Path, objective: SkillObjective, method: str, trials: int) -> Path:

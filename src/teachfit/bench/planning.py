@@ -100,6 +100,12 @@ class PlanningBenchConfig:
         """Planning queries in all (for a progress bar)."""
         return len(self.tasks) * (self.seeds + self.n_no_demo)
 
+    def check_overrides(self) -> None:
+        """Build each task's parts with :attr:`overrides` once: an override a task does not
+        have raises its PlanningError before any run."""
+        for task in self.tasks:
+            build_assembly(task, **dict(self.overrides))
+
     def command(self) -> str:
         """The ``teachfit bench planning`` command line that runs this configuration."""
         checks = "" if self.max_checks is None else f" --max-checks {self.max_checks}"

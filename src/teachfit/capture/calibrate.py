@@ -113,55 +113,81 @@ def calibrate_rig(
     board = spec.board()
     detector = cv2.aruco.CharucoDetector(board)
     found: dict[str, dict[str, tuple]] = {}
-    intr: dict[str, tuple[np.ndarray, np.ndarray, tuple[int, int]]] = {}
+    intr: dict[str, _Intrinsics] = {}
     rms_i: dict[str, float] = {}
     for cam, imgs in views.items():
-        sizes = {img.shape[:2] for img in imgs.values()}
-        if len(sizes) != 1:
-            raise CaptureError(f"camera {cam}: images of different sizes {sorted(sizes)}")
-        h, w = sizes.pop()
-        found[cam] = {k: c for k, img in imgs.items() if (c := _corners(detector, board, img))}
-        if len(found[cam]) < 3:
-            raise CaptureError(
-                f"camera {cam}: the board ({spec.squares[0]}x{spec.squares[1]}, "
-                f"{spec.dictionary}) was found in {len(found[cam])} of {len(imgs)} images; "
-                "need at least 3"
-            )
-        obj = [c[1].astype(np.float32) for c in found[cam].values()]
-        pts = [c[2].astype(np.float32) for c in found[cam].values()]
-        flags = cv2.CALIB_FIX_K3 if fix_k3 else 0
-        rms, K, dist, _, _ = cv2.calibrateCamera(obj, pts, (w, h), None, None, flags=flags)
-        intr[cam], rms_i[cam] = (K, dist.reshape(-1), (w, h)), float(rms)
+        found[cam], intr[cam], rms_i[cam] = _intrinsics(cam, imgs, detector, board, spec, fix_k3)
     names = list(views)
     ref = names[0]
     cams = [Camera(ref, intr[ref][2][0], intr[ref][2][1], intr[ref][0], intr[ref][1], np.eye(4))]
     rms_s: dict[str, float] = {}
     n_s: dict[str, int] = {}
     for cam in names[1:]:
-        obj, p0, pc = [], [], []
-        for shot in sorted(set(found[ref]) & set(found[cam])):
-            ids0, o0, q0 = found[ref][shot]
-            idsc, _, qc = found[cam][shot]
-            common, i0, ic = np.intersect1d(ids0, idsc, return_indices=True)
-            if len(common) >= MIN_CORNERS:
-                obj.append(o0[i0].astype(np.float32))
-                p0.append(q0[i0].astype(np.float32))
-                pc.append(qc[ic].astype(np.float32))
-        if len(obj) < 2:
-            raise CaptureError(f"camera {cam} shares {len(obj)} usable shot(s) with {ref}; need 2")
-        (K0, d0, size0), (Kc, dc, _) = intr[ref], intr[cam]
-        rms, *_, R, T, _, _ = cv2.stereoCalibrate(
-            obj, p0, pc, K0, d0, Kc, dc, size0, flags=cv2.CALIB_FIX_INTRINSIC
-        )
-        ref2cam = np.eye(4)
-        ref2cam[:3, :3], ref2cam[:3, 3] = R, np.asarray(T).reshape(3)
-        U, _, Vt = np.linalg.svd(ref2cam[:3, :3])
-        ref2cam[:3, :3] = U @ Vt
-        w, h = intr[cam][2]
-        cams.append(Camera(cam, w, h, Kc, dc, invert(ref2cam)))
-        rms_s[cam], n_s[cam] = float(rms), len(obj)
+        camera, rms_s[cam], n_s[cam] = _extrinsics(cam, ref, found, intr)
+        cams.append(camera)
     report = CalibrationReport(rms_i, {c: len(found[c]) for c in names}, rms_s, n_s)
     return Rig(tuple(cams)), report
+
+
+_Intrinsics = tuple[np.ndarray, np.ndarray, tuple[int, int]]
+"""A camera's K (3, 3) px, distortion coefficients and image size (width, height) px."""
+
+
+def _intrinsics(
+    cam: str,
+    imgs: Mapping[str, np.ndarray],
+    detector: cv2.aruco.CharucoDetector,
+    board: cv2.aruco.CharucoBoard,
+    spec: CharucoSpec,
+    fix_k3: bool,
+) -> tuple[dict[str, tuple], _Intrinsics, float]:
+    """Camera ``cam``'s board corners per shot of ``imgs``, its intrinsics and their RMS
+    reprojection error (px); CaptureError for mixed sizes or fewer than 3 usable images."""
+    sizes = {img.shape[:2] for img in imgs.values()}
+    if len(sizes) != 1:
+        raise CaptureError(f"camera {cam}: images of different sizes {sorted(sizes)}")
+    h, w = sizes.pop()
+    found = {k: c for k, img in imgs.items() if (c := _corners(detector, board, img))}
+    if len(found) < 3:
+        raise CaptureError(
+            f"camera {cam}: the board ({spec.squares[0]}x{spec.squares[1]}, "
+            f"{spec.dictionary}) was found in {len(found)} of {len(imgs)} images; "
+            "need at least 3"
+        )
+    obj = [c[1].astype(np.float32) for c in found.values()]
+    pts = [c[2].astype(np.float32) for c in found.values()]
+    flags = cv2.CALIB_FIX_K3 if fix_k3 else 0
+    rms, K, dist, _, _ = cv2.calibrateCamera(obj, pts, (w, h), None, None, flags=flags)
+    return found, (K, dist.reshape(-1), (w, h)), float(rms)
+
+
+def _extrinsics(
+    cam: str, ref: str, found: Mapping[str, Mapping[str, tuple]], intr: Mapping[str, _Intrinsics]
+) -> tuple[Camera, float, int]:
+    """Camera ``cam`` placed in the frame of camera ``ref`` by stereo calibration on the corners
+    both saw in the same shots, the RMS error (px) and the number of shots used; CaptureError
+    for fewer than 2 shared usable shots."""
+    obj, p0, pc = [], [], []
+    for shot in sorted(set(found[ref]) & set(found[cam])):
+        ids0, o0, q0 = found[ref][shot]
+        idsc, _, qc = found[cam][shot]
+        common, i0, ic = np.intersect1d(ids0, idsc, return_indices=True)
+        if len(common) >= MIN_CORNERS:
+            obj.append(o0[i0].astype(np.float32))
+            p0.append(q0[i0].astype(np.float32))
+            pc.append(qc[ic].astype(np.float32))
+    if len(obj) < 2:
+        raise CaptureError(f"camera {cam} shares {len(obj)} usable shot(s) with {ref}; need 2")
+    (K0, d0, size0), (Kc, dc, _) = intr[ref], intr[cam]
+    rms, *_, R, T, _, _ = cv2.stereoCalibrate(
+        obj, p0, pc, K0, d0, Kc, dc, size0, flags=cv2.CALIB_FIX_INTRINSIC
+    )
+    ref2cam = np.eye(4)
+    ref2cam[:3, :3], ref2cam[:3, 3] = R, np.asarray(T).reshape(3)
+    U, _, Vt = np.linalg.svd(ref2cam[:3, :3])
+    ref2cam[:3, :3] = U @ Vt
+    w, h = intr[cam][2]
+    return Camera(cam, w, h, Kc, dc, invert(ref2cam)), float(rms), len(obj)
 
 
 def calibrate_folder(

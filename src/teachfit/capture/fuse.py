@@ -169,22 +169,11 @@ def fuse_part(
     dets = [d for d in dets if d.marker_id in markers]
     if not dets:
         return None
-    hyps = []
-    for d in dets:
-        cam, m = rig.cameras[d.camera], markers[d.marker_id]
-        for marker2cam, err in square_poses(d.corners, m.size, cam.K, cam.dist):
-            hyps.append((cam.cam2rig @ marker2cam @ invert(m.marker2part), err))
+    hyps = _hypotheses(dets, rig, markers)
     if not hyps:
         return None
     groups = _stack(dets, markers)
-    tau2 = cfg.gate_px**2
-    scores = [sum(min(e * e, tau2) for e in _marker_rms(T, rig, groups).values()) for T, _ in hyps]
-    best = int(np.argmin(scores))
-    if len(dets) == 1 and len(hyps) == 2 and prior is not None:
-        e0, e1 = sorted(e for _, e in hyps)
-        if e1 < cfg.ambiguity_ratio * max(e0, 1e-3):
-            gaps = [rotation_angle_deg(prior[:3, :3].T @ T[:3, :3]) for T, _ in hyps]
-            best = int(np.argmin(gaps))
+    best = _best_hypothesis(hyps, len(dets), rig, groups, cfg, prior)
     # a single marker's pose is imprecise, so the first refinement takes every marker within
     # the loose gate; the final one only those within outlier_px of the refined pose
     rms = _marker_rms(hyps[best][0], rig, groups)
@@ -211,6 +200,41 @@ def fuse_part(
         cameras=tuple(sorted({d.camera for d in inliers})),
         rejected=tuple(sorted({d.marker_id for d in dets} - used)),
     )
+
+
+def _hypotheses(
+    dets: Sequence[Detection], rig: Rig, markers: Mapping[int, Marker]
+) -> list[tuple[np.ndarray, float]]:
+    """Every candidate ``part2rig`` (4, 4) of the single-marker poses of ``dets`` (both IPPE
+    solutions each), with its reprojection error (px)."""
+    hyps = []
+    for d in dets:
+        cam, m = rig.cameras[d.camera], markers[d.marker_id]
+        for marker2cam, err in square_poses(d.corners, m.size, cam.K, cam.dist):
+            hyps.append((cam.cam2rig @ marker2cam @ invert(m.marker2part), err))
+    return hyps
+
+
+def _best_hypothesis(
+    hyps: Sequence[tuple[np.ndarray, float]],
+    n_dets: int,
+    rig: Rig,
+    groups: dict,
+    cfg: FusionConfig,
+    prior: np.ndarray | None,
+) -> int:
+    """Index of the hypothesis that explains all detections best (robust score: squared RMS
+    per marker, capped at the gate); a lone marker's two nearly equal solutions are decided
+    by the rotation closer to ``prior`` (4, 4)."""
+    tau2 = cfg.gate_px**2
+    scores = [sum(min(e * e, tau2) for e in _marker_rms(T, rig, groups).values()) for T, _ in hyps]
+    best = int(np.argmin(scores))
+    if n_dets == 1 and len(hyps) == 2 and prior is not None:
+        e0, e1 = sorted(e for _, e in hyps)
+        if e1 < cfg.ambiguity_ratio * max(e0, 1e-3):
+            gaps = [rotation_angle_deg(prior[:3, :3].T @ T[:3, :3]) for T, _ in hyps]
+            best = int(np.argmin(gaps))
+    return best
 
 
 def relative_pose(ref: PartPose, moving: PartPose) -> tuple[np.ndarray, np.ndarray]:

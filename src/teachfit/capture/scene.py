@@ -127,50 +127,71 @@ def scene_xml(
                 f'<geom type="mesh" mesh="{part}_mesh" rgba="{_floats(rgba)}" '
                 'contype="0" conaffinity="0"/>'
             )
-        for j, box in enumerate(carriers.get(part, ())):
-            geoms.append(
-                f'<geom name="{part}_carrier{j}" type="box" pos="{_floats(box.center)}" '
-                f'size="{_floats(box.half)}" rgba="{_floats(box.rgba)}" '
-                'contype="0" conaffinity="0"/>'
-            )
+        geoms += [
+            _carrier_geom(f"{part}_carrier{j}", b) for j, b in enumerate(carriers.get(part, ()))
+        ]
         for quad in quads.get(part, ()):
-            img = (
-                quad.image if quad.image.ndim == 3 else cv2.cvtColor(quad.image, cv2.COLOR_GRAY2BGR)
-            )
-            ok, png = cv2.imencode(".png", img)
-            assets[f"{quad.name}.png"] = png.tobytes()
-            asset_xml += [
-                f'<texture name="{quad.name}_tex" type="2d" file="{quad.name}.png"/>',
-                f'<material name="{quad.name}_mat" texture="{quad.name}_tex" specular="0" '
-                'shininess="0" reflectance="0"/>',
-                _quad_mesh(f"{quad.name}_mesh", quad.size),
-            ]
-            geoms.append(
-                f'<geom type="mesh" mesh="{quad.name}_mesh" material="{quad.name}_mat" '
-                f'{_pose_attrs(quad.quad2part)} contype="0" conaffinity="0"/>'
-            )
+            geoms.append(_add_quad(quad, asset_xml, assets))
         body_xml.append(f'<body name="{part}" mocap="true">' + "".join(geoms) + "</body>")
-    cam_xml = []
-    for name, cam2world, fovy in cameras:
-        T = np.array(cam2world, dtype=float)
-        T[:3, :3] = T[:3, :3] @ CV2MJ
-        cam_xml.append(f'<camera name="{name}" fovy="{fovy:.9g}" {_pose_attrs(T)}/>')
-    w, h = offscreen
-    xml = f"""<mujoco model="capture">
+    cam_xml = [_camera(name, cam2world, fovy) for name, cam2world, fovy in cameras]
+    return _SCENE.format(
+        w=offscreen[0],
+        h=offscreen[1],
+        assets="".join(asset_xml),
+        cameras="".join(cam_xml),
+        bodies="".join(body_xml),
+    ), assets
+
+
+def _carrier_geom(name: str, box: Carrier) -> str:
+    return (
+        f'<geom name="{name}" type="box" pos="{_floats(box.center)}" '
+        f'size="{_floats(box.half)}" rgba="{_floats(box.rgba)}" '
+        'contype="0" conaffinity="0"/>'
+    )
+
+
+def _add_quad(quad: Quad, asset_xml: list[str], assets: dict[str, bytes]) -> str:
+    """Add ``quad``'s PNG texture to ``assets`` and its texture, material and mesh to
+    ``asset_xml``; return its geom."""
+    img = quad.image if quad.image.ndim == 3 else cv2.cvtColor(quad.image, cv2.COLOR_GRAY2BGR)
+    ok, png = cv2.imencode(".png", img)
+    assets[f"{quad.name}.png"] = png.tobytes()
+    asset_xml += [
+        f'<texture name="{quad.name}_tex" type="2d" file="{quad.name}.png"/>',
+        f'<material name="{quad.name}_mat" texture="{quad.name}_tex" specular="0" '
+        'shininess="0" reflectance="0"/>',
+        _quad_mesh(f"{quad.name}_mesh", quad.size),
+    ]
+    return (
+        f'<geom type="mesh" mesh="{quad.name}_mesh" material="{quad.name}_mat" '
+        f'{_pose_attrs(quad.quad2part)} contype="0" conaffinity="0"/>'
+    )
+
+
+def _camera(name: str, cam2world: np.ndarray, fovy: float) -> str:
+    """A MuJoCo camera of an OpenCV ``cam2world`` (4, 4) with a vertical field ``fovy`` (deg)."""
+    T = np.array(cam2world, dtype=float)
+    T[:3, :3] = T[:3, :3] @ CV2MJ
+    return f'<camera name="{name}" fovy="{fovy:.9g}" {_pose_attrs(T)}/>'
+
+
+_SCENE = """<mujoco model="capture">
   <compiler inertiafromgeom="false"/>
   <visual>
     <global offwidth="{w}" offheight="{h}"/>
     <quality shadowsize="0" offsamples="4"/>
     <headlight ambient="0.35 0.35 0.35" diffuse="0.25 0.25 0.25" specular="0 0 0"/>
   </visual>
-  <asset>{"".join(asset_xml)}</asset>
+  <asset>{assets}</asset>
   <worldbody>
     <light name="key" pos="0.3 -0.4 1.2" dir="-0.25 0.33 -1" diffuse="0.55 0.55 0.55"
            specular="0 0 0" castshadow="false"/>
     <geom type="plane" size="1 1 0.01" pos="0 0 -0.03" rgba="0.45 0.47 0.5 1"
           contype="0" conaffinity="0"/>
-    {"".join(cam_xml)}
-    {"".join(body_xml)}
+    {cameras}
+    {bodies}
   </worldbody>
 </mujoco>"""
-    return xml, assets
+"""The capture scene's MJCF: offscreen size ``w`` x ``h`` px, then the assets, cameras and
+part bodies as XML text."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 import typer
@@ -16,6 +16,11 @@ from teachfit.cli.common import append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import CaptureError
+
+if TYPE_CHECKING:
+    from teachfit.bench.capture import CaptureBench
+    from teachfit.capture.track import Track
+    from teachfit.demonstrations.dataset import Demonstration
 
 __all__ = ["bench_capture_cmd", "capture_app"]
 
@@ -95,7 +100,7 @@ def markers(
     from teachfit.capture.rig import read_rig
     from teachfit.capture.sources import CameraSet, VideoSet
     from teachfit.capture.track import TrackConfig, track_frames
-    from teachfit.demonstrations.dataset import read_demo, write_dataset
+    from teachfit.demonstrations.dataset import write_dataset
 
     videos = [*(video or []), *(more_videos or [])]
     if bool(videos) == bool(camera):
@@ -117,24 +122,29 @@ def markers(
         f"{track.n_frames} frames: {track.summary()}; median predicted error "
         f"{float(np.nanmedian(track.std_mm)):.3f} mm / {float(np.nanmedian(track.std_deg)):.3f} deg"
     )
-    truth_demo = None
-    if truth is not None:
-        from teachfit.bench.capture import pose_errors
-
-        truth_demo = read_demo(truth)
-        try:
-            mm, deg = pose_errors(track, truth_demo)
-        except ValueError as exc:
-            raise CaptureError(f"truth {truth}: {exc}") from exc
-        console.print(
-            f"error vs truth: median {np.median(mm):.3f} mm (p95 {np.percentile(mm, 95):.3f}), "
-            f"median {np.median(deg):.3f} deg (p95 {np.percentile(deg, 95):.3f})"
-        )
+    truth_demo = None if truth is None else _print_truth_errors(track, truth)
     console.print(f"wrote {out} ({demo.n_samples} poses of L in G)")
     if plot is not None:
         from teachfit.viz.capture_figures import track_figure
 
         console.print(f"wrote {track_figure(track, plot, truth_demo)}")
+
+
+def _print_truth_errors(track: Track, truth: Path) -> Demonstration:
+    """Print ``track``'s errors against the ground truth file ``truth``; return the truth."""
+    from teachfit.bench.capture import pose_errors
+    from teachfit.demonstrations.dataset import read_demo
+
+    truth_demo = read_demo(truth)
+    try:
+        mm, deg = pose_errors(track, truth_demo)
+    except ValueError as exc:
+        raise CaptureError(f"truth {truth}: {exc}") from exc
+    console.print(
+        f"error vs truth: median {np.median(mm):.3f} mm (p95 {np.percentile(mm, 95):.3f}), "
+        f"median {np.median(deg):.3f} deg (p95 {np.percentile(deg, 95):.3f})"
+    )
+    return truth_demo
 
 
 def _synth_config(cameras: int, resolution: list[str] | None, **kw: object):
@@ -223,6 +233,24 @@ def _filter_note(rows: list, stride: int) -> None:
     )
 
 
+def _print_accuracy(b: CaptureBench) -> None:
+    """The accuracy rows of ``b`` as a table."""
+    table = Table(title=f"Capture accuracy (L in G vs truth): {b.setup}")
+    for col in ("cameras", "filter", "valid", "median mm", "p95 mm", "median deg", "p95 deg"):
+        table.add_column(col, justify="right")
+    for r in b.rows:
+        table.add_row(
+            str(r.cameras),
+            "yes" if r.filtered else "no",
+            f"{r.valid}/{r.frames}",
+            f"{r.med_mm:.3f}",
+            f"{r.p95_mm:.3f}",
+            f"{r.med_deg:.3f}",
+            f"{r.p95_deg:.3f}",
+        )
+    print_table(table)
+
+
 @guarded
 def bench_capture_cmd(
     stride: Annotated[int, typer.Option(min=1, help="keep every n-th 30 Hz sample")] = 2,
@@ -258,20 +286,7 @@ def bench_capture_cmd(
             bar.update(jobs[label], completed=done)
 
         b = run_capture_bench(workdir or tmp, cfg, seed=seed, progress=tick)
-    table = Table(title=f"Capture accuracy (L in G vs truth): {b.setup}")
-    for col in ("cameras", "filter", "valid", "median mm", "p95 mm", "median deg", "p95 deg"):
-        table.add_column(col, justify="right")
-    for r in b.rows:
-        table.add_row(
-            str(r.cameras),
-            "yes" if r.filtered else "no",
-            f"{r.valid}/{r.frames}",
-            f"{r.med_mm:.3f}",
-            f"{r.p95_mm:.3f}",
-            f"{r.med_deg:.3f}",
-            f"{r.p95_deg:.3f}",
-        )
-    print_table(table)
+    _print_accuracy(b)
     _filter_note(b.rows, stride)
     three = [r for r in b.rows if r.filtered][-1] if b.rows[0].filtered else b.rows[-1]
     console.print(

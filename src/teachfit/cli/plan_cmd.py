@@ -9,7 +9,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
@@ -18,8 +18,11 @@ from teachfit.cli import options as o
 from teachfit.cli.common import append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_table
-from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import PlanningError, TeachfitError
+
+if TYPE_CHECKING:
+    from teachfit.bench.planning import TaskBench
+    from teachfit.plans.planner import MotionPlanner, PlanResult
 
 __all__ = [
     "app",
@@ -147,9 +150,6 @@ def plan(
     task_params: o.TaskParams = None,
 ) -> None:
     """Plan the moving part from its initial to its final pose."""
-    import numpy as np
-
-    from teachfit.core.geometry import poses_to_array
     from teachfit.plans.planner import MotionPlanner, PlannerConfig
 
     if (demo is None) == (not no_demo):
@@ -172,9 +172,14 @@ def plan(
     if not result.success:
         raise typer.Exit(code=1)
     if save is not None:
-        with atomic_path(save, "path file") as tmp, open(tmp, "xb") as fh:
-            np.save(fh, poses_to_array(result.poses))
-        console.print(f"wrote {save}")
+        console.print(f"wrote {result.save(save)}")
+    _write_path_media(asm, mp, result, strip, render)
+
+
+def _write_path_media(
+    asm: object, mp: MotionPlanner, result: PlanResult, strip: Path | None, render: Path | None
+) -> None:
+    """The planned path as a strip of poses (png) and as a video, where asked for."""
     if strip is not None:
         from teachfit.viz.plan_figures import path_strip_figure
 
@@ -188,6 +193,21 @@ def plan(
         console.print(f"wrote {render}")
 
 
+def _print_planning_report(results: list[TaskBench]) -> None:
+    """The Table I protocol's table and notes."""
+    from teachfit.bench import planning as bp
+
+    table = Table(title="Planning with demonstrated key poses (Table I protocol)")
+    for col in bp.TABLE_COLUMNS:
+        table.add_column(col)
+    for row in bp.report_table(results):
+        table.add_row(*row)
+    print_table(table)
+    for line in bp.report_notes(results):
+        console.print(line)
+
+
+# Long (> 60 lines) only by its options' declarations: the body parses, runs the bench, prints
 @bench_app.command("planning")
 @guarded
 def bench_planning_cmd(
@@ -245,21 +265,13 @@ def bench_planning_cmd(
         no_demo_budget=no_demo_budget,
         overrides=o.task_overrides(task_param, PlanningError, task_params),
     )
-    for task in cfg.tasks:  # bad overrides: one line before any run
-        _assembly(task, task_param, task_params)
+    cfg.check_overrides()  # bad overrides: one line before any run
     with progress_bar() as bar:
         job = bar.add_task("planning", total=cfg.n_runs)
         results = bp.run_planning_bench(
             cfg, progress=lambda label, _done: bar.update(job, advance=1, description=label)
         )
-    table = Table(title="Planning with demonstrated key poses (Table I protocol)")
-    for col in bp.TABLE_COLUMNS:
-        table.add_column(col)
-    for row in bp.report_table(results):
-        table.add_row(*row)
-    print_table(table)
-    for line in bp.report_notes(results):
-        console.print(line)
+    _print_planning_report(results)
     command = cfg.command() + (f" --variants {variants}" if variants else "")
     text = bp.to_markdown(results, command=command)
     if variants:

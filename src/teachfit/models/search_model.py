@@ -24,7 +24,7 @@ Units: m and rad for states and steps (steps per sample at ``rate_hz``), N and N
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -36,10 +36,51 @@ from teachfit.core.errors import ModelError
 from teachfit.models.covariance_choice import CovarianceChoice, choose_covariance
 from teachfit.models.dynamics import DynamicsModel, fit_dynamics
 from teachfit.models.exploration import ExplorationDistribution, fit_exploration
-from teachfit.models.search_data import dims_for_task, search_data, validate_dims
+from teachfit.models.search_data import SearchData, dims_for_task, search_data, validate_dims
 
 FORMAT = "teachfit.search_model"
 VERSION = 1
+
+
+def _covariance_choice(
+    covariance: str,
+    demos: list[Any],
+    dims: tuple[str, ...],
+    rate_hz: float,
+    fit: Callable[[np.ndarray, str], ExplorationDistribution],
+) -> CovarianceChoice:
+    """p_e's covariance structure: ``covariance`` as given (``"full"``, ``"diag"``), or for
+    ``"auto"`` chosen by held-out likelihood of each demonstration's states at ``rate_hz``
+    (Hz) under ``fit`` (states, structure) on the others. ModelError for another value."""
+    if covariance == "auto":
+        per_demo = [search_data(d, dims, rate_hz=rate_hz).states for d in demos]
+        return choose_covariance(per_demo, fit)
+    if covariance in ("full", "diag"):
+        return CovarianceChoice(covariance, "given")
+    raise ModelError(f"covariance must be 'auto', 'full' or 'diag', got {covariance!r}")
+
+
+def _fit_dynamics(
+    data: SearchData,
+    dims: tuple[str, ...],
+    n_components: int | Literal["bic"],
+    max_components: int,
+    rel_floor: float,
+    seed: int,
+) -> DynamicsModel | None:
+    """The dynamics of ``data``'s steps and actions (:func:`fit_dynamics`); None when no
+    wrench was recorded (no actions)."""
+    if data.actions is None:
+        return None
+    return fit_dynamics(
+        data.steps,
+        data.actions,
+        dims,
+        n_components=n_components,
+        max_components=max_components,
+        rel_floor=rel_floor,
+        seed=seed,
+    )
 
 
 @dataclass(frozen=True)
@@ -127,25 +168,9 @@ class SearchModel:
                 covariance=structure,  # type: ignore[arg-type]
             )
 
-        if covariance == "auto":
-            per_demo = [search_data(d, dims, rate_hz=data.rate_hz).states for d in demos]
-            choice = choose_covariance(per_demo, fit)
-        elif covariance in ("full", "diag"):
-            choice = CovarianceChoice(covariance, "given")
-        else:
-            raise ModelError(f"covariance must be 'auto', 'full' or 'diag', got {covariance!r}")
+        choice = _covariance_choice(covariance, demos, dims, data.rate_hz, fit)
         expl = fit(data.states, choice.covariance)
-        dyn = None
-        if data.actions is not None:
-            dyn = fit_dynamics(
-                data.steps,
-                data.actions,
-                dims,
-                n_components=dynamics_components,
-                max_components=max_components,
-                rel_floor=rel_floor,
-                seed=seed,
-            )
+        dyn = _fit_dynamics(data, dims, dynamics_components, max_components, rel_floor, seed)
         if data.speed <= 0:
             raise ModelError("the demonstrations never move in the search plane")
         return cls(

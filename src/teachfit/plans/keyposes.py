@@ -192,21 +192,9 @@ def rank_key_poses(
     PlanningError
         Fewer than two poses, unknown parameter, or a motionless demonstration.
     """
-    t = np.asarray(t, dtype=float)
-    pos = np.asarray(pos, dtype=float)
-    quat = np.asarray(quat, dtype=float)
-    if t.ndim != 1 or len(t) < 2 or pos.shape != (len(t), 3) or quat.shape != (len(t), 4):
-        raise PlanningError(
-            f"a demonstration needs at least 2 poses with matching shapes, got t {t.shape}, "
-            f"pos {pos.shape}, quat {quat.shape}"
-        )
+    t, pos, quat = _checked_demo(t, pos, quat)
     values6 = pose_parameters(pos, quat)
-    if param == "auto":
-        spread = np.ptp(values6, axis=0)
-        spread[:3] /= char_length
-        param = PARAMS[int(np.argmax(spread))]
-    if param not in PARAMS:
-        raise PlanningError(f"unknown pose parameter {param!r}; use one of {PARAMS} or 'auto'")
+    param = _ranking_param(values6, param, char_length)
     column = values6[:, PARAMS.index(param)]
     idx = select_candidates(
         pos, quat, n_candidates, char_length=char_length, eligible=eligible, include=include
@@ -215,23 +203,54 @@ def rank_key_poses(
     # conditioned for any demonstration length.
     poly = np.polynomial.Polynomial.fit(t, column, deg=int(min(degree, len(t) - 1)))
     derivative = poly.deriv()(t[idx])
-    order = np.argsort(-np.abs(derivative), kind="stable")
-    rot = wxyz_to_rotation(quat[idx]).as_matrix()
-    L2G = np.tile(np.eye(4), (len(idx), 1, 1))
-    L2G[:, :3, :3] = rot
-    L2G[:, :3, 3] = pos[idx]
     return KeyPoses(
         indices=idx,
         t=t[idx],
-        L2G=L2G,
+        L2G=_pose_matrices(pos[idx], quat[idx]),
         param=param,
         values=column[idx],
         derivative=derivative,
-        order=order,
+        order=np.argsort(-np.abs(derivative), kind="stable"),
         poly=poly,
         demo_t=t,
         demo_values=column,
     )
+
+
+def _checked_demo(
+    t: np.ndarray, pos: np.ndarray, quat: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``t`` (T,), ``pos`` (T, 3), ``quat`` (T, 4) as float arrays; PlanningError for fewer
+    than two poses or mismatched shapes."""
+    t = np.asarray(t, dtype=float)
+    pos = np.asarray(pos, dtype=float)
+    quat = np.asarray(quat, dtype=float)
+    if t.ndim != 1 or len(t) < 2 or pos.shape != (len(t), 3) or quat.shape != (len(t), 4):
+        raise PlanningError(
+            f"a demonstration needs at least 2 poses with matching shapes, got t {t.shape}, "
+            f"pos {pos.shape}, quat {quat.shape}"
+        )
+    return t, pos, quat
+
+
+def _ranking_param(values6: np.ndarray, param: str, char_length: float) -> str:
+    """``param`` checked against :data:`PARAMS`; ``"auto"``: the column of ``values6`` (T, 6)
+    with the largest range (positions divided by ``char_length`` m, to compare with rad)."""
+    if param == "auto":
+        spread = np.ptp(values6, axis=0)
+        spread[:3] /= char_length
+        param = PARAMS[int(np.argmax(spread))]
+    if param not in PARAMS:
+        raise PlanningError(f"unknown pose parameter {param!r}; use one of {PARAMS} or 'auto'")
+    return param
+
+
+def _pose_matrices(pos: np.ndarray, quat: np.ndarray) -> np.ndarray:
+    """(K, 4, 4) homogeneous matrices of positions (K, 3) m and quaternions (K, 4) w-x-y-z."""
+    L2G = np.tile(np.eye(4), (len(pos), 1, 1))
+    L2G[:, :3, :3] = wxyz_to_rotation(quat).as_matrix()
+    L2G[:, :3, 3] = pos
+    return L2G
 
 
 def straight_chain(n: int, connects: Callable[[int, int], bool]) -> list[int]:

@@ -1,13 +1,15 @@
-"""The planner's settings and the outcome of one query (values only)."""
+"""The planner's settings and the outcome of one query (values, and the path written to a file)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
+from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import PlanningError
-from teachfit.core.geometry import Pose, array_to_poses, poses_to_matrices
+from teachfit.core.geometry import Pose, array_to_poses, poses_to_array, poses_to_matrices
 from teachfit.plans.keyposes import KeyPoses
 from teachfit.plans.ompl_space import PLANNERS
 
@@ -132,3 +134,10 @@ class PlanResult:
     def L2G(self) -> np.ndarray:
         """(N, 4, 4) path as homogeneous transforms."""
         return poses_to_matrices(self.poses)
+
+    def save(self, path: str | Path) -> Path:
+        """Write the path to ``path`` (``.npy``) as (N, 7) rows ``x, y, z`` (m), ``qw, qx, qy,
+        qz``, atomically (nothing is left behind on failure); return ``path``."""
+        with atomic_path(path, "path file") as tmp, open(tmp, "xb") as fh:
+            np.save(fh, poses_to_array(self.poses))
+        return Path(path)

@@ -153,30 +153,12 @@ def synth_demo(
     if rate_hz <= 0 or tremor_mm < 0 or tremor_deg < 0 or not 0 <= p_penetrate <= 1:
         raise TaskError("rate_hz must be > 0, tremors >= 0 and p_penetrate in [0, 1]")
     rng = np.random.default_rng(seed)
-    # a steady hand keeps its tremor within the fit: 2 sigma of either tremor moves the part's
-    # farthest point at most half the clearance, so tight variants get collision-free scripts
-    room = 0.25 * float(asm.dimensions["clearance"])
-    radius = float(np.linalg.norm(asm.moving.vertices, axis=1).max())
-    tremor_mm = min(tremor_mm, 1e3 * room)
-    tremor_deg = min(tremor_deg, float(np.degrees(room / radius)))
+    tremor_mm, tremor_deg = _steady_tremors(asm, tremor_mm, tremor_deg)
     t, pos, rpy = keyframes_to_poses(nominal_keyframes(asm), rate_hz)
-    n = len(t)
-    # tremor: white noise low-passed at 2 Hz (physiological tremor and slow drift of a hand)
-    sos = butter(2, min(2.0 / (rate_hz / 2), 0.99), output="sos")
-    noise = sosfiltfilt(sos, rng.standard_normal((n, 6)), axis=0, padlen=min(n - 1, 12))
-    noise /= np.maximum(noise.std(axis=0, keepdims=True), 1e-12)
-    taper = np.minimum(1.0, np.minimum(np.arange(n), np.arange(n)[::-1]) / 5.0)[:, None]
-    pos = pos + 1e-3 * tremor_mm * noise[:, :3] * taper
-    rpy = rpy + tremor_deg * noise[:, 3:] * taper
-    pushed = rng.random() < p_penetrate
-    if pushed:
-        # a short push sideways into the fixed part, a typical capture artefact
-        i0 = int(rng.integers(n // 3, max(n // 3 + 1, n - 8)))
-        span = slice(i0, min(i0 + 4, n - 1))
-        pos[span, 1] += rng.choice([-1.0, 1.0]) * (asm.dimensions["clearance"] + 0.0008)
+    pos, rpy = _add_tremor(rng, pos, rpy, rate_hz, tremor_mm, tremor_deg)
+    pushed = _maybe_push(rng, pos, p_penetrate, float(asm.dimensions["clearance"]))
     quat = rotation_to_wxyz(Rotation.from_euler("xyz", rpy, degrees=True))  # w >= 0
-    checker = CollisionChecker.of(asm)
-    colliding = sum(checker.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True))
+    colliding = _n_colliding(asm, pos, quat)
     return Demonstration(
         t=t,
         pos=pos,
@@ -196,3 +178,51 @@ def synth_demo(
             "generator": "teachfit.plans",
         },
     )
+
+
+def _n_colliding(asm: Assembly, pos: np.ndarray, quat: np.ndarray) -> int:
+    """How many poses (positions (T, 3) m, quaternions (T, 4) w-x-y-z) collide."""
+    checker = CollisionChecker.of(asm)
+    return sum(checker.collides_xyzq(*p, *q) for p, q in zip(pos, quat, strict=True))
+
+
+def _steady_tremors(asm: Assembly, tremor_mm: float, tremor_deg: float) -> tuple[float, float]:
+    """The tremors (mm, deg) capped for a steady hand, which keeps its tremor within the fit:
+    2 sigma of either tremor moves the part's farthest point at most half the clearance, so
+    tight variants get collision-free scripts."""
+    room = 0.25 * float(asm.dimensions["clearance"])
+    radius = float(np.linalg.norm(asm.moving.vertices, axis=1).max())
+    return min(tremor_mm, 1e3 * room), min(tremor_deg, float(np.degrees(room / radius)))
+
+
+def _add_tremor(
+    rng: np.random.Generator,
+    pos: np.ndarray,
+    rpy: np.ndarray,
+    rate_hz: float,
+    tremor_mm: float,
+    tremor_deg: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``pos`` (T, 3) m and ``rpy`` (T, 3) deg plus a tremor: white noise low-passed at 2 Hz
+    (physiological tremor and slow drift of a hand), tapered to zero at both ends."""
+    n = len(pos)
+    sos = butter(2, min(2.0 / (rate_hz / 2), 0.99), output="sos")
+    noise = sosfiltfilt(sos, rng.standard_normal((n, 6)), axis=0, padlen=min(n - 1, 12))
+    noise /= np.maximum(noise.std(axis=0, keepdims=True), 1e-12)
+    taper = np.minimum(1.0, np.minimum(np.arange(n), np.arange(n)[::-1]) / 5.0)[:, None]
+    return pos + 1e-3 * tremor_mm * noise[:, :3] * taper, rpy + tremor_deg * noise[:, 3:] * taper
+
+
+def _maybe_push(
+    rng: np.random.Generator, pos: np.ndarray, p_penetrate: float, clearance: float
+) -> bool:
+    """With probability ``p_penetrate``, a short push sideways into the fixed part, a typical
+    capture artefact: moves a few samples of ``pos`` (T, 3) m in place by the clearance (m)
+    plus 0.8 mm along y. Whether it happened."""
+    if not rng.random() < p_penetrate:
+        return False
+    n = len(pos)
+    i0 = int(rng.integers(n // 3, max(n // 3 + 1, n - 8)))
+    span = slice(i0, min(i0 + 4, n - 1))
+    pos[span, 1] += rng.choice([-1.0, 1.0]) * (clearance + 0.0008)
+    return True

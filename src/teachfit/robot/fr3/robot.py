@@ -79,19 +79,13 @@ class FR3Robot:
         self.model = fr3_model.build_fr3_model(task, self.params)
         self.data = mujoco.MjData(self.model)
         self.rng = np.random.default_rng(seed)
-        m, d = self.model, self.data
-        obj = mujoco.mjtObj
-        self._tcp = mujoco.mj_name2id(m, obj.mjOBJ_SITE, fr3_model.TCP_SITE)
-        flange = mujoco.mj_name2id(m, obj.mjOBJ_SITE, fr3_model.FLANGE_SITE)
-        dofs = [m.jnt_dofadr[mujoco.mj_name2id(m, obj.mjOBJ_JOINT, j)] for j in fr3_model.JOINTS]
-        if dofs != list(range(m.nv)) or m.nq != m.nv:
-            raise RobotFault("the FR3 cell must have exactly the 7 arm joints as its dofs")
+        flange = self._find_sites_and_joints()
         self.q_min, self.q_max = np.array(Q_MIN), np.array(Q_MAX)
         self.dq_max = np.array(DQ_MAX)
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
         self.ctl = TorqueImpedance(
-            m,
-            d,
+            self.model,
+            self.data,
             self._tcp,
             make_law(self.controller_spec, np.ones(6), self.control_period),
             np.array(TAU_MAX),
@@ -99,6 +93,35 @@ class FR3Robot:
             self.params.null_stiffness,
             self.params.null_damping,
         )
+        self._build_sensing(flange)
+        self._limits = (self.q_min, self.q_max, self.dq_max)
+        self._warning_numbers = self.data.warning.number
+        self._warnings = 0
+        self._fault: RobotFault | None = None
+        self._cmd: ImpedanceCommand | None = None
+        self.q_start = np.array(READY_Q)
+        #: commanded joint torques of the last executions, one ``(t, tau)`` pair per reset: t
+        #: (T,) s since that reset, tau (T, 7) N·m, one row at the end of each ``step`` call
+        self.torque_traces: deque[tuple[np.ndarray, np.ndarray]] = deque(maxlen=TORQUE_TRACES)
+        self._trace_t: list[float] = []
+        self._trace_tau: list[np.ndarray] = []
+        self.reset(task.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.05]))
+
+    def _find_sites_and_joints(self) -> int:
+        """Look up the TCP site (kept) and the flange site (returned); RobotFault unless the
+        cell's dofs are exactly the 7 arm joints."""
+        m, obj = self.model, mujoco.mjtObj
+        self._tcp = mujoco.mj_name2id(m, obj.mjOBJ_SITE, fr3_model.TCP_SITE)
+        flange = mujoco.mj_name2id(m, obj.mjOBJ_SITE, fr3_model.FLANGE_SITE)
+        dofs = [m.jnt_dofadr[mujoco.mj_name2id(m, obj.mjOBJ_JOINT, j)] for j in fr3_model.JOINTS]
+        if dofs != list(range(m.nv)) or m.nq != m.nv:
+            raise RobotFault("the FR3 cell must have exactly the 7 arm joints as its dofs")
+        return flange
+
+    def _build_sensing(self, flange: int) -> None:
+        """The joint-torque observer and the wrist F/T sensor at ``flange`` (a site id), the
+        one ``wrench_source`` names switched on in the compiled tick, and their buffers."""
+        m, d, obj = self.model, self.data, mujoco.mjtObj
         self.observer = JointTorqueObserver(
             m,
             d,
@@ -123,18 +146,6 @@ class FR3Robot:
         sc[kernel.USE_FT] = float(self._use_ft)
         self._obs_bufs = (*self.observer.bufs, self.ft.adr, self.ft.filt, self.observer.coef)
         self._obs_bufs += (self.observer.tau_out, self.observer.tau_z, self.ft.out, self.ft.z)
-        self._limits = (self.q_min, self.q_max, self.dq_max)
-        self._warning_numbers = d.warning.number
-        self._warnings = 0
-        self._fault: RobotFault | None = None
-        self._cmd: ImpedanceCommand | None = None
-        self.q_start = np.array(READY_Q)
-        #: commanded joint torques of the last executions, one ``(t, tau)`` pair per reset: t
-        #: (T,) s since that reset, tau (T, 7) N·m, one row at the end of each ``step`` call
-        self.torque_traces: deque[tuple[np.ndarray, np.ndarray]] = deque(maxlen=TORQUE_TRACES)
-        self._trace_t: list[float] = []
-        self._trace_tau: list[np.ndarray] = []
-        self.reset(task.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.05]))
 
     # ------------------------------------------------------------------ Robot protocol
     @property
