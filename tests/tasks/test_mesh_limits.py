@@ -200,3 +200,21 @@ def test_building_a_cell_reports_its_stages(mesh_examples: dict[str, str]) -> No
     stages = [(done, total) for what, done, total in seen if what.startswith("building")]
     assert stages == [(0, 4), (1, 4), (2, 4), (3, 4), (4, 4)]
     assert ("self-intersection check usb_plug.stl", 1, 1) in seen
+
+
+def test_a_part_too_fine_for_coacd_is_refused_before_it_runs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import importlib
+
+    decompose = importlib.import_module("teachfit.tasks.mesh.decompose")
+
+    def never(*_: object) -> None:
+        raise AssertionError("coacd ran")
+
+    monkeypatch.setattr(decompose, "_run_coacd", never)
+    monkeypatch.setattr(decompose, "COACD_MAX_TRIANGLES", 2_000)
+    ring = trimesh.creation.torus(0.02, 0.005, major_sections=64, minor_sections=24)
+    assert len(ring.faces) > 2_000 and not decompose.is_convex(ring)
+    with pytest.raises(TaskError, match="decimate the part below 2,000 triangles"):
+        decompose.decompose(ring, decompose.CoacdSettings(), None, "ring")

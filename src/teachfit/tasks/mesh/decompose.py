@@ -81,6 +81,12 @@ class Decomposition:
         return [v @ T[:3, :3].T + T[:3, 3] for v, _ in self.pieces]
 
 
+#: the most triangles a part may have for coacd's decomposition (a cached one is read at any
+#: size): its time grows with the mesh (a torus of 20,000 triangles 42 s, 80,000 208 s on the
+#: project's busy 2-core machine), so a bigger part is refused with the hint to decimate it
+COACD_MAX_TRIANGLES = 100_000
+
+
 def is_convex(mesh: trimesh.Trimesh) -> bool:
     """Whether ``mesh`` fills its convex hull (volume within 0.1 %)."""
     return bool(mesh.volume >= 0.999 * mesh.convex_hull.volume)
@@ -177,6 +183,13 @@ def decompose(
         hit = _load(stem)
         if hit is not None:
             return Decomposition(tuple(hit[0]), float(hit[1].get("seconds", 0.0)), True, "coacd")
+    if len(mesh.faces) > COACD_MAX_TRIANGLES:
+        raise TaskError(
+            f"{name}: a convex decomposition (coacd) of {len(mesh.faces):,} triangles takes "
+            f"many minutes (it grows with the mesh; 80,000 took 3.5 min): decimate the part "
+            f"below {COACD_MAX_TRIANGLES:,} triangles (MeshLab's quadric edge collapse, "
+            "Blender's Decimate) or re-export it with a coarser tessellation"
+        )
     t0 = time.perf_counter()
     pieces = _run_coacd(mesh, settings)
     seconds = time.perf_counter() - t0
