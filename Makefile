@@ -17,16 +17,17 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/teachfit quickstart --out out/quickstart
 
-# `make test` lints first (ruff check and ruff format --check), then runs the tests
+# `make test` lints first (ruff check, ruff format --check and mypy), then runs the tests
 test: lint
 	$(BIN)/python -m pytest -n 2 --durations=10
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/ruff format --check src tests benchmarks
+	$(BIN)/mypy
 
 bench: $(STAMP)
 	$(BIN)/teachfit bench sim
 
 clean:
-	rm -rf $(VENV) out .pytest_cache .ruff_cache
+	rm -rf $(VENV) out .pytest_cache .ruff_cache .mypy_cache

@@ -25,6 +25,7 @@ from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.plans.collision import CollisionChecker
 from teachfit.plans.parts import PARTS, Assembly, build_assembly
+from teachfit.plans.plan_types import PlanResult
 from teachfit.plans.planner import PLANNERS, MotionPlanner, PlannerConfig
 from teachfit.plans.synth import synth_demo
 
@@ -158,7 +159,7 @@ class ModeStats:
 
     @staticmethod
     def from_results(
-        mode: str, budget: float, results: Sequence[object], unit: str = "s"
+        mode: str, budget: float, results: Sequence[PlanResult], unit: str = "s"
     ) -> ModeStats:
         """Aggregate :class:`~teachfit.plans.planner.PlanResult` objects."""
         if not results:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -47,7 +48,7 @@ def sample_variants(task: str, n: int, seed: int = 0) -> list[dict[str, float]]:
         raise PlanningError(f"variants must be >= 1, got {n}")
     base = PARTS[task]()
     names = [f.name for f in dataclasses.fields(base) if f.name != "clearance"]
-    default_clearance = float(base.clearance)  # type: ignore[union-attr]
+    default_clearance = float(base.clearance)
     rng = np.random.default_rng(seed)
     picks = [(CLEARANCE_RANGE[0], s) for s in (1.0, SCALE_RANGE[0], SCALE_RANGE[1])]
     while len(picks) < n:
@@ -106,7 +107,8 @@ def run_variants(
             results, collisions = [], 0
             for seed in range(runs):
                 collisions = max(
-                    collisions, int(synth_demo(asm, seed, p_penetrate=0.0).meta["n_colliding"])
+                    collisions,
+                    cast(int, synth_demo(asm, seed, p_penetrate=0.0).meta["n_colliding"]),
                 )
                 results.append(mp.plan(synth_demo(asm, seed), seed=seed))
                 if progress:

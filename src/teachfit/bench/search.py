@@ -16,9 +16,10 @@ Every execution is a :class:`~teachfit.bench.search_jobs.SearchJob` run in worke
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
+from typing import TypedDict, Unpack
 
 import numpy as np
 
@@ -38,6 +39,7 @@ from teachfit.execution.teacher import BlindTeacher, TeacherStyle
 from teachfit.execution.teacher_cache import cache_key, cached
 from teachfit.metrics.stats import SuccessSummary, summarize
 from teachfit.models.search_model import SearchModel
+from teachfit.tasks.geometry.socket3d import Socket3D
 from teachfit.tasks.registry import get_task
 
 #: the paper's real-robot results (successes, trials)
@@ -99,6 +101,17 @@ def use_robot(name: str) -> None:
     ROBOT[0] = name
 
 
+class JobOptions(TypedDict, total=False):
+    """The optional :class:`SearchJob` fields :func:`_jobs` passes on (same names)."""
+
+    feedforward: bool
+    length: float | None
+    sampling: str
+    robot_seed: int
+    passes: int
+    robot: str
+
+
 def _jobs(
     task: str,
     overrides: dict[str, float],
@@ -107,13 +120,13 @@ def _jobs(
     method: str,
     n_points: int,
     seeds: Sequence[int],
-    **kw: object,
+    **kw: Unpack[JobOptions],
 ) -> list[SearchJob]:
     doc = model_json(model)
     ov = tuple(sorted(overrides.items()))
     kw.setdefault("robot", ROBOT[0])
     return [
-        SearchJob(task, ov, doc, pose_tuple(p), method, n_points, s, **kw)  # type: ignore[arg-type]
+        SearchJob(task, ov, doc, pose_tuple(p), method, n_points, s, **kw)
         for p, s in zip(starts, seeds, strict=True)
     ]
 
@@ -170,7 +183,7 @@ def _planned_tshix(model: SearchModel, n_points: int, seeds: Sequence[int]) -> t
 
 def _run_rows(
     jobs: dict[str, list[SearchJob]],
-    paper: dict[str, tuple[int, int] | None],
+    paper: Mapping[str, tuple[int, int] | None],
     workers: int | None,
     progress: Progress,
 ) -> list[Row]:
@@ -285,17 +298,19 @@ def record_socket_demos(task: object, seed: int) -> tuple[list[Demonstration], l
 
 
 def _record_socket_demos(task: object, seed: int) -> tuple[list[Demonstration], list[str]]:
+    if not isinstance(task, Socket3D):
+        raise TeachfitError(f"socket demonstrations need the socket3d task, got {task!r}")
     rng = np.random.default_rng(seed)
-    dist = task.play - task.params.start_wall_gap  # type: ignore[attr-defined]
-    teacher = BlindTeacher(task, seed=seed, robot=ROBOT[0])  # type: ignore[arg-type]
+    dist = task.play - task.params.start_wall_gap
+    teacher = BlindTeacher(task, seed=seed, robot=ROBOT[0])
     demos: list[Demonstration] = []
     discarded: list[str] = []
-    rz_max = task.params.start_rz  # type: ignore[attr-defined]
+    rz_max = task.params.start_rz
     for (lo, hi), sign in (((0.05, 0.25), 1.0), ((0.75, 0.95), -1.0)):
         for _attempt in range(6):
             ang = np.pi * rng.uniform(lo, hi)
             rz = sign * rng.uniform(0.6 * rz_max, rz_max)  # worst case: far from aligned
-            start = task.contact_pose(dist * np.array([np.cos(ang), np.sin(ang)]), rz)  # type: ignore[attr-defined]
+            start = task.contact_pose(dist * np.array([np.cos(ang), np.sin(ang)]), rz)
             demo, why = teacher.demonstrate(start)
             if demo is not None:
                 demos.append(demo)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +25,9 @@ from teachfit.execution.batch import episode_seed
 from teachfit.execution.teacher import BlindTeacher
 from teachfit.models.search_model import SearchModel
 from teachfit.tasks.variants import Variant, sample_variants
+
+if TYPE_CHECKING:
+    from teachfit.viz.variant_figures import VariantRecord
 
 #: the protocol of each task: (protocol name, TSHIX points, demonstrations)
 PROTOCOLS = {"peg2d": ("table1", 300, 1), "socket3d": ("table3", 600, 2)}
@@ -133,10 +137,10 @@ def goal_misses(results: Sequence[VariantResult]) -> list[VariantResult]:
     ]
 
 
-def figure_data(results: Sequence[VariantResult]) -> list[dict[str, object]]:
+def figure_data(results: Sequence[VariantResult]) -> list[VariantRecord]:
     """Plain per-variant records for :func:`teachfit.viz.variant_figures.success_by_parameter`:
     the axis values, and per method ``(successes, trials, low, high)``."""
-    out = []
+    out: list[VariantRecord] = []
     for r in results:
         rates = {
             row.method: (row.ours.successes, row.ours.trials, row.ours.low, row.ours.high)
@@ -159,7 +163,7 @@ def results_json(results: Sequence[VariantResult]) -> str:
             "why": r.why,
             "rates": {
                 m: dict(zip(("successes", "trials", "low", "high"), v, strict=True))
-                for m, v in fig["rates"].items()  # type: ignore[attr-defined]
+                for m, v in fig["rates"].items()
             },
         }
         for r, fig in zip(results, figure_data(results), strict=True)

@@ -14,6 +14,7 @@ autocorrelation at least 0.9 at 100 Hz. Two recordings, on any robot of the regi
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -112,7 +113,7 @@ def slide_smoothness(
     duration: float = 4.0,
     start_xy: tuple[float, float] = (0.035, -0.024),
     style: TeacherStyle | None = None,
-    **options: object,
+    **options: Any,
 ) -> Smoothness:
     """f_z figures of a ``duration`` s straight slide along +y at the teacher's speed from
     ``start_xy`` (m, task frame) on the block top, driven as the teacher drives the robot

@@ -17,6 +17,7 @@ from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import TeachfitError
 
 if TYPE_CHECKING:
+    from teachfit.bench.search import Row
     from teachfit.bench.search_variants import VariantResult
 
 TABLES = ("1", "2", "ablation", "3", "all")
@@ -27,28 +28,28 @@ def _rate(s: int, n: int, lo: float, hi: float) -> str:
     return f"{s}/{n} = {100 * s / n:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]"
 
 
-def _cells(row: object) -> list[str]:
+def _cells(row: Row) -> list[str]:
     from teachfit.metrics.stats import wilson_interval
 
-    ours = row.ours  # type: ignore[attr-defined]
-    paper = row.paper  # type: ignore[attr-defined]
+    ours = row.ours
+    paper = row.paper
     p = "n/a" if paper is None else _rate(*paper, *wilson_interval(*paper))
     t = "n/a" if ours.median_time != ours.median_time else f"{ours.median_time:.1f} s"
-    plan = f"{row.plan_ms:.0f} ms"  # type: ignore[attr-defined]
-    if getattr(row, "paper_cpu_s", None) is not None:
-        plan += f" (paper {row.paper_cpu_s:.1f} s)"  # type: ignore[attr-defined]
+    plan = f"{row.plan_ms:.0f} ms"
+    if row.paper_cpu_s is not None:
+        plan += f" (paper {row.paper_cpu_s:.1f} s)"
     return [
-        row.method,  # type: ignore[attr-defined]
+        row.method,
         _rate(ours.successes, ours.trials, ours.low, ours.high),
         p,
         t,
         plan,
-        f"{row.length:.2f} m",  # type: ignore[attr-defined]
-        f"{row.ergodic:.4f}",  # type: ignore[attr-defined]
+        f"{row.length:.2f} m",
+        f"{row.ergodic:.4f}",
     ]
 
 
-def _emit(title: str, rows: Sequence[object], markdown: Path | None) -> None:
+def _emit(title: str, rows: Sequence[Row], markdown: Path | None) -> None:
     table = Table(title=title)
     for col in _COLS:
         table.add_column(col, justify="right")
@@ -202,7 +203,7 @@ def _paper_tables(
 
 def _task_table(
     task: str,
-    demo: Path | None,
+    demo: str | Path | None,
     seed: int,
     starts: int,
     points: int,

@@ -27,6 +27,17 @@ from teachfit.core.errors import ControlError
 Vec6 = tuple[float, float, float, float, float, float]
 
 
+def vec6(values: Sequence[float] | np.ndarray) -> Vec6:
+    """The six numbers of ``values`` (length 6, unchecked) as a tuple of floats."""
+    a, b, c, d, e, f = (float(v) for v in values)
+    return (a, b, c, d, e, f)
+
+
+def _split6(linear: float, angular: float) -> Vec6:
+    """``linear`` for x, y, z and ``angular`` for rx, ry, rz."""
+    return (linear, linear, linear, angular, angular, angular)
+
+
 @dataclass(frozen=True)
 class ImpedanceLimits:
     """Safety limits of the impedance controller (N, N·m, m/s, rad/s)."""
@@ -53,7 +64,7 @@ def _six(value: float | Sequence[float] | np.ndarray, name: str, *, positive: bo
         raise ControlError(f"{name} must be > 0 per coordinate, got {arr.tolist()}")
     if not positive and not np.all(arr >= 0):
         raise ControlError(f"{name} must be >= 0 per coordinate, got {arr.tolist()}")
-    return tuple(float(v) for v in arr)  # type: ignore[return-value]
+    return vec6(arr)
 
 
 @dataclass(frozen=True)
@@ -65,10 +76,10 @@ class AdaptiveLimits:
     broadcast to all six coordinates. Defaults are of the order of a Franka Panda's.
     """
 
-    k_max: Vec6 = (3000.0,) * 3 + (300.0,) * 3  # type: ignore[assignment]
-    dk_max: Vec6 = (2.0e4,) * 3 + (2.0e3,) * 3  # type: ignore[assignment]
-    f_max: Vec6 = (20.0,) * 3 + (2.0,) * 3  # type: ignore[assignment]
-    df_max: Vec6 = (500.0,) * 3 + (50.0,) * 3  # type: ignore[assignment]
+    k_max: Vec6 = _split6(3000.0, 300.0)
+    dk_max: Vec6 = _split6(2.0e4, 2.0e3)
+    f_max: Vec6 = _split6(20.0, 2.0)
+    df_max: Vec6 = _split6(500.0, 50.0)
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -87,11 +98,11 @@ class AdaptiveParams:
     e_max=(0.01,)*3 + (0.1,)*3, de_max=(0.1,)*3 + (1.0,)*3)``.
     """
 
-    alpha: Vec6 = (0.5,) * 3 + (0.02,) * 3  # type: ignore[assignment]
-    beta: Vec6 = (2.0e3,) * 3 + (5.0,) * 3  # type: ignore[assignment]
-    gamma_a: Vec6 = (1.0e-4,) * 3 + (1.0e-2,) * 3  # type: ignore[assignment]
-    gamma_b: Vec6 = (5.0e-7,) * 3 + (1.0e-4,) * 3  # type: ignore[assignment]
-    kappa: Vec6 = (10.0,) * 6  # type: ignore[assignment]
+    alpha: Vec6 = _split6(0.5, 0.02)
+    beta: Vec6 = _split6(2.0e3, 5.0)
+    gamma_a: Vec6 = _split6(1.0e-4, 1.0e-2)
+    gamma_b: Vec6 = _split6(5.0e-7, 1.0e-4)
+    kappa: Vec6 = _split6(10.0, 10.0)
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -144,14 +155,11 @@ def meta_bounds(
     df = np.asarray(limits.df_max) * period
     dk = np.asarray(limits.dk_max) * period
 
-    def t6(a: np.ndarray) -> Vec6:
-        return tuple(float(v) for v in a)  # type: ignore[return-value]
-
     return MetaBounds(
-        alpha=t6(df / eps),
-        beta=t6(dk / (eps * e)),
-        gamma_a=t6(eps / np.asarray(limits.f_max)),
-        gamma_b=t6(eps * e / np.asarray(limits.k_max)),
+        alpha=vec6(df / eps),
+        beta=vec6(dk / (eps * e)),
+        gamma_a=vec6(eps / np.asarray(limits.f_max)),
+        gamma_b=vec6(eps * e / np.asarray(limits.k_max)),
     )
 
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import TeachfitError
@@ -124,7 +125,7 @@ class Pose:
         inv = self.rotation.inv()
         return Pose(-inv.apply(np.array(self.pos)), rotation_to_wxyz(inv))
 
-    def translated(self, delta: np.ndarray) -> Pose:
+    def translated(self, delta: ArrayLike) -> Pose:
         return Pose(self.pos + np.asarray(delta, dtype=float), self.quat)
 
     @classmethod

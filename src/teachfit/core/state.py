@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -180,6 +181,6 @@ class ImpedanceCommand:
         return self
 
     @classmethod
-    def hold(cls, pose: Pose, **kwargs: object) -> ImpedanceCommand:
-        """A command that holds ``pose`` still."""
-        return cls(pos=pose.pos, quat=pose.quat, **kwargs)  # type: ignore[arg-type]
+    def hold(cls, pose: Pose, **kwargs: Any) -> ImpedanceCommand:
+        """A command that holds ``pose`` still (``kwargs``: the other fields, checked there)."""
+        return cls(pos=pose.pos, quat=pose.quat, **kwargs)

@@ -26,7 +26,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, partial
 
 import numpy as np
 
@@ -69,16 +69,24 @@ def open_loop_skill(controller: str = "adaptive") -> Skill:
     """The plan executed open loop: above the taught hole, then straight down to depth."""
     base = peg_in_hole.build(controller)
     stiff = (2000.0, 2000.0, 2000.0, 80.0, 80.0, 80.0)
-    fast = {k: k for k in ("v_max", "a_max", "w_max", "dw_max", "speed_factor")}
+    # the motion limits by the names of the learned parameters
+    fast = partial(
+        MoveTo,
+        stiffness=stiff,
+        a_max="a_max",
+        w_max="w_max",
+        dw_max="dw_max",
+        speed_factor="speed_factor",
+    )
     nodes = (
         Node(
             "approach",
-            MoveTo(goal=(0.0, 0.0, "approach_height"), yaw=0.0, tilt=0.0, stiffness=stiff, **fast),
+            fast(goal=(0.0, 0.0, "approach_height"), yaw=0.0, tilt=0.0, v_max="v_max"),
             TimeAbove("t_approach"),
         ),
         Node(
             "descend",
-            MoveTo(goal=(0.0, 0.0, "-depth"), stiffness=stiff, **(fast | {"v_max": "v_insert"})),
+            fast(goal=(0.0, 0.0, "-depth"), v_max="v_insert"),
             TimeAbove("t_approach"),
         ),
     )
@@ -232,17 +240,40 @@ def assembly_jobs(
     hole_errors: Sequence[float],
     trials: int,
     model: SearchModel | None = None,
-    **kw: object,
+    *,
+    overrides: Sequence[tuple[str, float]] | None = None,
+    seed: int = 0,
+    yaw_error: float = 0.0,
+    skill: str = "peg-in-hole",
+    controller: str = "adaptive",
+    learned: tuple[tuple[str, float], ...] = (),
+    robot: str = "floating",
+    keep_log: bool = False,
 ) -> list[AssemblyJob]:
-    """Jobs for every method x hole error x trial (trial ``i`` is the same for all methods)."""
+    """Jobs for every method x hole error x trial (trial ``i`` is the same for all methods);
+    the keyword arguments are the :class:`AssemblyJob` fields of the same names."""
     if trials < 1:
         raise TeachfitError(f"number of trials must be >= 1, got {trials}")
     for m in methods:
-        method_skill(m, model, str(kw.get("skill", "peg-in-hole")), "impedance")  # fail early
+        method_skill(m, model, skill, "impedance")  # fail early
     doc = "" if model is None else json.dumps(model.to_dict(), sort_keys=True)
-    ov = tuple(sorted(kw.pop("overrides", ()) or ()))  # type: ignore[call-overload]
+    ov = tuple(sorted(overrides or ()))
     return [
-        AssemblyJob(task, ov, doc, m, float(e), i, **kw)  # type: ignore[arg-type]
+        AssemblyJob(
+            task,
+            ov,
+            doc,
+            m,
+            float(e),
+            i,
+            seed=seed,
+            yaw_error=yaw_error,
+            skill=skill,
+            controller=controller,
+            learned=learned,
+            robot=robot,
+            keep_log=keep_log,
+        )  # fmt: skip
         for m in methods
         for e in hole_errors
         for i in range(trials)

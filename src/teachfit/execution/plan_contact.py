@@ -29,6 +29,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import TypedDict
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -208,11 +209,22 @@ def _recovery(
     return ctx, n * t_retry, [node], tr
 
 
+class CaptureError(TypedDict):
+    """A capture error as :class:`PartsCellParams` fields: translation (m), rotation (rad)."""
+
+    dx: float
+    dy: float
+    dz: float
+    droll: float
+    dpitch: float
+    dyaw: float
+
+
 def capture_error(
     rng: np.random.Generator,
     translation: tuple[float, float] = (0.0005, 0.003),
     rotation: tuple[float, float] = (np.radians(0.5), np.radians(2.0)),
-) -> dict[str, float]:
+) -> CaptureError:
     """A capture error: translation (m) and rotation (rad) of uniform magnitudes in the given
     ranges, in uniformly random directions; as :class:`PartsCellParams` fields."""
     d = rng.normal(size=3)
@@ -220,8 +232,8 @@ def capture_error(
     t = rng.uniform(*translation) * d / np.linalg.norm(d)
     r = Rotation.from_rotvec(rng.uniform(*rotation) * a / np.linalg.norm(a))
     rpy = r.as_euler("xyz")
-    names = ("dx", "dy", "dz", "droll", "dpitch", "dyaw")
-    return dict(zip(names, map(float, (*t, *rpy)), strict=True))
+    dx, dy, dz, droll, dpitch, dyaw = map(float, (*t, *rpy))
+    return CaptureError(dx=dx, dy=dy, dz=dz, droll=droll, dpitch=dpitch, dyaw=dyaw)
 
 
 def trial_cell(part: str, seed: int, i: int, **error_ranges: tuple[float, float]) -> PartsCell:

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -113,7 +114,7 @@ class SkillTrial:
         config: ExecConfig | None = None,
         robot: str = "floating",
         seed: int = 0,
-        **robot_options: object,
+        **robot_options: Any,
     ) -> None:
         self.setup = setup
         self.controller = controller
@@ -144,6 +145,7 @@ class SkillTrial:
     def __call__(
         self, learned: Mapping[str, float] | None = None, starts: Sequence[Pose] | None = None
     ) -> TrialOutcome:
+        runs: list[tuple[Pose, Pose | None]]
         if starts is None:
             s = self.setup
             runs = [(st, s.frame(i)) for i, st in enumerate(s.starts)]

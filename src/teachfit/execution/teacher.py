@@ -29,6 +29,8 @@ the disk cache of :mod:`.teacher_cache`).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from rich.progress import Progress
 
@@ -179,7 +181,7 @@ class BlindTeacher:
                     discarded.append(why)
                     continue
                 name = f"{self.task.name}-teacher-{len(demos)}"
-                demos.append(Demonstration(**{**_fields(demo), "name": name}))
+                demos.append(replace(demo, name=name, meta=dict(demo.meta)))
                 bar.advance(task_id)
         if len(demos) < n:
             raise TeachfitError(
@@ -187,18 +189,3 @@ class BlindTeacher:
                 f"discarded: {discarded}"
             )
         return demos, discarded
-
-
-def _fields(demo: Demonstration) -> dict[str, object]:
-    return {
-        "t": demo.t,
-        "pos": demo.pos,
-        "quat": demo.quat,
-        "wrench": demo.wrench,
-        "task": demo.task,
-        "source": demo.source,
-        "frame": demo.frame,
-        "child_frame": demo.child_frame,
-        "name": demo.name,
-        "meta": dict(demo.meta),
-    }

@@ -17,6 +17,7 @@ import os
 from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import DatasetError
@@ -24,13 +25,16 @@ from teachfit.demonstrations.dataset import Demonstration, read_dataset, write_d
 
 ENV = "TEACHFIT_TEACHER_CACHE"
 
+if TYPE_CHECKING:
+    from teachfit.execution.teacher_style import TeacherStyle
+
 Recording = tuple[list[Demonstration], list[str]]
 
 
 def cache_key(
     *,
     task: object,
-    style: object,
+    style: TeacherStyle,
     seed: int,
     robot: str,
     n: int,
@@ -47,7 +51,7 @@ def cache_key(
         "version": __version__,
         "task": getattr(task, "name", type(task).__name__),
         "params": repr(params),
-        "style": asdict(style),  # type: ignore[call-overload]
+        "style": asdict(style),
         "seed": int(seed),
         "robot": robot,
         "n": int(n),

@@ -13,12 +13,11 @@ sampler is passed in.
 from __future__ import annotations
 
 import importlib.util
-import sys
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, nullcontext
 
 import optuna
-from optuna.distributions import FloatDistribution
+from optuna.distributions import BaseDistribution, FloatDistribution
 
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import Candidate, Finished
@@ -32,9 +31,9 @@ def _one_thread() -> Iterator[None]:
     tensors (at most a few hundred trials x 15 parameters) are too small to share out, and
     two threads took 1.3 x the CPU time of one for the same points (85 vs 64 CPU-s for 70
     asks on the 2-core machine, identical candidates), CPU the trials' workers need."""
-    torch = sys.modules.get("torch")
-    if torch is None:  # not imported yet: the sampler imports it on its first GP step
-        import torch  # noqa: PLC0415
+    # imported here when not yet (the sampler imports it on its first GP step)
+    import torch  # noqa: PLC0415
+
     before = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
@@ -83,7 +82,9 @@ class BayesOpt:
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self._study = optuna.create_study(direction="minimize", sampler=sampler)
         # the sampler sees unit-cube coordinates u0..u{d-1}; log scales live in the space
-        self._dists = {f"u{i}": FloatDistribution(0.0, 1.0) for i in range(space.dim)}
+        self._dists: dict[str, BaseDistribution] = {
+            f"u{i}": FloatDistribution(0.0, 1.0) for i in range(space.dim)
+        }
         self._running: dict[str, optuna.trial.Trial] = {}
         self._known: set[str] = set()
         self._counter = 0

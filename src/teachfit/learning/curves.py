@@ -22,7 +22,7 @@ from scipy import stats
 from teachfit.core.params import LearningError
 
 
-def best_so_far(costs: Sequence[float]) -> np.ndarray:
+def best_so_far(costs: Sequence[float] | np.ndarray) -> np.ndarray:
     """``b_k = min(c_1..c_k)`` (n,); an empty input gives an empty curve."""
     arr = np.asarray(costs, dtype=float).reshape(-1)
     if arr.size and not np.all(np.isfinite(arr)):

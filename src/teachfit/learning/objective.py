@@ -81,7 +81,10 @@ class SkillObjective:
             setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
             from teachfit.execution.engine import ExecConfig
 
-            options = {"host": self.host, "realtime": self.realtime} if self.host else {}
+            # the real robot's own options (checked by its factory)
+            options: dict[str, Any] = (
+                {"host": self.host, "realtime": self.realtime} if self.host else {}
+            )
             # a simulated robot is reset before every execution: the recovery retract after a
             # failure would only cost compute (its robot time is not in the cost), a real one
             # needs it

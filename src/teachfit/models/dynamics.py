@@ -18,7 +18,7 @@ For K components (Gaussian mixture regression) with responsibilities
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -49,6 +49,10 @@ class DynamicsModel(GaussianMixture):
     """
 
     KIND: ClassVar[str] = "dynamics model"
+    #: derived in ``__post_init__``: the gain Σ_as Σ_ss⁻¹ (K, D, D) and the conditional
+    #: covariance of the action given the step (K, D, D)
+    _gain: np.ndarray = field(init=False, repr=False, compare=False)
+    _cond_cov: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -75,6 +75,7 @@ def fit_regularised_gmm(
     centre = x.mean(axis=0)
     scale = np.maximum(x.std(axis=0), np.maximum(abs_floor, 1e-300))
     z = (x - centre) / scale
+    candidates: Sequence[int]
     if n_components == "bic":
         candidates = range(1, max(1, min(int(max_components), n // (d + 1))) + 1)
     else:

@@ -199,7 +199,7 @@ def search_data(
         rs = _resample(t, s, rate_hz)
         states.append(rs)
         steps.append(np.diff(rs, axis=0))
-        if has_wrench:
+        if has_wrench and a is not None:  # a is never None when has_wrench
             actions.append(_resample(t, a, rate_hz)[:-1])
     steps_all = np.concatenate(steps)
     lin = [i for i, d in enumerate(dims) if d != "rz"]

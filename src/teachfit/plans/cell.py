@@ -151,7 +151,9 @@ class PartsProtocol(Protocol):
     def teacher_start(self, rng: np.random.Generator) -> Pose:
         raise TaskError("the parts cell has no blind-teacher start: execute a plan instead")
 
-    def paper_starts(self, protocol, n, rng, demo_start):  # type: ignore[no-untyped-def]
+    def paper_starts(
+        self, protocol: str, n: int, rng: np.random.Generator, demo_start: Pose | None
+    ) -> list[Pose]:
         raise TaskError(f"the parts cell has no protocol {protocol!r}")
 
 

@@ -18,6 +18,7 @@ Distances (reports only) always use the meshes.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import coal
 import numpy as np
@@ -25,6 +26,9 @@ import trimesh
 
 from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import quat_normalize_into, quat_to_matrix_into
+
+if TYPE_CHECKING:
+    from teachfit.plans.parts import Assembly
 
 __all__ = [
     "CollisionChecker",
@@ -182,12 +186,12 @@ class CollisionChecker:
         return self._boxes is not None
 
     @classmethod
-    def of(cls, asm: object, *, margin: float = 0.0) -> CollisionChecker:
+    def of(cls, asm: Assembly, *, margin: float = 0.0) -> CollisionChecker:
         """The checker of an assembly (``moving``, ``fixed`` meshes), on its boxes where it has
         them (``moving_boxes`` and ``fixed_boxes`` not None)."""
-        mov, fix = getattr(asm, "moving_boxes", None), getattr(asm, "fixed_boxes", None)
+        mov, fix = asm.moving_boxes, asm.fixed_boxes
         boxes = None if mov is None or fix is None else (mov, fix)
-        return cls(asm.moving, asm.fixed, margin=margin, boxes=boxes)  # type: ignore[attr-defined]
+        return cls(asm.moving, asm.fixed, margin=margin, boxes=boxes)
 
     def collides_xyzq(
         self, x: float, y: float, z: float, w: float, qx: float, qy: float, qz: float

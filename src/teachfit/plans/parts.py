@@ -21,13 +21,14 @@ Tenon (paper Sec. IV)
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 
 import manifold3d
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import TaskError
@@ -43,7 +44,7 @@ __all__ = [
 ]
 
 
-def pose_from_xyz_rpy(xyz: np.ndarray, rpy_deg: np.ndarray) -> np.ndarray:
+def pose_from_xyz_rpy(xyz: ArrayLike, rpy_deg: ArrayLike) -> np.ndarray:
     """4x4 homogeneous transform from a position (m) and extrinsic x-y-z Euler angles (deg)."""
     T = np.eye(4)
     T[:3, :3] = Rotation.from_euler("xyz", rpy_deg, degrees=True).as_matrix()
@@ -340,7 +341,7 @@ class TenonParams:
         )
 
 
-PARTS: Mapping[str, Callable[..., LGrooveParams | TenonParams]] = MappingProxyType(
+PARTS: Mapping[str, type[LGrooveParams] | type[TenonParams]] = MappingProxyType(
     {"l-groove": LGrooveParams, "tenon": TenonParams}
 )
 """Task name -> parameter class; ``PARTS[name](**overrides).build()`` gives the assembly."""

@@ -34,6 +34,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Sequence
+from typing import Protocol
 
 import numpy as np
 import ompl.base as ob
@@ -54,6 +55,19 @@ from teachfit.plans.keyposes import KeyPoses, rank_key_poses, straight_chain
 from teachfit.plans.ompl_space import PLANNERS, matrix_to_state, seed_ompl, slerp
 from teachfit.plans.parts import Assembly
 from teachfit.plans.plan_types import PlannerConfig, PlanResult
+
+
+class DemoPoses(Protocol):
+    """What the planner reads of a demonstration (a
+    :class:`~teachfit.demonstrations.dataset.Demonstration`): the ``L2G`` positions (T, 3) in m
+    and unit quaternions (T, 4) w-x-y-z; ``task`` and ``t`` are read where present."""
+
+    @property
+    def pos(self) -> np.ndarray: ...
+
+    @property
+    def quat(self) -> np.ndarray: ...
+
 
 __all__ = [
     "PLANNERS",
@@ -237,7 +251,7 @@ class MotionPlanner:
 
     # -- public -------------------------------------------------------------------------------
     def plan(
-        self, demo: object | None = None, *, te: float | None = None,
+        self, demo: DemoPoses | None = None, *, te: float | None = None,
         max_checks: int | None = None, seed: int = 0,
     ) -> PlanResult:  # fmt: skip
         """Plan from start to goal, inserting ranked key poses of ``demo`` as needed.
@@ -326,7 +340,7 @@ class MotionPlanner:
         return False, te, f"te={te} s"
 
     def _candidates(
-        self, demo: object | None, rng: np.random.Generator
+        self, demo: DemoPoses | None, rng: np.random.Generator
     ) -> tuple[KeyPoses | None, dict[int, np.ndarray | None], dict[tuple[int, int], bool]]:
         """The demonstration's ranked key poses (None without one), their repairs by position,
         and the straight motions between them found free or not while ranking."""
@@ -351,14 +365,12 @@ class MotionPlanner:
             return 0
         demo_states = matrix_to_state(keys.L2G)
         return sum(
-            1
-            for i in chosen
-            if repaired[i] is None or not np.array_equal(repaired[i], demo_states[i])
+            1 for i in chosen if (r := repaired[i]) is None or not np.array_equal(r, demo_states[i])
         )
 
     def _rank(
         self,
-        demo: object,
+        demo: DemoPoses,
         include: np.ndarray | None = None,
         eligible: np.ndarray | None = None,
     ) -> tuple[KeyPoses, np.ndarray | None]:
@@ -373,8 +385,8 @@ class MotionPlanner:
         t = np.asarray(getattr(demo, "t", []), dtype=float)
         if t.ndim != 1 or len(t) < 2:
             raise PlanningError(f"demonstration has {t.size} pose(s); need at least 2")
-        pos = np.asarray(demo.pos, dtype=float)  # type: ignore[attr-defined]
-        quat = np.asarray(demo.quat, dtype=float)  # type: ignore[attr-defined]
+        pos = np.asarray(demo.pos, dtype=float)
+        quat = np.asarray(demo.quat, dtype=float)
         shapes_ok = pos.shape == (len(t), 3) and quat.shape == (len(t), 4)
         if eligible is None and self.key_region > 0 and shapes_ok:
             # every third sample, each standing for its neighbours (a 30 Hz demonstration moves
@@ -395,7 +407,7 @@ class MotionPlanner:
         return keys, eligible
 
     def _demonstrated(
-        self, demo: object | None, keys: KeyPoses | None
+        self, demo: DemoPoses | None, keys: KeyPoses | None
     ) -> Callable[[int, int], np.ndarray | None]:
         """``via(a, b)``: the demonstrated states strictly between neighbouring nodes ``a`` and
         ``b = a + 1`` (-1 the start, ``0 .. K-1`` the candidates, ``K`` the goal); None for
@@ -415,7 +427,7 @@ class MotionPlanner:
 
         return via
 
-    def _demo_chain(self, demo: object, than: int) -> np.ndarray | None:
+    def _demo_chain(self, demo: DemoPoses, than: int) -> np.ndarray | None:
         """Sample indices of the demonstration's own greedy straight chain
         (:func:`straight_chain` over :data:`CHAIN_NODES` of its poses, from the start to the goal
         or approach pose) if it needs fewer than ``than`` poses, at most the task's candidate
@@ -475,14 +487,20 @@ class MotionPlanner:
         the chain's length."""
         n = len(keys.indices)
         end = n if self.approach is None else n + 1  # the attempts' id of the chain's last node
-        nodes = {-1: self.start, n: self.goal if self.approach is None else self.approach}
+        nodes: dict[int, np.ndarray | None] = {
+            -1: self.start,
+            n: self.goal if self.approach is None else self.approach,
+        }
         nodes |= repaired
         straight: dict[tuple[int, int], bool] = {}
 
         def connects(a: int, b: int) -> bool:
             sa, sb = nodes[a], nodes[b]
-            ok = sa is not None and sb is not None
-            ok = ok and bool(self.si.checkMotion(self._to_ompl(sa), self._to_ompl(sb)))
+            ok = (
+                sa is not None
+                and sb is not None
+                and bool(self.si.checkMotion(self._to_ompl(sa), self._to_ompl(sb)))
+            )
             straight[(a, end if b == n else b)] = ok
             return ok
 
@@ -538,10 +556,10 @@ class MotionPlanner:
         return not any(self._collides(s) for s in dense)
 
 
-def _demo_states(demo: object) -> np.ndarray:
+def _demo_states(demo: DemoPoses) -> np.ndarray:
     """(T, 7) states ``[x, y, z, qw, qx, qy, qz]`` of a demonstration's ``L2G``."""
-    pos = np.asarray(demo.pos, dtype=float)  # type: ignore[attr-defined]
-    return np.concatenate([pos, np.asarray(demo.quat, dtype=float)], axis=1)  # type: ignore[attr-defined]
+    pos = np.asarray(demo.pos, dtype=float)
+    return np.concatenate([pos, np.asarray(demo.quat, dtype=float)], axis=1)
 
 
 def _chain_ahead(keys: KeyPoses, chain: list[int]) -> KeyPoses:
@@ -584,6 +602,7 @@ class _Attempts:
             budget = self.per_attempt - spent
             if self.failed.get((a, b), -1.0) * 1.5 >= budget:
                 return None  # failed before with as much budget: insert another key pose
+            seg: np.ndarray | None
             if self.straight.get((a, b)):  # found free while ranking
                 seg = np.stack([states[a], states[b]])
             else:

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.floating import FloatingToolRobot
@@ -46,7 +48,7 @@ def push(
     start = task.hole2world.compose(Pose.from_xyz_rz(x, y, start_height, 0.0))
     robot.reset(start)
     target = start.pos - [0.0, 0.0, 0.03]
-    robot.command(ImpedanceCommand(pos=target, quat=start.quat, stiffness=list(STIFFNESS)))
+    robot.command(ImpedanceCommand(pos=target, quat=start.quat, stiffness=np.array(STIFFNESS)))
     return robot.step(steps).pose
 
 

@@ -91,7 +91,7 @@ def build_scene(task: Task, params: FloatingToolParams | None = None) -> str:
     )
     task.scene.add_fixture(scene, contact)
     length = task.scene.held_part_length
-    start = task.contact_pose([0.05, 0.0]).translated([0, 0, 0.02])
+    start = task.contact_pose(np.array([0.05, 0.0])).translated([0, 0, 0.02])
     tool = ET.SubElement(scene.worldbody, "body", name="tool", pos=fmt(start.pos), gravcomp="1")
     ET.SubElement(tool, "freejoint", name="tool_free")
     ET.SubElement(
@@ -236,7 +236,13 @@ class FloatingToolRobot:
         """The compiled tick for the current law (None: a law only Python runs)."""
         if not FloatingKernel.supports(self._law):
             return None
-        st = (self._pos, self._quat, self._linvel, self._angvel_local, self._angvel)
+        st: tuple[np.ndarray, ...] = (
+            self._pos,
+            self._quat,
+            self._linvel,
+            self._angvel_local,
+            self._angvel,
+        )
         st += (self.data.xpos[self._body], self.data.qfrc_applied, self.data.sensordata)
         st += (np.zeros(6),)
         return FloatingKernel(self.model, self.data, self._body, self._law, st)

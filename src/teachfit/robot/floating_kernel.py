@@ -28,6 +28,7 @@ from __future__ import annotations
 import ctypes
 import math
 from functools import cache
+from typing import TypeGuard
 
 import mujoco
 import numba
@@ -138,10 +139,12 @@ class FloatingKernel:
         self.law = law
         self.sc = np.zeros(N_SCALARS)
         self.sc[k.DT] = float(model.opt.timestep)
-        self.adaptive = type(law) is AdaptiveImpedance
+        self.adaptive = isinstance(law, AdaptiveImpedance)  # the exact class: see supports
         e = law._error  # the law's own buffers: the kernel updates them in place
         bufs = (e._xd, e._qd, e._vd, e.err, e.derr, e._qtmp, e._rtmp, np.zeros(6))
-        if self.adaptive:
+        self.law_bufs: tuple[np.ndarray, ...]
+        self.ad: tuple[np.ndarray, ...]
+        if isinstance(law, AdaptiveImpedance):
             self.law_bufs = (law._k0, law._d0, law._fd, *bufs)
             self.ad = (law._alpha, law._beta, law._gamma_a, law._gamma_b, law._kappa)
             self.ad += (law._df_step, law._dk_step, law._f_max, law._ff_adapt, law._k_adapt)
@@ -151,7 +154,7 @@ class FloatingKernel:
             self.ad = (np.zeros(6),) * 14
 
     @staticmethod
-    def supports(law: object) -> bool:
+    def supports(law: object) -> TypeGuard[AdaptiveImpedance | CartesianImpedance]:
         """Whether ``law`` runs compiled (the two laws of :mod:`teachfit.control`)."""
         return type(law) in (AdaptiveImpedance, CartesianImpedance)
 
@@ -162,12 +165,12 @@ class FloatingKernel:
         e = law._error
         sc[k.T0], sc[k.EXPIRY] = e._t0, e._expiry
         sc[k.SPINNING], sc[k.LAPSED] = float(e._spinning), float(e.lapsed)
-        lim = law.impedance_limits if self.adaptive else law.limits
-        if self.adaptive:
+        if isinstance(law, AdaptiveImpedance):
+            lim = law.impedance_limits
             sc[k.MAX_F] = sc[k.MAX_T] = np.inf
             sc[CLIP_F], sc[CLIP_T], sc[XI] = lim.max_force, lim.max_torque, law._xi
         else:
-            sc[k.MAX_F], sc[k.MAX_T] = lim.max_force, lim.max_torque
+            sc[k.MAX_F], sc[k.MAX_T] = law.limits.max_force, law.limits.max_torque
         done = run(
             n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
             self.adaptive, self.state, self.law_bufs, self.ad, sc, ft, f_adr,

@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Protocol, cast
 
 import mujoco
 import numpy as np
 
 from teachfit.core.errors import TeachfitError
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.tasks.base import Task
 
@@ -34,18 +36,32 @@ class SimSpeed:
     contacts: int
 
 
-def _pressed_robot(task: Task, name: str) -> tuple[object, ImpedanceCommand]:
+class _MujocoRobot(Robot, Protocol):
+    """A robot simulated in MuJoCo: its model and data are open to the measurement."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+
+
+class _TimedRobot(_MujocoRobot, Protocol):
+    """The FR3, whose compiled tick also times the torque law."""
+
+    def step_timed(self, n: int) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+def _pressed_robot(task: Task, name: str) -> tuple[_MujocoRobot, ImpedanceCommand]:
     robot = make_robot(name, task)
     if not (hasattr(robot, "model") and hasattr(robot, "data")):
         raise TeachfitError(f"robot {name!r} is not simulated in MuJoCo: no simulation speed")
+    robot = cast(_MujocoRobot, robot)  # checked just above
     start = task.protocol.teacher_start(np.random.default_rng(0))
     robot.reset(start)
     cmd = ImpedanceCommand(
         pos=start.pos,
         quat=start.quat,
-        lin_vel=[0.01, 0.0, 0.0],
-        wrench_ff=[0, 0, -6.0, 0, 0, 0],
-        stiffness=[1500, 150, 100, 40, 40, 40],
+        lin_vel=np.array([0.01, 0.0, 0.0]),
+        wrench_ff=np.array([0, 0, -6.0, 0, 0, 0]),
+        stiffness=np.array([1500, 150, 100, 40, 40, 40]),
         expires_after=60.0,  # one command slides the tool for the whole measurement
     )
     robot.command(cmd)
@@ -53,12 +69,12 @@ def _pressed_robot(task: Task, name: str) -> tuple[object, ImpedanceCommand]:
     return robot, cmd
 
 
-def _contacts_while(sim: object, steps: int) -> int:
+def _contacts_while(sim: _MujocoRobot, steps: int) -> int:
     """The most contacts seen over ``steps`` controlled ticks (a sliding part can hop)."""
     most = 0
     for _ in range(steps):
-        sim.step(1)  # type: ignore[attr-defined]
-        most = max(most, int(sim.data.ncon))  # type: ignore[attr-defined]
+        sim.step(1)
+        most = max(most, int(sim.data.ncon))
     return most
 
 
@@ -83,7 +99,7 @@ def measure_sim_speed(
     contacts = 0
     for _ in range(repeats):
         sim, cmd = _pressed_robot(task, robot)
-        m, d = sim.model, sim.data  # type: ignore[attr-defined]
+        m, d = sim.model, sim.data
         snapshot = (d.qpos.copy(), d.qvel.copy(), d.time)
         t0 = time.perf_counter()
         for _ in range(steps):
@@ -91,12 +107,12 @@ def measure_sim_speed(
         raw_best = max(raw_best, steps / (time.perf_counter() - t0))
         d.qpos[:], d.qvel[:], d.time = snapshot
         mujoco.mj_forward(m, d)
-        sim.command(cmd)  # type: ignore[attr-defined]
+        sim.command(cmd)
         t0 = time.perf_counter()
-        sim.step(steps)  # type: ignore[attr-defined]
+        sim.step(steps)
         ctl_best = max(ctl_best, steps / (time.perf_counter() - t0))
         contacts = max(contacts, _contacts_while(sim, 50))
-    rtf = ctl_best * sim.control_period  # type: ignore[attr-defined]
+    rtf = ctl_best * sim.control_period
     return SimSpeed(raw_best, ctl_best, ctl_best / raw_best, rtf, contacts)
 
 
@@ -119,12 +135,13 @@ def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSim
     samples: list[np.ndarray] = []
     robot = None
     for _ in range(repeats):
-        robot, _cmd = _pressed_robot(task, "fr3")
-        m, d = robot.model, robot.data  # type: ignore[attr-defined]
+        pressed, _cmd = _pressed_robot(task, "fr3")
+        robot = cast(_TimedRobot, pressed)  # the FR3
+        m, d = robot.model, robot.data
         snapshot = (d.qpos.copy(), d.qvel.copy(), d.ctrl.copy(), d.qacc_warmstart.copy(), d.time)
         contacts = max(contacts, int(d.ncon))
         t0 = time.thread_time()
-        ticks, log = robot.step_timed(steps)  # type: ignore[attr-defined]
+        ticks, log = robot.step_timed(steps)
         ctl_best = max(ctl_best, steps / (time.thread_time() - t0))
         samples.append(ticks)
         d.qpos[:], d.qvel[:], d.ctrl[:], d.qacc_warmstart[:], d.time = snapshot
@@ -133,7 +150,7 @@ def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSim
         kernel.replay(kernel.routines(), m._address, d._address, d.ctrl, log)
         raw_best = max(raw_best, steps / (time.thread_time() - t0))
     assert robot is not None
-    rtf = ctl_best * robot.control_period  # type: ignore[attr-defined]
+    rtf = ctl_best * robot.control_period
     per_tick = np.concatenate(samples)
     return ArmSimSpeed(
         raw_best,

@@ -116,7 +116,7 @@ class _Walk:
         cur, nxt = self.cur, self._draw()
         if nxt is None:  # reflect: head for the centre instead
             to_c = self.s0 - cur
-            nxt = cur + to_c * min(1.0, self.step_max / max(np.linalg.norm(to_c[:2]), 1e-15))
+            nxt = cur + to_c * min(1.0, self.step_max / max(float(np.linalg.norm(to_c[:2])), 1e-15))
         if not np.linalg.norm(nxt - cur) > 0:
             return None
         self.cur = nxt

@@ -28,7 +28,7 @@ because no maintained Python package provides SMC with closed-form Gaussian coef
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -68,6 +68,10 @@ class CosineBasis:
     lo: np.ndarray
     hi: np.ndarray
     n_coeffs: int
+    #: derived in ``__post_init__``: indices k (D, K, ..., K), h_k and Λ_k (K,)*D
+    k: np.ndarray = field(init=False, repr=False, compare=False)
+    norm: np.ndarray = field(init=False, repr=False, compare=False)
+    weights: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         lo, hi = np.asarray(self.lo, float), np.asarray(self.hi, float)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -208,8 +208,13 @@ class TshixPlanner:
             raise ModelError(f"sampling must be 'qmc' or 'random', got {self.sampling!r}")
         if self.length_scale is None:
             object.__setattr__(self, "length_scale", default_length_scale(self.exploration))
-        if not self.length_scale > 0 or self.rate_hz <= 0 or self.smooth < 0:
+        if not self._length_scale > 0 or self.rate_hz <= 0 or self.smooth < 0:
             raise ModelError("length_scale and rate_hz must be positive, smooth >= 0")
+
+    @property
+    def _length_scale(self) -> float:
+        """``length_scale``, never None after ``__post_init__`` (which sets the default)."""
+        return cast(float, self.length_scale)
 
     @classmethod
     def from_model(cls, model: Any, **kwargs: Any) -> TshixPlanner:
@@ -222,7 +227,7 @@ class TshixPlanner:
         if not isinstance(n, int | np.integer) or n <= 0:
             raise PlanningError(f"number of samples must be a positive integer, got {n!r}")
         dims = self.exploration.dims
-        w = metric_weights(dims, self.length_scale)
+        w = metric_weights(dims, self._length_scale)
         samples = self.exploration.sample(int(n), rng, qmc=self.sampling == "qmc")
         tour = open_tour(samples, start, weights=w, solver=self.solver, rng=rng)
         poly = np.vstack([start[None], samples[tour.order]]) * w
@@ -240,7 +245,7 @@ class TshixPlanner:
             dims,
             speed=self.speed,
             angular_speed=self.angular_speed,
-            length_scale=self.length_scale,
+            length_scale=self._length_scale,
             rate_hz=self.rate_hz,
             t0=t0,
         )

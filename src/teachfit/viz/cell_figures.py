@@ -4,6 +4,7 @@ section at the hole entry with the part's footprint (lengths in mm, world frame)
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -12,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import shapely  # noqa: E402
 import trimesh  # noqa: E402
+from mpl_toolkits.mplot3d import Axes3D  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from teachfit.tasks.mesh.sections import ENTRY_EPS, footprint, section  # noqa: E402
@@ -21,7 +23,7 @@ from teachfit.viz.output import save_figure
 __all__ = ["cell_figure"]
 
 
-def _pieces(ax: plt.Axes, pieces: list[np.ndarray], cmap: str, alpha: float) -> None:
+def _pieces(ax: Axes3D, pieces: list[np.ndarray], cmap: str, alpha: float) -> None:
     colors = plt.get_cmap(cmap)(np.linspace(0.25, 0.85, max(len(pieces), 1)))
     for verts, color in zip(pieces, colors, strict=False):
         hull = trimesh.Trimesh(verts).convex_hull
@@ -31,7 +33,7 @@ def _pieces(ax: plt.Axes, pieces: list[np.ndarray], cmap: str, alpha: float) -> 
         )
 
 
-def _outline(ax: plt.Axes, geom: object, **kw: object) -> None:
+def _outline(ax: plt.Axes, geom: object, **kw: Any) -> None:
     for poly in getattr(geom, "geoms", [geom]):
         if poly.is_empty:
             continue

@@ -24,7 +24,7 @@ def _hole_patch(ax: plt.Axes, task: Task | None, scale: float) -> None:
     params = getattr(task, "params", None)
     radius = (
         (params.peg_diameter + params.clearance) / 2
-        if hasattr(params, "peg_diameter") and hasattr(params, "clearance")
+        if params is not None and hasattr(params, "peg_diameter") and hasattr(params, "clearance")
         else 0.002
     )
     hole = task.hole2world.pos

@@ -11,6 +11,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+import trimesh  # noqa: E402
+from mpl_toolkits.mplot3d import Axes3D  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from teachfit.core.geometry import Pose  # noqa: E402
@@ -25,8 +27,8 @@ FIXED_COLOR = (0.55, 0.6, 0.7)
 
 
 def add_mesh(
-    ax: plt.Axes,
-    mesh: object,
+    ax: Axes3D,
+    mesh: trimesh.Trimesh,
     T: np.ndarray | None = None,
     *,
     color=FIXED_COLOR,
@@ -47,7 +49,7 @@ def add_mesh(
     return coll
 
 
-def _frame_axes(ax: plt.Axes, asm: Assembly, extra: np.ndarray | None = None) -> None:
+def _frame_axes(ax: Axes3D, asm: Assembly, extra: np.ndarray | None = None) -> None:
     pts = [asm.fixed.vertices, (asm.moving.vertices @ asm.goal[:3, :3].T) + asm.goal[:3, 3]]
     if extra is not None:
         pts.append(extra)

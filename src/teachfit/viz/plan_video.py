@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from contextlib import ExitStack
 from pathlib import Path
+from typing import cast
 
 import imageio.v2 as imageio
 import matplotlib
@@ -12,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 
 from teachfit.core.atomic import atomic_path  # noqa: E402
 from teachfit.core.errors import RenderError  # noqa: E402
@@ -78,5 +80,6 @@ def render_path_video(
             moving = add_mesh(ax, asm.moving, path[i].matrix, color=MOVING_COLOR, alpha=0.9)
             ax.set_title(f"{asm.task}: pose {i + 1}/{len(path)}")
             fig.canvas.draw()
-            writer.append_data(np.asarray(fig.canvas.buffer_rgba())[..., :3])
+            canvas = cast(FigureCanvasAgg, fig.canvas)  # the Agg backend: see plan_figures
+            writer.append_data(np.asarray(canvas.buffer_rgba())[..., :3])
     return out

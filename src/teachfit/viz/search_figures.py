@@ -85,15 +85,15 @@ def tshix_stages(
     """Three panels: samples, itinerary (open tour from the start), smoothed trajectory."""
     from matplotlib.lines import Line2D
 
-    it = traj.itinerary
-    if it is None:
+    it, samples = traj.itinerary, traj.samples
+    if it is None or samples is None:
         raise ValueError("trajectory has no samples / itinerary (not a TSHIX trajectory)")
     fig, axes = plt.subplots(1, 3, figsize=(11, 4.8), sharex=True, sharey=True)
     for ax in axes:
         if expl is not None:
             gx, gy, z = _density_grid(expl)
             ax.contour(gx, gy, z, levels=6, colors="0.75", linewidths=0.7)
-        ax.plot(traj.samples[:, 0] * _MM, traj.samples[:, 1] * _MM, ".", color="crimson", ms=3)
+        ax.plot(samples[:, 0] * _MM, samples[:, 1] * _MM, ".", color="crimson", ms=3)
         ax.set_aspect("equal")
         ax.set_xlabel("x (mm)")
     axes[1].plot(it[:, 0] * _MM, it[:, 1] * _MM, "-", color="0.3", lw=0.8)
@@ -115,7 +115,7 @@ def tshix_stages(
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8)
     seeded = "" if seed is None else f", seed {seed}"
     fig.suptitle(
-        f"TSHIX, N = {len(traj.samples)}{seeded}: from samples to a trajectory (search frame; "
+        f"TSHIX, N = {len(samples)}{seeded}: from samples to a trajectory (search frame; "
         "the start is the demonstration's first pose)",
         fontsize=10,
     )

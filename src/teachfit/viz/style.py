@@ -4,6 +4,7 @@ legend entry for every marker, and titles that name what was run (method, N, see
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import matplotlib
 
@@ -11,12 +12,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.typing import ColorType  # noqa: E402
 
 __all__ = ["START", "END", "axis_label", "end_handles", "mark_ends", "run_title"]
 
 #: marker of a path's first point (hollow circle) and of its last point (filled square)
-START = {"marker": "o", "ms": 6, "mfc": "white", "mew": 1.2, "ls": "none"}
-END = {"marker": "s", "ms": 5, "ls": "none"}
+START: dict[str, Any] = {"marker": "o", "ms": 6, "mfc": "white", "mew": 1.2, "ls": "none"}
+END: dict[str, Any] = {"marker": "s", "ms": 5, "ls": "none"}
 
 
 def axis_label(name: str, unit: str, frame: str | None = None) -> str:
@@ -24,14 +26,14 @@ def axis_label(name: str, unit: str, frame: str | None = None) -> str:
     return f"{name}{f' in {frame}' if frame else ''} ({unit})"
 
 
-def mark_ends(ax: plt.Axes, xs: np.ndarray, ys: np.ndarray, color: object = "k") -> None:
+def mark_ends(ax: plt.Axes, xs: np.ndarray, ys: np.ndarray, color: ColorType = "k") -> None:
     """Draw the start and end markers of the path ``(xs, ys)`` in ``color``."""
     xs, ys = np.asarray(xs), np.asarray(ys)
     ax.plot(xs[:1], ys[:1], mec=color, **START)
     ax.plot(xs[-1:], ys[-1:], color=color, mec=color, **END)
 
 
-def end_handles(color: object = "0.3") -> list[Line2D]:
+def end_handles(color: ColorType = "0.3") -> list[Line2D]:
     """Legend entries explaining :func:`mark_ends`' markers."""
     return [
         Line2D([], [], mec=color, label="start", **START),

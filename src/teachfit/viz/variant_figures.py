@@ -7,7 +7,8 @@ they do not hide each other), and the goal as a dashed line.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
+from typing import TypedDict
 
 import matplotlib
 
@@ -15,6 +16,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+
+
+class VariantRecord(TypedDict):
+    """One variant's figure data: ``values`` axis -> value (as shown), ``rates`` method ->
+    ``(successes, trials, low, high)`` (Wilson 95 % interval)."""
+
+    values: dict[str, float]
+    rates: dict[str, tuple[int, int, float, float]]
+
 
 _COLOURS = {"tshix": "tab:blue", "ergodic": "tab:orange"}
 _LABELS = {
@@ -29,24 +39,24 @@ _LABELS = {
 
 
 def success_by_parameter(
-    records: Sequence[Mapping[str, object]], title: str, goal: float | None = None
+    records: Sequence[VariantRecord], title: str, goal: float | None = None
 ) -> Figure:
     """Panels of success rate (%) against each axis of ``records`` (dicts with ``values``:
     axis -> value, and ``rates``: method -> ``(successes, trials, low, high)``)."""
     if not records:
         raise ValueError("no variants to plot")
-    axes_names = list(records[0]["values"])  # type: ignore[arg-type]
-    methods = sorted({m for r in records for m in r["rates"]})  # type: ignore[attr-defined]
+    axes_names = list(records[0]["values"])
+    methods = sorted({m for r in records for m in r["rates"]})
     fig, axs = plt.subplots(1, len(axes_names), figsize=(3.6 * len(axes_names), 3.6), squeeze=False)
     for ax, name in zip(axs[0], axes_names, strict=True):
-        xs = np.array([r["values"][name] for r in records], dtype=float)  # type: ignore[index]
+        xs = np.array([r["values"][name] for r in records], dtype=float)
         levels = np.unique(xs)
         step = float(np.min(np.diff(levels))) if levels.size > 1 else abs(levels[0]) or 1.0
         for k, method in enumerate(methods):
             pts = [
-                (x, r["rates"][method])  # type: ignore[index]
+                (x, r["rates"][method])
                 for x, r in zip(xs, records, strict=True)
-                if method in r["rates"]  # type: ignore[operator]
+                if method in r["rates"]
             ]
             if not pts:
                 continue

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import imageio.v2 as imageio
 import numpy as np
+from imageio.core.format import Format
 
 from teachfit.core.atomic import atomic_path
 from teachfit.robot.render import motion_frames
@@ -20,7 +21,7 @@ from teachfit.tasks.base import Task
 
 
 @contextmanager
-def video_writer(path: str | Path, fps: int = 30) -> Iterator[imageio.core.Format.Writer]:
+def video_writer(path: str | Path, fps: int = 30) -> Iterator[Format.Writer]:
     """An mp4 writer (H.264 through the ``imageio-ffmpeg`` packaged binary)."""
     with atomic_path(path, "video") as tmp:
         writer = imageio.get_writer(tmp, fps=fps, codec="libx264", quality=7, macro_block_size=8)

@@ -27,6 +27,8 @@ The arithmetic runs compiled (:mod:`teachfit.robot.fr3.kernel`); this class owns
 
 from __future__ import annotations
 
+from typing import cast
+
 import mujoco
 import numpy as np
 
@@ -111,7 +113,8 @@ class TorqueImpedance:
         self._law = law
         #: True when the whole tick runs compiled (:func:`teachfit.robot.fr3.kernel.run_fixed`)
         self.compiled = type(law) is CartesianImpedance
-        if self.compiled:
+        self.law_bufs: tuple[np.ndarray, ...]
+        if type(law) is CartesianImpedance:
             e = law._error  # the law's own buffers: the kernel updates them in place
             self.law_bufs = (law._k, law._d, law._ff, e._xd, e._qd, e._vd, e.err, e.derr)
             self.law_bufs += (e._qtmp, e._rtmp, self.wrench, self.quat, self.twist)
@@ -125,19 +128,26 @@ class TorqueImpedance:
         tau = self.tau
         return (self.jac, jminv, lam, self.q_null, self.tau_prev, self.tau_max, tau, tau0, y, z)
 
+    def _fixed_law(self) -> CartesianImpedance:
+        """The installed law, which is the fixed-gain one while :attr:`compiled` (the only time
+        :meth:`load_law` and :meth:`store_law` run)."""
+        return cast(CartesianImpedance, self._law)
+
     def load_law(self) -> None:
         """Copy the fixed-gain law's scalar state into the kernel's scalars."""
-        e, lim, sc = self._law._error, self._law.limits, self.sc
+        law, sc = self._fixed_law(), self.sc
+        e, lim = law._error, law.limits
         sc[k.T0], sc[k.EXPIRY] = e._t0, e._expiry
         sc[k.SPINNING], sc[k.LAPSED] = float(e._spinning), float(e.lapsed)
         sc[k.MAX_F], sc[k.MAX_T] = lim.max_force, lim.max_torque
 
     def store_law(self) -> None:
         """Copy the kernel's scalars back into the fixed-gain law (after a compiled run)."""
-        e, sc = self._law._error, self.sc
+        law, sc = self._fixed_law(), self.sc
+        e = law._error
         e._t0, e._expiry = float(sc[k.T0]), float(sc[k.EXPIRY])
         e._spinning, e.lapsed = bool(sc[k.SPINNING]), bool(sc[k.LAPSED])
-        self._law.last_wrench = self.wrench.copy()
+        law.last_wrench = self.wrench.copy()
 
     def reset(self, q_null: np.ndarray) -> None:
         """Hold the posture ``q_null`` and start the rate limit from the current bias torque

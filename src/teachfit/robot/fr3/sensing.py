@@ -77,7 +77,7 @@ class JointTorqueObserver:
         adr = np.array([model.sensor_adr[i] for i in ids], dtype=np.int64)
         axes = np.array([model.jnt_axis[model.dof_jntid[i]] for i in range(nv)])
         # dq_prev, ddq, M ddq, sensor addresses, joint axes, armature, noise, tau_ext (kernel order)
-        self.bufs = (np.zeros(nv), np.zeros(nv), np.zeros(nv), adr, axes)
+        self.bufs: tuple[np.ndarray, ...] = (np.zeros(nv), np.zeros(nv), np.zeros(nv), adr, axes)
         self.bufs += (model.dof_armature.copy(), self.noise, self.tau_ext)
         self.draw_noise()
 
