@@ -74,11 +74,11 @@ def scaling(
     if not counts or counts[0] < 1 or trials_per_worker < 1:
         raise LearningError(f"need worker counts >= 1 and trials >= 1, got {workers}")
     obj = SkillObjective(task, seed=seed, n_starts=n_starts)
-    started = False
+    started, reaper = False, None
     if ray is not None:
         from teachfit.learning.ray_runner import _init, import_ray
 
-        started = _init(import_ray(), ray, counts[-1])
+        started, reaper = _init(import_ray(), ray, counts[-1])
     try:
         if ray is not None:
             run_experiment(obj, "lhs", counts[-1], workers=counts[-1], ray=ray)  # warm-up
@@ -91,6 +91,8 @@ def scaling(
     finally:
         if started:
             import_ray().shutdown()
+        if reaper is not None:
+            reaper.stop()  # what the shutdown left of a local instance is killed
 
 
 def scaling_markdown(rows: Sequence[ScalingRow]) -> str:

@@ -110,10 +110,10 @@ class _Lines:
         try:
             line = self.handle.readline(MAX_LINE_CHARS + 1)
         except UnicodeDecodeError as exc:
-            line, offset = _first_bad_byte(Path(self.handle.name))
+            bad_row, offset = _first_bad_byte(Path(self.handle.name))
             raise self.fail(
                 f"not UTF-8 text ({exc.reason} at byte {offset}): save the log as UTF-8",
-                row=line,
+                row=bad_row,
             ) from exc
         if not line:
             raise StopIteration

@@ -179,7 +179,7 @@ def build_demos(log: RawLog, *, task: str, name: str, options: ImportOptions) ->
         found = [check_orientation(source.sliced(a, b), limits)]
         found += check_demo_shape(piece.t - piece.t[0], piece.pos, log, limits)
         notes += enforce([f for f in found if f is not None], options.accept, log.path, context)
-        extra = {"source_frame": source.frame}
+        extra: dict[str, object] = {"source_frame": source.frame}
         if seg is not None:
             extra.update(segment=k, segment_start_s=float(piece.t[0]), segmented_by=seg.mode)
         try:
@@ -202,5 +202,6 @@ def _summary(demo: Demonstration, start_s: float) -> Piece:
     wrench = demo.wrench
     force = None if wrench is None else float(np.linalg.norm(wrench[:, :3], axis=1).max())
     ex, ey = (float(v) for v in np.ptp(demo.pos[:, :2], axis=0) * 1e3)
-    rate = float(demo.meta["rate_hz"])
+    stored = demo.meta["rate_hz"]
+    rate = float(stored) if isinstance(stored, int | float) else float("nan")
     return Piece(demo.name or "", start_s, demo.duration, demo.n_samples, rate, (ex, ey), force)

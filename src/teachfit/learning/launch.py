@@ -81,7 +81,8 @@ def open_learning(req: LearnRequest) -> Launch:
     from teachfit.tasks.registry import get_task
 
     get_task(req.task)  # an unknown task fails here, before any study file is created
-    workers, notes = req.workers, ()
+    workers = req.workers
+    notes: tuple[str, ...] = ()
     if req.robot in ROBOTS and not ROBOTS[req.robot].simulated:
         if req.ray:
             raise LearningError(f"--ray runs trials in parallel: not on the one real {req.robot}")
@@ -112,8 +113,10 @@ def _options(req: LearnRequest) -> dict[str, Any]:
     design's size, which cannot grow); a new one gets :func:`method_options`."""
     tags = stored_tags(req.study)
     same = tags is not None and tags.get("method") == req.method
-    options = dict(tags.get("options", {})) if same else method_options(req.method, req.trials)
-    if same and req.method == "lhs" and int(options.get("n", req.trials)) < req.trials:
+    stored = tags.get("options", {}) if tags is not None and same else {}
+    options = dict(stored) if same else method_options(req.method, req.trials)
+    n_design = options.get("n", req.trials)
+    if same and req.method == "lhs" and isinstance(n_design, int) and n_design < req.trials:
         raise LearningError(
             f"the stored Latin hypercube has {options.get('n')} points; --trials {req.trials} "
             "cannot extend it (a new design needs a new --study)"

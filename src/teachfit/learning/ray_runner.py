@@ -85,12 +85,12 @@ def _loopback(ray: ModuleType) -> Iterator[None]:
     Windows), not the one other machines reach it at; its servers then listen on 127.0.0.1."""
     consts = getattr(getattr(ray, "_private", None), "ray_constants", None)
     was = getattr(consts, "ENABLE_RAY_CLUSTER", None)
-    if was is not None:
+    if consts is not None and was is not None:
         consts.ENABLE_RAY_CLUSTER = False
     try:
         yield
     finally:
-        if was is not None:
+        if consts is not None and was is not None:
             consts.ENABLE_RAY_CLUSTER = was
 
 

@@ -63,7 +63,7 @@ def _touching(whole: coal.BVHModelOBBRSS, part: np.ndarray, first: int) -> np.nd
     eye = coal.Transform3s()
     coal.collide(_bvh(part), eye, whole, eye, request, result)
     pairs = np.array([(c.b1, c.b2) for c in result.getContacts()], dtype=np.int64)
-    pairs = pairs.reshape(-1, 2) + [first, 0]
+    pairs = pairs.reshape(-1, 2) + np.array([first, 0], dtype=np.int64)
     return pairs[pairs[:, 0] != pairs[:, 1]]
 
 
