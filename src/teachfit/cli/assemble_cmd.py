@@ -73,7 +73,7 @@ def assemble(
     """Assemble over trials: taught hole -> approach -> skill -> learned search recovery.
 
     Exit status 1 when the robot stopped a trial (each reason is printed); a run cut short
-    (Ctrl-C) prints and logs the trials that finished (README, "Outputs and bad input")."""
+    (Ctrl-C) prints and logs the trials that finished; see the README."""
     from teachfit.metrics.stats import summarize
     from teachfit.robot.registry import ROBOTS
 

@@ -168,7 +168,7 @@ def run(
     with --demo.
 
     Exit status: 0, or 1 when the robot stopped an execution (each reason is printed); a run
-    cut short (lost connection, Ctrl-C) prints and logs what finished (README, "Outputs and bad input").
+    cut short (lost connection, Ctrl-C) prints and logs what finished; see the README.
     """
     points = o.pick(points, n)
     from teachfit.execution.search import run_protocol

@@ -119,7 +119,7 @@ def run(
     (Johannsmeier et al. 2019), its successes and cost.
 
     Exit status: 0, or 1 when the robot stopped an execution (each reason is printed); a run
-    cut short (lost connection, Ctrl-C) prints and logs what finished (README, "Outputs and bad input")."""
+    cut short (lost connection, Ctrl-C) prints and logs what finished; see the README."""
     from teachfit.core.errors import SkillError
     from teachfit.execution.recording import Episode
     from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
