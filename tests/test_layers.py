@@ -83,3 +83,74 @@ def test_only_robot_and_scene_building_call_mujoco_math() -> None:
         if "mju_" in path.read_text():
             found.append(str(rel))
     assert not found
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(ROOT.parent).with_suffix("")
+    parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+    return ".".join(parts)
+
+
+def _runtime_imports(tree: ast.AST) -> list[ast.Import | ast.ImportFrom]:
+    """Every import statement that can run: at module level or inside a function (imported on
+    use), but not under ``if TYPE_CHECKING:``, which never runs."""
+    found: list[ast.Import | ast.ImportFrom] = []
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            todo.extend(node.orelse)
+            continue
+        if isinstance(node, ast.Import | ast.ImportFrom):
+            found.append(node)
+        todo.extend(ast.iter_child_nodes(node))
+    return found
+
+
+def _runtime_edges() -> dict[str, set[str]]:
+    """``module -> {teachfit modules it imports when it runs}``, with the package ``__init__``
+    each such import runs (but not the module's own packages, already running)."""
+    modules = {_module_name(p): p for p in ROOT.rglob("*.py")}
+    edges: dict[str, set[str]] = {}
+    for name, path in modules.items():
+        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        found: set[str] = set()
+        for imp in _runtime_imports(ast.parse(path.read_text())):
+            if isinstance(imp, ast.Import):
+                found |= {a.name for a in imp.names}
+                continue
+            base = imp.module or ""
+            if imp.level:
+                up = package.split(".")[: len(package.split(".")) - imp.level + 1]
+                base = ".".join(up + ([base] if base else []))
+            found |= {f"{base}.{a.name}" for a in imp.names} | {base}
+        ancestors = {".".join(name.split(".")[:i]) for i in range(1, name.count(".") + 1)}
+        edges[name] = {m for m in found if m in modules and m != name and m not in ancestors}
+    return edges
+
+
+def test_no_runtime_import_cycle_between_files() -> None:
+    """No chain of imports that run (at import time or on use) leads from a file back to
+    itself: two files that need each other are one concept, or a third file is missing."""
+    edges = _runtime_edges()
+    cycles: set[tuple[str, ...]] = set()
+
+    def visit(node: str, stack: list[str], on_stack: set[str], done: set[str]) -> None:
+        stack.append(node)
+        on_stack.add(node)
+        for nxt in sorted(edges[node]):
+            if nxt in on_stack:
+                loop = stack[stack.index(nxt) :]
+                k = loop.index(min(loop))
+                cycles.add(tuple(loop[k:] + loop[:k]))
+            elif nxt not in done:
+                visit(nxt, stack, on_stack, done)
+        stack.pop()
+        on_stack.discard(node)
+        done.add(node)
+
+    done: set[str] = set()
+    for start in sorted(edges):
+        if start not in done:
+            visit(start, [], set(), done)
+    assert not sorted(" -> ".join(c) for c in cycles)

@@ -20,7 +20,7 @@ from teachfit.capture.markers import Marker, marker_image
 from teachfit.capture.rig import Camera, Rig
 from teachfit.capture.scene import camera_K, look_at
 from teachfit.capture.temporal import FilterConfig, PoseFilter
-from teachfit.plans.parts import pose_from_xyz_rpy
+from teachfit.tasks.parts import pose_from_xyz_rpy
 
 K = camera_K(1280, 720, 40.0)
 

@@ -15,7 +15,7 @@ from teachfit.capture.markers import (
 )
 from teachfit.capture.rig import Camera, Rig, read_rig, write_rig
 from teachfit.core.errors import CaptureError
-from teachfit.plans.parts import pose_from_xyz_rpy
+from teachfit.tasks.parts import pose_from_xyz_rpy
 
 
 def _rig() -> Rig:

@@ -119,7 +119,7 @@ def _marker_box(rig, markers: MarkerSet, part2rig, cam, marker_id, pad=6):
 
 
 def test_occlusion_is_marked_not_invented(clip):
-    from teachfit.plans.parts import pose_from_xyz_rpy
+    from teachfit.tasks.parts import pose_from_xyz_rpy
 
     rig, markers, truth = (
         read_rig(clip["rig"]),

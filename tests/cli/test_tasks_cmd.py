@@ -21,6 +21,7 @@ def test_tasks_alone_and_list_list_the_built_in_tasks() -> None:
         res = invoke(*args)
         assert res.exit_code == 0, res.output
         assert "peg2d" in res.output and "socket3d" in res.output and "tasks new" in res.output
+        assert "l-groove" in res.output and "tenon" in res.output and "opening_length" in res.output
 
 
 def test_new_infers_the_hole_and_show_reports_and_plots(mesh_examples, tmp_path: Path) -> None:

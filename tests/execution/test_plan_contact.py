@@ -11,7 +11,7 @@ from teachfit.execution.plan_contact import (
     contact_skill,
     run_plan_trials,
 )
-from teachfit.plans.parts import build_assembly
+from teachfit.tasks.registry import build_assembly
 
 
 def test_capture_error_magnitudes_lie_in_their_ranges():

@@ -24,10 +24,11 @@ from teachfit.core.atomic import atomic_append_text
 from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.plans.collision import CollisionChecker
-from teachfit.plans.parts import PARTS, Assembly, build_assembly
 from teachfit.plans.plan_types import PlanResult
 from teachfit.plans.planner import PLANNERS, MotionPlanner, PlannerConfig
 from teachfit.plans.synth import synth_demo
+from teachfit.tasks.parts import PARTS, Assembly
+from teachfit.tasks.registry import build_assembly
 
 __all__ = [
     "TABLE_COLUMNS",
@@ -51,7 +52,7 @@ class PlanningBenchConfig:
     Attributes
     ----------
     tasks : tuple of str
-        Task names (keys of :data:`teachfit.plans.parts.PARTS`).
+        Task names (keys of :data:`teachfit.tasks.parts.PARTS`).
     seeds : int
         Seeds per task for the guided planner (seeds 0 .. seeds-1).
     te : float

@@ -18,9 +18,10 @@ from typing import cast
 import numpy as np
 
 from teachfit.core.errors import PlanningError, TeachfitError
-from teachfit.plans.parts import PARTS, build_assembly
 from teachfit.plans.planner import MotionPlanner, PlannerConfig
 from teachfit.plans.synth import synth_demo
+from teachfit.tasks.parts import PARTS
+from teachfit.tasks.registry import build_assembly
 
 __all__ = [
     "CLEARANCE_RANGE",

@@ -30,8 +30,9 @@ from teachfit.core.atomic import atomic_path
 from teachfit.core.errors import CaptureError, RenderError
 from teachfit.core.geometry import rotation_to_wxyz, wxyz_to_rotation
 from teachfit.demonstrations.dataset import Demonstration, write_dataset
-from teachfit.plans.parts import Assembly, build_assembly, pose_from_xyz_rpy
 from teachfit.plans.synth import synth_demo
+from teachfit.tasks.parts import Assembly, pose_from_xyz_rpy
+from teachfit.tasks.registry import build_assembly
 
 __all__ = [
     "SynthConfig",

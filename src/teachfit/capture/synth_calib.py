@@ -22,7 +22,7 @@ from teachfit.capture.synth import SynthConfig, synth_rig
 from teachfit.core.atomic import atomic_write_bytes
 from teachfit.core.errors import RenderError
 from teachfit.core.geometry import rotation_to_wxyz
-from teachfit.plans.parts import pose_from_xyz_rpy
+from teachfit.tasks.parts import pose_from_xyz_rpy
 
 __all__ = ["write_charuco_shots"]
 

@@ -98,7 +98,7 @@ def demo_synth(
 
 def _assembly(task: str, items: list[str] | None, path: Path | None) -> object:
     """The task's parts with the ``--task-params`` file and ``--task-param`` overrides."""
-    from teachfit.plans.parts import build_assembly
+    from teachfit.tasks.registry import build_assembly
 
     return build_assembly(task, **dict(o.task_overrides(items, PlanningError, path)))
 

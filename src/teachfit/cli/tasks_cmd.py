@@ -25,7 +25,7 @@ _XML = typer.Option(help="print the MJCF scene of this task (name or .toml)")
 
 
 def _list(xml: str | None) -> None:
-    from teachfit.tasks.registry import TASKS, load_task
+    from teachfit.tasks.registry import TASKS, load_task, part_tables, task_names
 
     if xml is not None:
         from teachfit.cli.geometry_progress import geometry_progress
@@ -45,6 +45,15 @@ def _list(xml: str | None) -> None:
             table.add_row(pname, f"{value:g}" if isinstance(value, float) else str(value), doc)
         console.print(table)
         console.print(f"  search dims: {', '.join(cls.search_dims)}\n")
+    for name, params in part_tables().items():
+        console.print(f"{name}: {task_names()[name]} (Wang et al. 2019)")
+        table = Table()
+        table.add_column("dimension")
+        table.add_column("default (m)", justify="right")
+        for pname, value in params:
+            table.add_row(pname, f"{value:g}")
+        console.print(table)
+        console.print("  plans over the moving part's 6-DOF pose (teachfit plan --task)\n")
     console.print("Your own parts: teachfit tasks new FILE.toml --held PART --fixed PART")
 
 

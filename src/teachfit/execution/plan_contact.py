@@ -4,8 +4,8 @@ skill.
 Wang et al. 2019 executed its plans on the robot open loop and failed when vision was off. Here the
 plan (:class:`~teachfit.plans.planner.MotionPlanner`, guided by a demonstration) is executed by the
 impedance-controlled floating robot holding the part in MuJoCo physics
-(:class:`~teachfit.plans.cell.PartsCell`), with the fixed part where it truly is -- its
-captured pose off by a sampled capture error (:func:`capture_error`) -- while the robot
+(:class:`~teachfit.tasks.geometry.parts_cell.PartsCell`), with the fixed part where it truly is --
+its captured pose off by a sampled capture error (:func:`capture_error`) -- while the robot
 believes the captured pose:
 
 - ``"joined"``: the path is tracked by the impedance controller (stiffness :data:`TRACK`;
@@ -39,8 +39,6 @@ from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.execution.batch import episode_rng
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
-from teachfit.plans.cell import G_NOMINAL, PartsCell, PartsCellParams
-from teachfit.plans.parts import build_assembly
 from teachfit.plans.planner import MotionPlanner, PlannerConfig, PlanResult
 from teachfit.plans.synth import synth_demo
 from teachfit.robot.registry import make_robot
@@ -58,6 +56,8 @@ from teachfit.skills.follow import FollowConfig, FollowSetpoints
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, SkillParams
 from teachfit.skills.primitive import Move
+from teachfit.tasks.geometry.parts_cell import G_NOMINAL, PartsCell, PartsCellParams
+from teachfit.tasks.registry import build_assembly
 
 #: T in G: z along G's +x (rotation by +90 deg about G's y)
 T2G = Pose(np.zeros(3), rotation_to_wxyz(Rotation.from_euler("y", np.pi / 2)))

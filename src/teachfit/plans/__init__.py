@@ -1,22 +1,14 @@
 """Motion planning guided by demonstrated key poses (docs/methods.md, Wang et al. 2019).
 
-Parametric parts (:mod:`.parts`), mesh-mesh collision (:mod:`.collision`), synthetic
-demonstrations (:mod:`.synth`), key-pose ranking (:mod:`.keyposes`) and the planner loop
-(:mod:`.planner`, with its values in :mod:`.plan_types` and the OMPL boundary in
-:mod:`.ompl_space`). Poses are ``L2G``: the moving part ``L`` in the fixed part's frame ``G``.
+The parts planned for are tasks (:mod:`teachfit.tasks.parts`, their assemblies from
+:func:`teachfit.tasks.registry.build_assembly`, re-exported here); mesh-mesh collision
+(:mod:`.collision`), synthetic demonstrations (:mod:`.synth`), key-pose ranking
+(:mod:`.keyposes`) and the planner loop (:mod:`.planner`, with its values in :mod:`.plan_types`
+and the OMPL boundary in :mod:`.ompl_space`). Poses are ``L2G``: the moving part ``L`` in the fixed part's frame ``G``.
 """
 
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
 from teachfit.plans.keyposes import PARAMS, KeyPoses, pose_parameters, rank_key_poses
-from teachfit.plans.parts import (
-    PARTS,
-    Assembly,
-    LGrooveParams,
-    PaperResult,
-    TenonParams,
-    build_assembly,
-    pose_from_xyz_rpy,
-)
 from teachfit.plans.planner import (
     PLANNERS,
     MotionPlanner,
@@ -26,6 +18,15 @@ from teachfit.plans.planner import (
     seed_ompl,
 )
 from teachfit.plans.synth import nominal_keyframes, synth_demo
+from teachfit.tasks.parts import (
+    PARTS,
+    Assembly,
+    LGrooveParams,
+    PaperResult,
+    TenonParams,
+    pose_from_xyz_rpy,
+)
+from teachfit.tasks.registry import build_assembly
 
 __all__ = [
     "PARAMS",

@@ -28,7 +28,7 @@ from teachfit.core.errors import PlanningError
 from teachfit.core.geometry import quat_normalize_into, quat_to_matrix_into
 
 if TYPE_CHECKING:
-    from teachfit.plans.parts import Assembly
+    from teachfit.tasks.parts import Assembly
 
 __all__ = [
     "CollisionChecker",

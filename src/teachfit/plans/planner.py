@@ -53,8 +53,8 @@ from teachfit.core.geometry import (
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix
 from teachfit.plans.keyposes import KeyPoses, rank_key_poses, straight_chain
 from teachfit.plans.ompl_space import PLANNERS, matrix_to_state, seed_ompl, slerp
-from teachfit.plans.parts import Assembly
 from teachfit.plans.plan_types import PlannerConfig, PlanResult
+from teachfit.tasks.parts import Assembly
 
 
 class DemoPoses(Protocol):

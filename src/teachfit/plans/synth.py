@@ -18,7 +18,7 @@ from teachfit.core.errors import TaskError
 from teachfit.core.geometry import rotation_to_wxyz
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.plans.collision import CollisionChecker
-from teachfit.plans.parts import Assembly
+from teachfit.tasks.parts import Assembly
 
 __all__ = ["nominal_keyframes", "synth_demo", "keyframes_to_poses"]
 

@@ -1,7 +1,18 @@
-"""Built-in tasks by name, their search dimensions, and loading a task from a name or a file."""
+"""The one task registry: every task by name, their search dimensions, and loading a task from
+a name or a file.
+
+- :data:`TASKS`: the simulated cells of the search and skill papers (``peg2d``, ``socket3d``,
+  ``puzzle``, ``key``, ``peg``);
+- :data:`~teachfit.tasks.parts.PARTS`: the planning paper's parts (``l-groove``, ``tenon``),
+  whose cells are :class:`~teachfit.tasks.geometry.parts_cell.PartsCell` and whose assemblies
+  :func:`build_assembly` gives;
+- task files (``.toml``): a built-in kind with other parameters, or a user's meshes
+  (``task = "mesh"``), which have an assembly too.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from teachfit.core.errors import TaskError
@@ -11,6 +22,7 @@ from teachfit.tasks.geometry.peg import AluminiumPeg
 from teachfit.tasks.geometry.peg2d import Peg2D
 from teachfit.tasks.geometry.puzzle import Puzzle
 from teachfit.tasks.geometry.socket3d import Socket3D
+from teachfit.tasks.parts import PARTS, Assembly, part_assembly
 
 TASKS: dict[str, type[Task]] = {
     cls.name: cls for cls in (Peg2D, Socket3D, Puzzle, Key, AluminiumPeg)
@@ -77,3 +89,36 @@ def load_task(spec: str, **overrides: object) -> Task:
             return TASKS[kind].from_mapping(values)
         return task
     raise TaskError(f"unknown task {spec!r}; built-in tasks: {sorted(TASKS)} (or a .toml file)")
+
+
+def task_names() -> dict[str, str]:
+    """Every built-in task name -> what it is for (``teachfit tasks`` lists them)."""
+    sims = {name: "simulated cell (search, skill, assemble)" for name in TASKS}
+    return sims | {name: "parts planned for (plan, capture, assemble)" for name in PARTS}
+
+
+def part_tables() -> dict[str, list[tuple[str, float]]]:
+    """Each planning part's dimensions (m) and their defaults."""
+    return {
+        name: [(f.name, float(getattr(cls(), f.name))) for f in dataclasses.fields(cls)]
+        for name, cls in PARTS.items()
+    }
+
+
+def build_assembly(task: str, **overrides: float) -> Assembly:
+    """The planning assembly of a built-in part (``l-groove``, ``tenon``; dimension overrides
+    in m) or of a mesh task file (``.toml``: its exact meshes,
+    :mod:`teachfit.tasks.mesh.assembly`).
+
+    Raises
+    ------
+    TaskError
+        Unknown task name, unknown or invalid dimension, overrides for a mesh task.
+    """
+    if _is_file(task) and task not in PARTS:
+        if overrides:
+            raise TaskError("a mesh task's dimensions are in its meshes: no overrides")
+        from teachfit.tasks.mesh.assembly import mesh_assembly
+
+        return mesh_assembly(task)
+    return part_assembly(task, **overrides)

@@ -17,7 +17,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.plans.keyposes import KeyPoses  # noqa: E402
-from teachfit.plans.parts import Assembly  # noqa: E402
+from teachfit.tasks.parts import Assembly  # noqa: E402
 from teachfit.viz.output import save_figure
 
 __all__ = ["add_mesh", "keypose_figure", "parts_figure", "path_strip_figure"]

@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from teachfit.core.atomic import atomic_path  # noqa: E402
 from teachfit.core.errors import RenderError  # noqa: E402
 from teachfit.core.geometry import Pose  # noqa: E402
-from teachfit.plans.parts import Assembly  # noqa: E402
+from teachfit.tasks.parts import Assembly  # noqa: E402
 from teachfit.viz.plan_figures import MOVING_COLOR, _frame_axes, add_mesh  # noqa: E402
 
 __all__ = ["render_path_video"]

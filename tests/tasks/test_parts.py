@@ -53,3 +53,14 @@ def test_unknown_task_or_dimension_raises():
         build_assembly("peg")
     with pytest.raises(TaskError, match="unknown dimension"):
         build_assembly("tenon", colour=1.0)
+
+
+def test_the_registry_knows_every_task_and_builds_every_assembly() -> None:
+    from teachfit.tasks.registry import TASKS, build_assembly, part_tables, task_names
+
+    names = task_names()
+    assert set(names) == set(TASKS) | set(PARTS)
+    assert [n for n, _ in part_tables()["tenon"]][0] == "bar_side"
+    assert build_assembly("tenon", clearance=0.002).dimensions["clearance"] == 0.002
+    with pytest.raises(TaskError, match="no overrides"):
+        build_assembly("mine.toml", width=0.01)

@@ -1,5 +1,9 @@
 """Parametric parts for planning: an L-part with a closed groove, a tenon with two mortises.
 
+The built-in tasks ``l-groove`` and ``tenon`` (Wang et al. 2019); the task registry
+(:func:`teachfit.tasks.registry.build_assembly`) gives their assemblies and those of mesh task
+files, :class:`~teachfit.tasks.geometry.parts_cell.PartsCell` their MuJoCo cells.
+
 Every assembly is expressed in the frame ``G`` of its fixed part. The moving part's frame ``L``
 is attached to its mesh as documented per task, and the planner searches over ``L2G``, the pose
 of ``L`` in ``G``.
@@ -39,7 +43,7 @@ __all__ = [
     "LGrooveParams",
     "PaperResult",
     "TenonParams",
-    "build_assembly",
+    "part_assembly",
     "pose_from_xyz_rpy",
 ]
 
@@ -347,21 +351,9 @@ PARTS: Mapping[str, type[LGrooveParams] | type[TenonParams]] = MappingProxyType(
 """Task name -> parameter class; ``PARTS[name](**overrides).build()`` gives the assembly."""
 
 
-def build_assembly(task: str, **overrides: float) -> Assembly:
-    """Build a registered task's assembly, with optional dimension overrides (m); a mesh
-    task file (``.toml``) gives its exact meshes (:mod:`teachfit.plans.mesh_parts`).
-
-    Raises
-    ------
-    TaskError
-        Unknown task name, unknown or invalid dimension.
-    """
-    if task.endswith(".toml") and task not in PARTS:
-        if overrides:
-            raise TaskError("a mesh task's dimensions are in its meshes: no overrides")
-        from teachfit.plans.mesh_parts import mesh_assembly
-
-        return mesh_assembly(task)
+def part_assembly(task: str, **overrides: float) -> Assembly:
+    """The assembly of the built-in part ``task`` (``l-groove``, ``tenon``), with optional
+    dimension overrides (m); :class:`TaskError` for an unknown part, dimension or value."""
     if task not in PARTS:
         raise TaskError(f"unknown task {task!r}; known: {', '.join(PARTS)} (or a mesh .toml)")
     cls = PARTS[task]

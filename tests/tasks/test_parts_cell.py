@@ -8,9 +8,9 @@ import pytest
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
-from teachfit.plans.cell import PartsCell, PartsCellParams, part_boxes
-from teachfit.plans.parts import build_assembly
 from teachfit.robot.registry import make_robot
+from teachfit.tasks.geometry.parts_cell import PartsCell, PartsCellParams, part_boxes
+from teachfit.tasks.registry import build_assembly
 
 
 def _volume(lo, hi):

@@ -16,14 +16,16 @@ them on ``square-peg``, none without a demonstration).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
-from teachfit.plans.parts import Assembly, PaperResult
-from teachfit.tasks.registry import load_task
+from teachfit.tasks.base import read_task_toml
+from teachfit.tasks.mesh.task import load_mesh_task
+from teachfit.tasks.parts import Assembly, PaperResult
 
 #: no paper reports a user's task: zero candidates, zero times
 NO_PAPER = PaperResult(candidates=0, used=(0, 0), time_s=(0.0, 0.0))
@@ -47,11 +49,9 @@ class MeshAssembly(Assembly):
 
 def mesh_assembly(spec: str, start_height: float = 0.01) -> Assembly:
     """The :class:`Assembly` of the mesh task file ``spec`` (see the module docstring; m)."""
-    from teachfit.tasks.mesh.task import MeshTask
-
-    task = load_task(spec)
-    if not isinstance(task, MeshTask):
+    if read_task_toml(Path(spec)).get("task") != "mesh":
         raise TaskError(f'{spec} is not a mesh task file (task = "mesh")')
+    task = load_mesh_task(spec)
     cell, hole = task.cell, task.hole2world
     start = hole.compose(Pose(np.array([task.params.demo_offset, 0.0, start_height]))).matrix
     goal = hole.compose(Pose(np.array([0.0, 0.0, -task.success_depth]))).matrix

@@ -1,6 +1,6 @@
 """The planning parts as a MuJoCo cell: convex boxes, the fixed part placed by a capture error.
 
-:mod:`teachfit.plans.parts` builds the L-groove and tenon parts as unions and differences of
+:mod:`teachfit.tasks.parts` builds the L-groove and tenon parts as unions and differences of
 boxes (for mesh-mesh planning). MuJoCo collides each geom as a convex solid, so here the same
 solids are cut directly into disjoint boxes -- the fixed groove into floor, side walls, end
 walls and lip; each mortise into the four bars around its square hole; the L into base and leg;
@@ -26,8 +26,8 @@ import numpy as np
 
 from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose, quat_angle, rotation_to_wxyz
-from teachfit.plans.parts import Assembly, LGrooveParams, TenonParams, build_assembly
 from teachfit.tasks.base import Task
+from teachfit.tasks.parts import Assembly, LGrooveParams, TenonParams, part_assembly
 from teachfit.tasks.protocols.base import Protocol
 from teachfit.tasks.scene.builder import SceneBuilder, add_geom
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
@@ -173,7 +173,7 @@ class PartsCell(Task):
 
     @cached_property
     def assembly(self) -> Assembly:
-        return build_assembly(self.params.part)
+        return part_assembly(self.params.part)
 
     @cached_property
     def boxes(self) -> tuple[list[Box], list[Box]]:

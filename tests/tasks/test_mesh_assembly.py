@@ -7,8 +7,8 @@ import pytest
 
 from teachfit.core.errors import PlanningError, TaskError
 from teachfit.plans.collision import CollisionChecker
-from teachfit.plans.parts import build_assembly
 from teachfit.plans.planner import MotionPlanner
+from teachfit.tasks.registry import build_assembly
 
 
 def test_mesh_task_file_gives_exact_meshes_and_free_end_poses(mesh_examples) -> None:
