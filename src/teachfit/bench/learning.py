@@ -1,4 +1,4 @@
-"""Seed B's learning experiments (Sec. V, Fig. 6) over tasks x methods x experiments.
+"""Johannsmeier et al.'s learning experiments (Sec. V, Fig. 6) over tasks x methods x experiments.
 
 An *experiment* is one learning run of ``trials`` trials (each: one parameter set, ``n_starts``
 executions) with its own seed ``seed + e``: its own hole estimate, start poses, sensor noise

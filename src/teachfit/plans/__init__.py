@@ -4,7 +4,8 @@ The parts planned for are tasks (:mod:`teachfit.tasks.parts`, their assemblies f
 :func:`teachfit.tasks.registry.build_assembly`, re-exported here); mesh-mesh collision
 (:mod:`.collision`), synthetic demonstrations (:mod:`.synth`), key-pose ranking
 (:mod:`.keyposes`) and the planner loop (:mod:`.planner`, with its values in :mod:`.plan_types`
-and the OMPL boundary in :mod:`.ompl_space`). Poses are ``L2G``: the moving part ``L`` in the fixed part's frame ``G``.
+and the OMPL boundary in :mod:`.ompl_space`). Poses are ``L2G``: the moving part ``L`` in the fixed
+part's frame ``G``.
 """
 
 from teachfit.plans.collision import CollisionChecker, pose_to_matrix

@@ -1,5 +1,6 @@
-"""Skill graphs (seed B): manipulation primitives, conditions, parameters; following set-point
-trajectories (search, replay) as a primitive. They run in :mod:`teachfit.execution.engine`."""
+"""Skill graphs (Johannsmeier et al. 2019): manipulation primitives, conditions, parameters;
+following set-point trajectories (search, replay) as a primitive. They run in
+:mod:`teachfit.execution.engine`."""
 
 from teachfit.skills.follow import FollowConfig, FollowSetpoints, follow_skill
 from teachfit.skills.graph import Node, Skill, Transition

@@ -1,7 +1,7 @@
 """Conditions over the percept: when transitions fire, when a skill succeeds or fails.
 
-Seed B (Def. 1) defines a condition as ``c(x) in C`` for a closed set ``C`` of some function
-of the percept ``x``. Here a condition is a frozen spec (TOML-able, validated) that
+Johannsmeier et al. 2019 (Def. 1) defines a condition as ``c(x) in C`` for a closed set ``C`` of
+some function of the percept ``x``. Here a condition is a frozen spec (TOML-able, validated) that
 :meth:`Condition.compile` turns, once per execution and with the parameter values resolved,
 into a plain ``percept -> bool`` function (stateful ones, like a sustained low speed, carry
 their state in the closure and restart with :meth:`Check.restart` when their node is entered).

@@ -12,7 +12,7 @@ The recovery nodes of :mod:`teachfit.execution.plan_contact`, when the part stop
 - :class:`SpiralPush` (a tenon's face on a mortise): presses the part along the insertion
   (task -z, force-controlled: the z set-point follows the part) while its set-point runs an
   outward Archimedean spiral across it, until the part has advanced ``advance`` (the hole
-  caught it) -- seed B's compliant search, with a spiral instead of a circle.
+  caught it) -- Johannsmeier et al.'s compliant search, with a spiral instead of a circle.
 
 Timing of a retry: every step at ``speed`` (m/s) or ``angular_speed`` (rad/s), whichever is
 slower (:func:`time_poses`, also the timing of the planned path itself).

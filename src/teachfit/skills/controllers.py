@@ -1,8 +1,8 @@
 """The controller a skill runs on, and the adaptive controller's meta-parameters as learned
 skill parameters.
 
-Seed B learns the adaptive impedance controller's meta-parameters together with the skill's
-own. Per coordinate group ``g`` in ``t`` (x, y, z) and ``r`` (rx, ry, rz) they are
+Johannsmeier et al. 2019 learns the adaptive impedance controller's meta-parameters together with
+the skill's own. Per coordinate group ``g`` in ``t`` (x, y, z) and ``r`` (rx, ry, rz) they are
 ``alpha_g``, ``beta_g``, ``gamma_a_g``, ``gamma_b_g`` (see
 :mod:`teachfit.control.adaptive`), each in a log domain ``[bound * 1e-3, bound]`` whose upper
 bound follows from the system limits by

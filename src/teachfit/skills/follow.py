@@ -1,13 +1,13 @@
 """Following a set-point trajectory as a manipulation primitive: search and replay in a graph.
 
-A search trajectory (seed A) or a replayed demonstration is a time-sampled
+A search trajectory (Ehlers et al. 2019) or a replayed demonstration is a time-sampled
 :class:`~teachfit.core.setpoints.SetpointTrajectory` of desired poses and feed-forward wrenches.
 :class:`FollowSetpoints` makes it one node of a skill graph: every command tick at node time
 ``t`` it sets the set-point to the trajectory's sample ``x_d(t)`` (task frame), commands the
 sample's velocity so that the controller extrapolates between ticks, adds the feed-forward
 wrench and a constant push ``-push_force`` along the task frame's z (into the surface), and
-asks for a stiffness that is high along the direction of motion and low across it (seed A,
-Sec. III-D: the part can fall into a hole it passes over)::
+asks for a stiffness that is high along the direction of motion and low across it (Ehlers et al.
+2019, Sec. III-D: the part can fall into a hole it passes over)::
 
     K_xy = k_across I + (k_along - k_across) u u^T,   u = v_xy / |v_xy|
 

@@ -1,4 +1,5 @@
-"""The skill graph (seed B, Sec. III): primitives as nodes, transitions fired by conditions.
+"""The skill graph (Johannsmeier et al. 2019, Sec. III): primitives as nodes, transitions fired by
+conditions.
 
 A :class:`Skill` is a directed graph ``G = (N, E)`` of :class:`Node` s (each one manipulation
 primitive with its own error condition) and :class:`Transition` s (each fired by a condition,

@@ -1,10 +1,10 @@
 """Skill parameters: context parameters set by the task, learned parameters with domains.
 
-Following seed B (Sec. III), the parameter set ``P`` of a skill splits into ``P_C``, fixed by
-the context of the task (estimated hole pose, depth, approach height, region of interest,
-system limits), and ``P_L``, the parameters to learn, each inside a domain derived from system
-and safety limits. The learned domains form a :class:`~teachfit.learning.base.ParamSpace`, so a
-learner consumes a skill's space directly.
+Following Johannsmeier et al. 2019 (Sec. III), the parameter set ``P`` of a skill splits into
+``P_C``, fixed by the context of the task (estimated hole pose, depth, approach height, region of
+interest, system limits), and ``P_L``, the parameters to learn, each inside a domain derived from
+system and safety limits. The learned domains form a :class:`~teachfit.learning.base.ParamSpace`, so
+a learner consumes a skill's space directly.
 
 Primitive and condition fields are :data:`Value` s: a number, or a reference to a parameter by
 name (``"force"``), optionally negated (``"-lateral_offset"``). References are resolved once
@@ -123,8 +123,8 @@ class SkillParams:
 
     def with_fixed(self, values: Mapping[str, float]) -> SkillParams:
         """A copy in which the learned parameters named in ``values`` are context parameters
-        with those values (each inside its domain): a task that fixes them, as seed B fixes
-        the key's initial tilt (Sec. V). Unknown names and values outside a domain are
+        with those values (each inside its domain): a task that fixes them, as Johannsmeier et al.
+        2019 fixes the key's initial tilt (Sec. V). Unknown names and values outside a domain are
         errors."""
         checked = self.check_learned(values)
         ctx = dict(self.context)
@@ -136,9 +136,9 @@ class SkillParams:
 
     def with_domains(self, domains: Mapping[str, ParamDomain], why: str = "") -> SkillParams:
         """A copy in which the learned parameters named in ``domains`` search those domains
-        instead (a task that bounds them tighter, as seed B gives each task its own largest
-        rotational amplitude, Sec. V); a default outside its new domain is clipped into it.
-        ``why`` (who bounds them, how to widen) is added to an out-of-domain error. Unknown
+        instead (a task that bounds them tighter, as Johannsmeier et al. 2019 gives each task its
+        own largest rotational amplitude, Sec. V); a default outside its new domain is clipped into
+        it. ``why`` (who bounds them, how to widen) is added to an out-of-domain error. Unknown
         names are errors; names the task fixed are skipped (nothing left to bound)."""
         bad = sorted(n for n in domains if n not in self.learned and n not in self.context)
         if bad:

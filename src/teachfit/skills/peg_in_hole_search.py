@@ -1,4 +1,5 @@
-"""Seed B's peg-in-hole skill whose recovery is seed A's learned search (the seeds joined).
+"""Johannsmeier et al.'s peg-in-hole skill whose recovery is Ehlers et al.'s learned search (the
+methods joined).
 
 The graph is :func:`teachfit.skills.peg_in_hole.build`'s with one more node, ``search``
 (:class:`~teachfit.skills.search.LearnedSearch`), and three more transitions::
@@ -16,7 +17,7 @@ below the surface (the lateral move stopped on a false constraint). Both enter t
 which ends with the part caught in the hole (``drop_depth`` below the entry) -> ``align`` ->
 ``insert``, or with the tour done / ``t_search`` over -> error -> ``retract``.
 
-Learned, besides seed B's: ``t_switch``, ``t_stuck`` (when to switch to search) and the
+Learned, besides Johannsmeier et al.'s: ``t_switch``, ``t_stuck`` (when to switch to search) and the
 search's ``search_points``, ``search_scale``, ``search_speed``, ``search_push``; the meta
 learners tune them with the rest. Context adds ``t_search``, ``search_seed`` and raises the
 skill's ``t_max`` to leave time for a search.

@@ -117,7 +117,7 @@ class Percept:
 
 
 class MPCommand:
-    """What a primitive emits each command tick, task frame (seed B, Sec. III).
+    """What a primitive emits each command tick, task frame (Johannsmeier et al. 2019, Sec. III).
 
     ``twist`` (6,) desired ``[v; w]`` (m/s, rad/s) that moves the set-point over the next
     command period, ``wrench`` (6,) feed-forward ``[f; tau]`` (N, N·m) the robot adds,

@@ -1,7 +1,7 @@
 """Manipulation primitives (MPs): desired twist and feed-forward wrench in the task frame.
 
-Seed B (Sec. III): an MP maps the percept ``x`` and its parameters to a desired twist
-``xdot_d = f_t(x, P_t)`` and a feed-forward wrench ``F_d = f_w(x, P_w)``, both in the task
+Johannsmeier et al. 2019 (Sec. III): an MP maps the percept ``x`` and its parameters to a desired
+twist ``xdot_d = f_t(x, P_t)`` and a feed-forward wrench ``F_d = f_w(x, P_w)``, both in the task
 frame. Here an MP also states the Cartesian stiffness (diagonal, task axes) it wants, which
 the controller uses as its (initial) impedance.
 
@@ -312,7 +312,7 @@ class Insert(Primitive):
     with ``rho(t) = min(1, f_t t)`` growing the circle from the entry point over one period.
 
     about the entry set-point. The wiggle lets a part with lateral and angular error slip
-    into the hole (seed B, MP 5).
+    into the hole (Johannsmeier et al. 2019, MP 5).
     """
 
     force: Value = 10.0

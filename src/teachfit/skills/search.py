@@ -1,11 +1,11 @@
-"""Learned search (seed A) as a manipulation primitive: the recovery of a skill graph.
+"""Learned search (Ehlers et al. 2019) as a manipulation primitive: the recovery of a skill graph.
 
-:class:`LearnedSearch` is seed A's exception strategy inside seed B's skill formalism. When the
-node is entered it plans a TSHIX tour through ``n_points`` samples of the learned exploration
-distribution, starting *where the skill is* (the measured TCP pose, task frame), and then
-follows it with the compliant set-point follower of :mod:`teachfit.skills.follow` (stiff along
-the motion, soft across it, pressed onto the surface) plus the GMR feed-forward wrench the
-model gives for each planned step (seed A, Sec. III-C).
+:class:`LearnedSearch` is Ehlers et al.'s exception strategy inside Johannsmeier et al.'s skill
+formalism. When the node is entered it plans a TSHIX tour through ``n_points`` samples of the
+learned exploration distribution, starting *where the skill is* (the measured TCP pose, task frame),
+and then follows it with the compliant set-point follower of :mod:`teachfit.skills.follow` (stiff
+along the motion, soft across it, pressed onto the surface) plus the GMR feed-forward wrench the
+model gives for each planned step (Ehlers et al. 2019, Sec. III-C).
 
 Where the distribution is put. A search model is learned in the search frame of each
 demonstration (origin at the teacher's start, world axes); its mean records how far the

@@ -1,5 +1,5 @@
-"""Searching with a tilted part: tilt, feel the drop, slide to the wall, align (seed B's
-``tilt``, ``lateral`` and ``align`` primitives as the nodes of a search graph).
+"""Searching with a tilted part: tilt, feel the drop, slide to the wall, align (Johannsmeier et
+al.'s ``tilt``, ``lateral`` and ``align`` primitives as the nodes of a search graph).
 
 An upright sharp-edged peg drops into its hole only when its axis passes within the radial
 clearance of the hole's (0.1-0.25 mm in the peg2d variants). Tilted by ``angle`` about the

@@ -1,4 +1,5 @@
-"""Parameter grids of seed A's tasks: variants a new user might build, as task parameter sets.
+"""Parameter grids of Ehlers et al.'s tasks: variants a new user might build, as task parameter
+sets.
 
 ``peg2d``: peg diameter 8-30 mm, diametral clearance 0.2-0.5 mm, sliding friction 0.2-0.8,
 chamfered (the default 1 mm peg and 0.5 mm hole chamfers) or sharp-edged (no chamfers).

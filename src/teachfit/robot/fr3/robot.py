@@ -55,7 +55,7 @@ class FR3Robot:
     #: pressing by feel corrects within 0.15 s; and a hand guiding the arm's few kilograms of
     #: apparent mass moves with less bandwidth than the free tool's (its wander and tremor
     #: low-passed over 0.1 s: unfiltered, their 100 Hz velocity steps shake the arm at
-    #: 10-25 Hz and f_z with them; BENCHMARKS.md, session 6)
+    #: 10-25 Hz and f_z with them; docs/notes/sensor-realism.md)
     TEACHER_HINTS = TeacherHints(press_feel=0.15, hand_smoothing=0.1)
     #: and on tasks that search in rz: the arm's yaw follows the teacher's 0.4 Hz wiggle about
     #: 2 degrees late (the floating tool's 0.3) and its joint friction stops the valleys from

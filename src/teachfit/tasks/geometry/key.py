@@ -1,7 +1,7 @@
-"""``key``: a grooved key blade into a narrow warded keyway (seed B).
+"""``key``: a grooved key blade into a narrow warded keyway (Johannsmeier et al. 2019).
 
-Seed B's second task: a key whose tip and keyhole are chamfered, which makes the first entry
-easy; the hole is so small that the paper applied no deliberate start deviation. The paper's
+Johannsmeier et al.'s second task: a key whose tip and keyhole are chamfered, which makes the first
+entry easy; the hole is so small that the paper applied no deliberate start deviation. The paper's
 numbers are lost in the extracted text, so the defaults are plausible ones: a 7 mm x 2 mm
 blade 30 mm long with 0.5 mm tip chamfers, a keyway 0.3 mm wider in both directions, 20 mm
 deep, with 0.8 mm entry chamfers along its outline, in a 40 mm square lock face.
@@ -35,7 +35,7 @@ Random (Latin hypercube) parameters succeed in 35 % [31, 39] of 480 executions o
 set-ups (``teachfit bench learning --random-rate 12 --tasks key --experiments 10``; 43 %
 [39, 48] with ``a_r`` up to 0.1 rad, the plain slot: 100 %) and in 40 % [38, 41] of the 2,600
 executions of the Fig. 6 grid's LHS cell (five set-ups, one of them out of every method's
-reach); the learners solve four of the five (BENCHMARKS.md, seed B, session 15).
+reach); the learners solve four of the five (BENCHMARKS.md, the learning grid).
 
 Geometry (:mod:`teachfit.tasks.geometry.prism_hole`). The slot is a rectangle
 ``blade_width + clearance`` (along the hole frame's x) by ``blade_thickness + clearance``
@@ -179,8 +179,8 @@ class Key(PrismHoleTask):
 
     @property
     def skill_fixed(self) -> dict[str, float]:
-        """Learned skill parameters the key fixes: the initial tilt (seed B: "we omit the
-        learning of the initial alignment and set it to [x] rad")."""
+        """Learned skill parameters the key fixes: the initial tilt (Johannsmeier et al. 2019: "we
+        omit the learning of the initial alignment and set it to [x] rad")."""
         return {"tilt": self.params.fixed_tilt}
 
     @property

@@ -1,8 +1,9 @@
-"""``peg``: a chamfered aluminium peg into a hole without walls around it (seed B).
+"""``peg``: a chamfered aluminium peg into a hole without walls around it (Johannsmeier et al.
+2019).
 
-Seed B's hardest task: an aluminium peg with a chamfer, into a hole that "has no walls", so the
-peg can slide off, tilt and get stuck. The paper's numbers are lost in the extracted text, so
-the defaults are plausible ones: a 16 mm peg with a 0.5 mm chamfer, 0.3 mm diametral
+Johannsmeier et al.'s hardest task: an aluminium peg with a chamfer, into a hole that "has no
+walls", so the peg can slide off, tilt and get stuck. The paper's numbers are lost in the extracted
+text, so the defaults are plausible ones: a 16 mm peg with a 0.5 mm chamfer, 0.3 mm diametral
 clearance, a 25 mm deep hole.
 
 How hard (issue 16, part 4), from the paper's words (Sec. V): a chamfer on the peg only
@@ -11,7 +12,7 @@ rim a 4 mm overhang slides off ("the hole has no walls"); the taught hole error 
 tasks (0.5 mm per axis: "teaching accuracy below [1] mm"); and ``start_deviation`` 2 mm, the
 "deliberate initial pose deviation" of the four starts (as on the puzzle; see
 :meth:`~teachfit.tasks.protocols.skill.SkillProtocol.start_frames`). The chamfer's size is
-lost; 0.5 mm (session 6; 1 mm before) puts the peg's capture range, chamfer plus half the
+lost; 0.5 mm (1 mm until 2026-12-01) puts the peg's capture range, chamfer plus half the
 clearance = 0.65 mm, below the stated teaching accuracy, so that the taught error matters on
 the paper's hardest task (P(radial error < 0.65 mm) = 57 % at 0.5 mm per axis; with the 1 mm
 chamfer 93 %, and the taught error changed nothing measurable). ``teachfit bench learning

@@ -1,4 +1,5 @@
-"""``peg2d``: a round peg searching on the flat top of a cylinder with a round hole (seed A, 2D).
+"""``peg2d``: a round peg searching on the flat top of a cylinder with a round hole (Ehlers et al.
+2019, 2D).
 
 The fixture is a cylinder of diameter ``block_diameter`` whose top holds a round hole of
 diameter ``peg_diameter + clearance`` (diametral clearance) and depth ``hole_depth``, centred at
@@ -19,7 +20,7 @@ from teachfit.core.teaching import TeacherHints
 from teachfit.tasks.base import Task
 from teachfit.tasks.geometry.round_peg import RoundPegParams
 from teachfit.tasks.params import doc_field
-from teachfit.tasks.protocols.seed_a import Peg2DProtocol
+from teachfit.tasks.protocols.ehlers import Peg2DProtocol
 from teachfit.tasks.scene.round_hole import Peg2DScene
 
 #: the blind teacher's defaults (m, N/m, m/s) and the load it slides (push + peg weight, N)

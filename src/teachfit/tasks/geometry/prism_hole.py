@@ -123,9 +123,9 @@ class PrismHoleTask(SkillTask):
         the rotational oscillation amplitude ``a_r`` up to ``a_r_max``, by default the
         part's :attr:`yaw_play`.
 
-        Seed B gives each task its own "maximum rotational amplitude of the oscillatory
-        motion" (Sec. V; the values are lost in the extracted text) and derives the domains
-        from system and safety limits. For a part that cannot turn freely in its hole the
+        Johannsmeier et al. 2019 gives each task its own "maximum rotational amplitude of the
+        oscillatory motion" (Sec. V; the values are lost in the extracted text) and derives the
+        domains from system and safety limits. For a part that cannot turn freely in its hole the
         limit is the hole: an amplitude beyond the yaw play only twists the part's corners
         into the walls. A round part (``peg``) keeps the skill's 0.1 rad.
         """

@@ -1,7 +1,8 @@
-"""``puzzle``: an equilateral-triangle puzzle piece into a triangular hole (seed B).
+"""``puzzle``: an equilateral-triangle puzzle piece into a triangular hole (Johannsmeier et al.
+2019).
 
-Seed B's first task: a triangular puzzle piece, no chamfers, sub-millimetre tolerance. The
-extracted paper text lost its numbers, so the defaults are plausible ones, not the paper's: a
+Johannsmeier et al.'s first task: a triangular puzzle piece, no chamfers, sub-millimetre tolerance.
+The extracted paper text lost its numbers, so the defaults are plausible ones, not the paper's: a
 30 mm piece (side), 0.4 mm clearance, a 15 mm deep hole in a 90 mm square block.
 
 How hard (issue 16, part 4), each value from what the paper says in words (Sec. V):
@@ -22,7 +23,8 @@ How hard (issue 16, part 4), each value from what the paper says in words (Sec. 
   the skill's 0.1 rad (14 % [12, 18] against 15 % [12, 18], ten set-ups).
 
 Random parameters then succeed in 10 of 48 executions (21 %) instead of 25 of 48 (52 %) with
-no deviation; ``teachfit bench learning --random-rate N`` measures it (BENCHMARKS.md, seed B).
+no deviation; ``teachfit bench learning --random-rate N`` measures it (BENCHMARKS.md, Johannsmeier
+et al. 2019).
 
 Geometry (:mod:`teachfit.tasks.geometry.prism_hole`). The hole is an equilateral triangle whose
 inscribed circle is ``clearance`` wider (in diameter) than the piece's, so each edge of a

@@ -1,6 +1,6 @@
 """What the skill paper's cells share: hole depth, yaw symmetry, tilt and their ground truth.
 
-Seed B's tasks (``puzzle``, ``key``, ``peg``) are evaluated by its skill protocol
+Johannsmeier et al.'s tasks (``puzzle``, ``key``, ``peg``) are evaluated by its skill protocol
 (:class:`~teachfit.tasks.protocols.skill.SkillProtocol`), whose parameters
 (:class:`~teachfit.tasks.protocols.skill.SkillProtocolParams`) their own extend. Frames as in
 :mod:`teachfit.tasks.base`; lengths in metres, angles in radians.
@@ -22,7 +22,8 @@ _SHARED = {f.name for f in dataclasses.fields(SkillProtocolParams)}
 
 
 class SkillTask(Task):
-    """A :class:`Task` of seed B; ``params`` derive from :class:`SkillProtocolParams`.
+    """A :class:`Task` of Johannsmeier et al. 2019; ``params`` derive from
+    :class:`SkillProtocolParams`.
 
     Subclasses with ``"rz"`` in ``search_dims`` set ``rz_period`` (the part's rotational
     symmetry, rad) and :attr:`rz_tolerance`.

@@ -1,4 +1,4 @@
-"""``socket3d``: a two-pin plug into a recessed round socket with valleys (seed A, 3D).
+"""``socket3d``: a two-pin plug into a recessed round socket with valleys (Ehlers et al. 2019, 3D).
 
 Europlug-like plug: two round pins (``pin_diameter``, ``pin_spacing`` apart, rounded tips) under
 a round plug body. Socket: a round recess (``recess_diameter`` x ``recess_depth``) whose wall
@@ -30,7 +30,7 @@ import numpy as np
 from teachfit.core.geometry import Pose
 from teachfit.tasks.base import Task
 from teachfit.tasks.geometry.socket3d_params import Socket3DParams
-from teachfit.tasks.protocols.seed_a import SocketProtocol
+from teachfit.tasks.protocols.ehlers import SocketProtocol
 from teachfit.tasks.scene.socket import SocketScene
 
 __all__ = ["Socket3D", "Socket3DParams"]

@@ -1,8 +1,8 @@
 """``mesh``: a task built from a user's held and fixed part meshes (a TOML task file).
 
-The task is one of seed B's kind (:class:`~teachfit.tasks.geometry.skill.SkillTask`): the
-skill protocol's four starts above the hole and the taught hole pose, and for seed A's search
-the ``"table1"`` starts (uniform in a disc of ``table1_radius`` halfway between the teacher's
+The task is one of Johannsmeier et al.'s kind (:class:`~teachfit.tasks.geometry.skill.SkillTask`):
+the skill protocol's four starts above the hole and the taught hole pose, and for Ehlers et al.'s
+search the ``"table1"`` starts (uniform in a disc of ``table1_radius`` halfway between the teacher's
 start and the hole) and the blind teacher's starts ``demo_offset`` from the hole. Frames as
 in :mod:`teachfit.tasks.base` (placement in :mod:`teachfit.tasks.mesh.cell`); the task's
 ``name`` is its file's path, so every command and worker process that gets the name loads the
@@ -76,7 +76,7 @@ class MeshScene(SceneBuilder):
 
 
 class MeshProtocol(SkillProtocol):
-    """Seed B's ``"skill"`` starts and seed A's ``"table1"`` disc of starts."""
+    """Johannsmeier et al.'s ``"skill"`` starts and Ehlers et al.'s ``"table1"`` disc of starts."""
 
     task: MeshTask
     names = ("skill", "table1")

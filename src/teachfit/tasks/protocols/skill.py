@@ -1,8 +1,9 @@
-"""Seed B's start protocol and taught hole pose, shared by ``puzzle``, ``key`` and ``peg``.
+"""Johannsmeier et al.'s start protocol and taught hole pose, shared by ``puzzle``, ``key`` and
+``peg``.
 
-Seed B (Johannsmeier et al., ICRA 2019) evaluates every trial from *four slightly different
-start poses* above the hole, and the skill only knows the hole pose a human taught it (with an
-error below a millimetre). :class:`SkillProtocol` provides both:
+Johannsmeier et al. 2019 (Johannsmeier et al., ICRA 2019) evaluates every trial from *four slightly
+different start poses* above the hole, and the skill only knows the hole pose a human taught it
+(with an error below a millimetre). :class:`SkillProtocol` provides both:
 
 * :meth:`SkillProtocol.skill_starts` / ``protocol_starts("skill", n, rng)``: ``n`` (4 in the
   paper) TCP poses ``approach_height`` above the surface, ``start_offset`` from the hole axis in
@@ -68,7 +69,8 @@ class SkillProtocolParams(TaskParams):
 
 
 class SkillProtocol(Protocol):
-    """Seed B's ``"skill"`` starts above the hole and the taught (estimated) hole pose."""
+    """Johannsmeier et al.'s ``"skill"`` starts above the hole and the taught (estimated) hole
+    pose."""
 
     task: SkillTask
     names = ("skill",)
@@ -127,8 +129,8 @@ class SkillProtocol(Protocol):
         """Per start, the hole estimate the skill runs with: ``around`` (the taught hole)
         moved ``start_deviation`` along the start's own direction from the (true) hole axis.
 
-        Seed B applies a "deliberate initial pose deviation" to the four starts of a trial
-        (none on the key, "due to the very small hole"): the skill then looks for the hole
+        Johannsmeier et al. 2019 applies a "deliberate initial pose deviation" to the four starts of
+        a trial (none on the key, "due to the very small hole"): the skill then looks for the hole
         that far from where it is, in a different direction each start. Without deviation
         (or for a start on the axis) every start gets ``around``.
         """

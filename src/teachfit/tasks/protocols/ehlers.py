@@ -1,4 +1,4 @@
-"""Seed A's start protocols: ``peg2d`` (tables 1 and 2) and ``socket3d`` (table 3).
+"""Ehlers et al.'s start protocols: ``peg2d`` (tables 1 and 2) and ``socket3d`` (table 3).
 
 Poses are TCP poses in the world frame resting on the task's surface
 (:meth:`~teachfit.tasks.base.Task.contact_pose`); lengths in metres, angles in radians.
@@ -22,7 +22,7 @@ TABLE1_RADIUS = 0.015
 
 
 class Peg2DProtocol(Protocol):
-    """Seed A's 2D protocols on the cylinder top."""
+    """Ehlers et al.'s 2D protocols on the cylinder top."""
 
     task: Peg2D
     names = ("table1", "table2")
@@ -55,7 +55,7 @@ class Peg2DProtocol(Protocol):
 
 
 class SocketProtocol(Protocol):
-    """Seed A's 3D protocol inside the socket's recess."""
+    """Ehlers et al.'s 3D protocol inside the socket's recess."""
 
     task: Socket3D
     names = ("table3",)
