@@ -174,11 +174,17 @@ def test_bench_sim_prints_ratio():
     assert re.search(r"real-time factor\W+[0-9.]+x", out)
 
 
-def test_console_script_installed():
+def test_console_script_runs_the_installed_package():
+    import subprocess
     import sys
 
+    import teachfit
+
     beside = Path(sys.executable).parent / "teachfit"
-    assert beside.exists() or shutil.which("teachfit") is not None
+    exe = str(beside) if beside.exists() else shutil.which("teachfit")
+    assert exe is not None, "the teachfit console script is not installed"
+    out = subprocess.run([exe, "--version"], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == f"teachfit {teachfit.__version__}"
 
 
 def test_learn_plan_run_search(tmp_path):
