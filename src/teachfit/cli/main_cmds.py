@@ -9,7 +9,7 @@ import typer
 from rich.table import Table
 
 from teachfit.cli import options as o
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli.common import RobotOpt, append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_table
 from teachfit.tasks.registry import load_task
@@ -94,26 +94,40 @@ def bench_sim(
     steps: Annotated[int, typer.Option(min=1, help="steps per measurement")] = 5000,
     repeats: Annotated[int, typer.Option(min=1, help="measurements (the fastest counts)")] = 3,
     robot: RobotOpt = "floating",
+    markdown: o.Markdown = None,
 ) -> None:
     """Raw mj_step steps/s vs. steps/s with the controller in the loop, in contact."""
     from teachfit.robot.speed import ArmSimSpeed, measure_sim_speed
 
     the_task = load_task(task)
     s = measure_sim_speed(the_task, steps, repeats, robot=robot)
-    table = Table(
-        title=f"simulation speed, {robot} on {the_task.name} in contact ({s.contacts} contacts)"
-    )
+    title = f"simulation speed, {robot} on {the_task.name} in contact ({s.contacts} contacts)"
+    arm = isinstance(s, ArmSimSpeed)
+    rows = [
+        ("raw mj_step", f"{s.raw_steps_per_s:,.0f} steps/s", ""),
+        ("with controller", f"{s.controlled_steps_per_s:,.0f} steps/s", ""),
+        ("ratio", f"{s.ratio:.2f}", ">= 0.70"),
+        ("real-time factor", f"{s.real_time_factor:.1f}x", ">= 5" if arm else ">= 10"),
+    ]
+    if isinstance(s, ArmSimSpeed):
+        rows += [
+            ("law per tick p50", f"{s.compute_p50_us:.1f} µs", ""),
+            ("law per tick p99", f"{s.compute_p99_us:.1f} µs", "<= 100 µs"),
+        ]
+    table = Table(title=title)
     for col in ("measure", "value", "goal"):
         table.add_column(col, justify="right")
-    table.add_row("raw mj_step", f"{s.raw_steps_per_s:,.0f} steps/s", "")
-    table.add_row("with controller", f"{s.controlled_steps_per_s:,.0f} steps/s", "")
-    table.add_row("ratio", f"{s.ratio:.2f}", ">= 0.70")
-    arm = isinstance(s, ArmSimSpeed)
-    table.add_row("real-time factor", f"{s.real_time_factor:.1f}x", ">= 5" if arm else ">= 10")
-    if isinstance(s, ArmSimSpeed):
-        table.add_row("law per tick p50", f"{s.compute_p50_us:.1f} µs", "")
-        table.add_row("law per tick p99", f"{s.compute_p99_us:.1f} µs", "<= 100 µs")
+    for row in rows:
+        table.add_row(*row)
     print_table(table)
+    if markdown is not None:
+        lines = [
+            f"**{title}** (best of {repeats} x {steps} steps)",
+            "",
+            "| measure | value | goal |",
+        ]
+        lines += ["| --- | --- | --- |"] + [f"| {a} | {b} | {c} |" for a, b, c in rows]
+        console.print(f"markdown appended to {append_markdown(markdown, chr(10).join(lines))}")
 
 
 def register(app: typer.Typer, bench_app: typer.Typer) -> None:
