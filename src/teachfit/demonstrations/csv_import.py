@@ -16,7 +16,7 @@ Errors name the file, the line (1-based, the header is line 1) and the CSV colum
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
@@ -70,44 +70,13 @@ def read_csv_log(csv_path: str | Path, columns: ColumnMap) -> RawLog:
             f"non-finite value {data[r, c]}", path=where, row=lines[r], column=names[c]
         )
     meta: dict = {"source_file": csv_path.name, "source_format": "csv"}
-    k = 0
-    step_units = None
-    if columns.time is not None:
-        times = table.times or []
-        raw_t = _offsets(times, data[:, 0])
-        steps = np.flatnonzero(np.diff(raw_t) <= 0)
-        if steps.size:
-            r = int(steps[0]) + 1
-            raise DatasetError(
-                f"time not strictly increasing ({times[r - 1].strip()} then {times[r].strip()})",
-                path=where,
-                row=lines[r],
-                column=names[0],
-            )
-        t = raw_t * columns.time_scale
-        step_units = float(np.median(np.diff(raw_t)))
-        meta["time_offset_s"] = float(data[0, 0] * columns.time_scale)
-        k = 1
-    else:
-        t = np.arange(n) / float(columns.rate_hz)  # type: ignore[arg-type]
-        meta["rate_hz_given"] = float(columns.rate_hz)  # type: ignore[arg-type]
+    cells = _Cells(data, lines, names, where)
+    t, step_units, k = _time_axis(cells, table.times, columns, meta)
     pos = data[:, k : k + 3] * columns.length_scale
     k += 3
     quat = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
     if columns.has_quat:
-        norms = np.linalg.norm(data[:, k : k + 4], axis=1)
-        off = np.flatnonzero(np.abs(norms - 1.0) > QUAT_NORM_TOL)
-        if off.size:
-            r = int(off[0])
-            raise DatasetError(
-                f"quaternion ({', '.join(names[k : k + 4])}) has norm {norms[r]:.6g}, not 1 "
-                f"(tolerance {QUAT_NORM_TOL})",
-                path=where,
-                row=lines[r],
-                column=names[k],
-            )
-        quat = to_wxyz(data[:, k : k + 4], columns.quat_order)
-        meta["quat_order"] = columns.quat_order
+        quat = _orientation(cells, k, columns, meta)
         k += 4
     wrench = data[:, k : k + 6] * columns.wrench_sign if columns.has_wrench else None
     if wrench is not None:
@@ -127,6 +96,65 @@ def read_csv_log(csv_path: str | Path, columns: ColumnMap) -> RawLog:
         quat_order=columns.quat_order,
         time_step_units=step_units,
     )
+
+
+@dataclass(frozen=True)
+class _Cells:
+    """The log's numbers (rows, mapped columns), each row's line (1-based) and each column's
+    CSV name, and the file for error messages."""
+
+    data: np.ndarray
+    lines: list[int]
+    names: list[str]
+    where: str
+
+
+def _time_axis(
+    cells: _Cells, times: list[str] | None, columns: ColumnMap, meta: dict
+) -> tuple[np.ndarray, float | None, int]:
+    """Times (s from 0), the median time step in the log's units (None without a time
+    column) and the index of the first column after the time; notes the time offset (or the
+    given rate) in ``meta``."""
+    data = cells.data
+    if columns.time is None:
+        t = np.arange(data.shape[0]) / float(columns.rate_hz)  # type: ignore[arg-type]
+        meta["rate_hz_given"] = float(columns.rate_hz)  # type: ignore[arg-type]
+        return t, None, 0
+    times = times or []
+    raw_t = _offsets(times, data[:, 0])
+    steps = np.flatnonzero(np.diff(raw_t) <= 0)
+    if steps.size:
+        r = int(steps[0]) + 1
+        raise DatasetError(
+            f"time not strictly increasing ({times[r - 1].strip()} then {times[r].strip()})",
+            path=cells.where,
+            row=cells.lines[r],
+            column=cells.names[0],
+        )
+    t = raw_t * columns.time_scale
+    step_units = float(np.median(np.diff(raw_t)))
+    meta["time_offset_s"] = float(data[0, 0] * columns.time_scale)
+    return t, step_units, 1
+
+
+def _orientation(cells: _Cells, k: int, columns: ColumnMap, meta: dict) -> np.ndarray:
+    """The quaternions in columns ``k .. k + 3`` as w-x-y-z, each of norm 1 within
+    ``QUAT_NORM_TOL``; notes their order in ``meta``."""
+    names = cells.names
+    norms = np.linalg.norm(cells.data[:, k : k + 4], axis=1)
+    off = np.flatnonzero(np.abs(norms - 1.0) > QUAT_NORM_TOL)
+    if off.size:
+        r = int(off[0])
+        raise DatasetError(
+            f"quaternion ({', '.join(names[k : k + 4])}) has norm {norms[r]:.6g}, not 1 "
+            f"(tolerance {QUAT_NORM_TOL})",
+            path=cells.where,
+            row=cells.lines[r],
+            column=names[k],
+        )
+    quat = to_wxyz(cells.data[:, k : k + 4], columns.quat_order)
+    meta["quat_order"] = columns.quat_order
+    return quat
 
 
 def import_csv(

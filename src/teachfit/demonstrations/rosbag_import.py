@@ -182,16 +182,69 @@ def read_bag(
         Naming the bag for an unreadable bag, a missing topic, a wrong message type, too few
         messages or no overlap between the pose and wrench stamps.
     """
+    path = _checked_path(path, wrench_sign)
+    where = str(path)
+    notes: list[str] = []
+    poses, wrenches, generation = _read_streams(path, pose_topic, wrench_topic, child_frame)
+    stamps, values, rows = _timed(poses, pose_topic, where, notes)
+    meta: dict[str, Any] = {"source_file": path.name, "source_format": generation}
+    meta.update(pose_topic=pose_topic, time_offset_s=float(stamps[0]) * 1e-9)
+    topics = (pose_topic, wrench_topic)
+    stamps, values, rows, wrench = _with_wrench(
+        (stamps, values, rows, poses.frames[0]), wrenches, topics, wrench_sign, where, notes, meta
+    )
+    if stamps.size < MIN_SAMPLES:
+        raise DatasetError(f"{stamps.size} pose messages, need at least {MIN_SAMPLES}", path=where)
+    return RawLog(
+        path=where,
+        t=(stamps - stamps[0]).astype(float) * 1e-9,
+        pos=values[:, :3],
+        quat=_unit_quats(values[:, 3:], rows, pose_topic, where),
+        wrench=wrench,
+        frame=poses.frames[0] or "world",
+        rows=rows,
+        notes=tuple(notes),
+        meta=meta,
+        fix_in=None,
+        quat_order="w,x,y,z",
+        time_step_units=None,
+    )
+
+
+def _checked_path(path: str | Path, wrench_sign: int) -> Path:
+    """``path`` as a Path; a wrench sign other than +1 or -1, or a bag that does not exist, is
+    a :class:`DatasetError`."""
+    path = Path(path)
+    if wrench_sign not in (1, -1):
+        raise DatasetError(f"--wrench-sign must be +1 or -1, got {wrench_sign}", path=str(path))
+    if not path.exists():
+        raise DatasetError("no such file or folder", path=str(path))
+    return path
+
+
+def _unit_quats(quat: np.ndarray, rows: np.ndarray, topic: str, where: str) -> np.ndarray:
+    """The orientations (w, x, y, z) normalised; one off norm 1 by more than 1e-3 is a
+    :class:`DatasetError` naming its message (``rows``)."""
+    norms = np.linalg.norm(quat, axis=1)
+    bad = np.flatnonzero(np.abs(norms - 1.0) > 1e-3)
+    if bad.size:
+        raise DatasetError(
+            f"{topic} message {rows[bad[0]]}: orientation norm {norms[bad[0]]:.6g}, not 1",
+            path=where,
+        )
+    return quat / norms[:, None]
+
+
+def _read_streams(
+    path: Path, pose_topic: str, wrench_topic: str | None, child_frame: str | None
+) -> tuple[_Stream, _Stream | None, str]:
+    """The pose stream (all in one frame), the wrench stream (None without ``wrench_topic``) and
+    the bag's ROS generation (``"ros1"`` or ``"ros2"``); a bag rosbags cannot read, or poses in
+    several frames, are a :class:`DatasetError`."""
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.typesys import Stores, get_typestore
 
-    path = Path(path)
     where = str(path)
-    if wrench_sign not in (1, -1):
-        raise DatasetError(f"--wrench-sign must be +1 or -1, got {wrench_sign}", path=where)
-    if not path.exists():
-        raise DatasetError("no such file or folder", path=where)
-    notes: list[str] = []
     try:
         with AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
             poses = _read_topic(reader, pose_topic, POSE_TYPES, where, child_frame)
@@ -209,60 +262,52 @@ def read_bag(
     frames = sorted(set(poses.frames))
     if len(frames) != 1:
         raise DatasetError(f"{pose_topic} poses are in several frames {frames}", path=where)
-    stamps, values, rows = _timed(poses, pose_topic, where, notes)
-    wrench = None
-    meta: dict[str, Any] = {"source_file": path.name, "source_format": generation}
-    meta.update(pose_topic=pose_topic, time_offset_s=float(stamps[0]) * 1e-9)
-    if wrenches is not None:
-        w_stamps, w_values, _ = _timed(wrenches, wrench_topic, where, notes)
-        inside = (stamps >= w_stamps[0]) & (stamps <= w_stamps[-1])
-        if np.count_nonzero(inside) < MIN_SAMPLES:
-            raise DatasetError(
-                f"{pose_topic} and {wrench_topic} stamps do not overlap (poses "
-                f"{stamps[0] * 1e-9:.3f}..{stamps[-1] * 1e-9:.3f} s, wrenches "
-                f"{w_stamps[0] * 1e-9:.3f}..{w_stamps[-1] * 1e-9:.3f} s)",
-                path=where,
-            )
-        if not inside.all():
-            notes.append(
-                f"dropped {np.count_nonzero(~inside)} {pose_topic} samples outside the time span "
-                f"of {wrench_topic}"
-            )
-        stamps, values, rows = stamps[inside], values[inside], rows[inside]
-        dt = (w_stamps - stamps[0]).astype(float)
-        at = (stamps - stamps[0]).astype(float)
-        wrench = np.column_stack([np.interp(at, dt, w_values[:, k]) for k in range(6)])
-        wrench *= wrench_sign
-        w_frame = wrenches.frames[0]
-        if w_frame and w_frame != frames[0]:
-            rot = wxyz_to_rotation(values[:, 3:])
-            wrench = np.hstack([rot.apply(wrench[:, :3]), rot.apply(wrench[:, 3:])])
-            notes.append(
-                f"{wrench_topic} is in {w_frame!r}: rotated it into {frames[0]!r} with the tool "
-                "orientation (assumes the sensor axes are the tool's)"
-            )
-        meta.update(wrench_topic=wrench_topic, wrench_sign=wrench_sign, wrench_frame=w_frame)
-    if stamps.size < MIN_SAMPLES:
-        raise DatasetError(f"{stamps.size} pose messages, need at least {MIN_SAMPLES}", path=where)
-    quat = values[:, 3:]
-    norms = np.linalg.norm(quat, axis=1)
-    bad = np.flatnonzero(np.abs(norms - 1.0) > 1e-3)
-    if bad.size:
+    return poses, wrenches, generation
+
+
+def _with_wrench(
+    poses: tuple[np.ndarray, np.ndarray, np.ndarray, str],
+    wrenches: _Stream | None,
+    topics: tuple[str, str | None],
+    wrench_sign: int,
+    where: str,
+    notes: list[str],
+    meta: dict[str, Any],
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """The pose samples (stamps ns, values, message indices) inside the wrench's time span and
+    the wrench (N, N*m; times ``wrench_sign``) interpolated onto them, in the poses' frame; the
+    poses as they are and no wrench without ``wrenches``. Notes the wrench topic, sign and frame
+    in ``meta``."""
+    stamps, values, rows, frame = poses
+    if wrenches is None:
+        return stamps, values, rows, None
+    pose_topic, wrench_topic = topics[0], str(topics[1])  # a topic when there are wrenches
+    w_stamps, w_values, _ = _timed(wrenches, wrench_topic, where, notes)
+    inside = (stamps >= w_stamps[0]) & (stamps <= w_stamps[-1])
+    if np.count_nonzero(inside) < MIN_SAMPLES:
         raise DatasetError(
-            f"{pose_topic} message {rows[bad[0]]}: orientation norm {norms[bad[0]]:.6g}, not 1",
+            f"{pose_topic} and {wrench_topic} stamps do not overlap (poses "
+            f"{stamps[0] * 1e-9:.3f}..{stamps[-1] * 1e-9:.3f} s, wrenches "
+            f"{w_stamps[0] * 1e-9:.3f}..{w_stamps[-1] * 1e-9:.3f} s)",
             path=where,
         )
-    return RawLog(
-        path=where,
-        t=(stamps - stamps[0]).astype(float) * 1e-9,
-        pos=values[:, :3],
-        quat=quat / norms[:, None],
-        wrench=wrench,
-        frame=frames[0] or "world",
-        rows=rows,
-        notes=tuple(notes),
-        meta=meta,
-        fix_in=None,
-        quat_order="w,x,y,z",
-        time_step_units=None,
-    )
+    if not inside.all():
+        notes.append(
+            f"dropped {np.count_nonzero(~inside)} {pose_topic} samples outside the time span "
+            f"of {wrench_topic}"
+        )
+    stamps, values, rows = stamps[inside], values[inside], rows[inside]
+    dt = (w_stamps - stamps[0]).astype(float)
+    at = (stamps - stamps[0]).astype(float)
+    wrench = np.column_stack([np.interp(at, dt, w_values[:, k]) for k in range(6)])
+    wrench *= wrench_sign
+    w_frame = wrenches.frames[0]
+    if w_frame and w_frame != frame:
+        rot = wxyz_to_rotation(values[:, 3:])
+        wrench = np.hstack([rot.apply(wrench[:, :3]), rot.apply(wrench[:, 3:])])
+        notes.append(
+            f"{wrench_topic} is in {w_frame!r}: rotated it into {frame!r} with the tool "
+            "orientation (assumes the sensor axes are the tool's)"
+        )
+    meta.update(wrench_topic=wrench_topic, wrench_sign=wrench_sign, wrench_frame=w_frame)
+    return stamps, values, rows, wrench

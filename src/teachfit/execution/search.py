@@ -143,14 +143,7 @@ def plan_search(
     starting where the previous one ends (seed A's re-sampling): the runner stops at insertion,
     so a pass is only executed when every pass before it failed.
     """
-    if not 0 < n_points <= MAX_POINTS:
-        raise TeachfitError(
-            f"number of points must be 1 ... {MAX_POINTS} (Ehlers et al. use 300-600), "
-            f"got {n_points}"
-        )
-    if passes < 1 or (passes > 1 and method != "tshix"):
-        raise TeachfitError(f"passes must be 1, or >= 1 for tshix; got {passes} for {method}")
-    dims = model.dims
+    _check_plan(method, n_points, passes)
     if method == "tshix":
         planner = TshixPlanner.from_model(model, sampling=sampling)
         traj = planner.plan(n_points, rng)
@@ -158,21 +151,54 @@ def plan_search(
             traj = planner.extend(traj, n_points, rng)
         return traj
     if method in ("ergodic", "ergodic-opt"):
-        if length is None:
-            planner = TshixPlanner.from_model(model, sampling=sampling)
-            length = planner.plan(n_points, rng).path_length(planner.length_scale)
-        traj = ergodic_trajectory(
-            model.exploration,
-            speed=model.speed,
-            length=length,
-            angular_speed=model.angular_speed,
-            start=np.zeros(len(dims)),
+        return _plan_ergodic(model, method, n_points, rng, length, sampling)
+    return _plan_baseline(model, method, n_points, rng)
+
+
+def _check_plan(method: str, n_points: int, passes: int) -> None:
+    """Refuse a number of points or passes :func:`plan_search` cannot plan."""
+    if not 0 < n_points <= MAX_POINTS:
+        raise TeachfitError(
+            f"number of points must be 1 ... {MAX_POINTS} (Ehlers et al. use 300-600), "
+            f"got {n_points}"
         )
-        if method == "ergodic":
-            return traj
-        return optimise_ergodic(
-            traj, model.exploration, speed=model.speed, angular_speed=model.angular_speed
-        )
+    if passes < 1 or (passes > 1 and method != "tshix"):
+        raise TeachfitError(f"passes must be 1, or >= 1 for tshix; got {passes} for {method}")
+
+
+def _plan_ergodic(
+    model: SearchModel,
+    method: str,
+    n_points: int,
+    rng: np.random.Generator,
+    length: float | None,
+    sampling: str,
+) -> SearchTrajectory:
+    """An ergodic trajectory of ``length`` (by default a TSHIX pass's through ``n_points``
+    samples), optimised for ``"ergodic-opt"``."""
+    if length is None:
+        planner = TshixPlanner.from_model(model, sampling=sampling)
+        length = planner.plan(n_points, rng).path_length(planner.length_scale)
+    traj = ergodic_trajectory(
+        model.exploration,
+        speed=model.speed,
+        length=length,
+        angular_speed=model.angular_speed,
+        start=np.zeros(len(model.dims)),
+    )
+    if method == "ergodic":
+        return traj
+    return optimise_ergodic(
+        traj, model.exploration, speed=model.speed, angular_speed=model.angular_speed
+    )
+
+
+def _plan_baseline(
+    model: SearchModel, method: str, n_points: int, rng: np.random.Generator
+) -> SearchTrajectory:
+    """A spiral or a random walk over the exploration distribution's 2-sigma radius (and
+    2-sigma rz range); any other ``method`` is refused."""
+    dims = model.dims
     ex = model.exploration
     var = np.diag(ex.cov)
     lin = [i for i, d in enumerate(dims) if d != "rz"]

@@ -166,48 +166,93 @@ def run_study_ray(
     ray = import_ray()
     t0 = time.perf_counter()
     started, reaper = _init(ray, address, workers)
-    restored, here, failed = study.n_finished, study.n_here, 0
-    pending: dict[Any, Candidate] = {}
+    restored, here = study.n_finished, study.n_here
+    trials = _RayTrials(ray, study, budget, on_trial)
     try:
-        slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
-        task = ray.remote(num_cpus=1, max_retries=0)(evaluate)
-        obj_ref = ray.put(objective)
+        trials.start(objective, workers)
         with Interrupts(handle_signals) as sig:
-            while True:
-                while not sig.stop and len(pending) < slots:
-                    cand = study.ask(budget)
-                    if cand is None:
-                        break
-                    pending[task.remote(obj_ref, study.params_of(cand))] = cand
-                if not pending:
-                    if sig.stop or study.settled(budget):
-                        break
-                    time.sleep(POLL_S)  # other processes run trials this learner waits for
-                    continue
-                done, _ = ray.wait(list(pending), num_returns=1, timeout=0.2)
-                for ref in done:
-                    cand = pending.pop(ref)
-                    result: TrialResult | None
-                    try:
-                        result, error = ray.get(ref)
-                    except ray.exceptions.RayError as exc:  # the worker died, or was lost
-                        why = str(exc).strip().splitlines()[-1:] or [""]
-                        result, error = None, f"Ray worker failed: {type(exc).__name__}: {why[0]}"
-                    rec = study.tell(cand, result, error)
-                    if rec is None:
-                        continue  # the claim was lost to another process, which runs it
-                    failed += rec.outcome == "error"
-                    if on_trial is not None:
-                        on_trial(rec)
+            trials.run(sig)
             interrupted = sig.stop
     except BaseException:
-        for ref in pending:
-            ray.cancel(ref, force=True)
-        study.abandon()  # other processes may run our unfinished trials at once
+        trials.cancel()
         raise
     finally:
         if started:
             ray.shutdown()
         if reaper is not None:
             reaper.stop()  # what the shutdown left of the local instance is killed
-    return RunReport(restored, study.n_here - here, failed, interrupted, time.perf_counter() - t0)
+    elapsed = time.perf_counter() - t0
+    return RunReport(restored, study.n_here - here, trials.failed, interrupted, elapsed)
+
+
+class _RayTrials:
+    """The trials of one :func:`run_study_ray` call: asked from ``study``, in flight as Ray
+    tasks (``pending``: task reference -> candidate), told to ``study`` as they finish."""
+
+    def __init__(
+        self,
+        ray: ModuleType,
+        study: Study,
+        budget: int,
+        on_trial: Callable[[TrialRecord], None] | None,
+    ) -> None:
+        self.ray, self.study, self.budget, self.on_trial = ray, study, budget, on_trial
+        self.failed = 0  # trials told as errors
+        self.pending: dict[Any, Candidate] = {}
+
+    def start(self, objective: Objective, workers: int | None) -> None:
+        """Size the trials in flight (``workers``, or the cluster's CPUs), declare the Ray
+        task and ship the objective to the cluster once."""
+        ray = self.ray
+        self.slots = workers or max(1, int(ray.cluster_resources().get("CPU", 1)))
+        self.task = ray.remote(num_cpus=1, max_retries=0)(evaluate)
+        self.obj_ref = ray.put(objective)
+
+    def run(self, sig: Interrupts) -> None:
+        """Keep the slots filled and tell finished trials until the study is settled or a
+        signal stops the asking and the trials in flight have finished."""
+        while True:
+            self._fill(sig)
+            if not self.pending:
+                if sig.stop or self.study.settled(self.budget):
+                    break
+                time.sleep(POLL_S)  # other processes run trials this learner waits for
+                continue
+            self._tell_finished()
+
+    def _fill(self, sig: Interrupts) -> None:
+        """Ask and submit candidates while slots are free (and no signal came)."""
+        while not sig.stop and len(self.pending) < self.slots:
+            cand = self.study.ask(self.budget)
+            if cand is None:
+                break
+            self.pending[self.task.remote(self.obj_ref, self.study.params_of(cand))] = cand
+
+    def _tell_finished(self) -> None:
+        """Wait up to 0.2 s for a trial to finish and tell it to the study."""
+        done, _ = self.ray.wait(list(self.pending), num_returns=1, timeout=0.2)
+        for ref in done:
+            cand = self.pending.pop(ref)
+            rec = self.study.tell(cand, *self._outcome(ref))
+            if rec is None:
+                continue  # the claim was lost to another process, which runs it
+            self.failed += rec.outcome == "error"
+            if self.on_trial is not None:
+                self.on_trial(rec)
+
+    def _outcome(self, ref: Any) -> tuple[TrialResult | None, str]:
+        """The finished task's (result, error); a worker that died or was lost is an error."""
+        result: TrialResult | None
+        try:
+            result, error = self.ray.get(ref)
+        except self.ray.exceptions.RayError as exc:  # the worker died, or was lost
+            why = str(exc).strip().splitlines()[-1:] or [""]
+            result, error = None, f"Ray worker failed: {type(exc).__name__}: {why[0]}"
+        return result, error
+
+    def cancel(self) -> None:
+        """Cancel the trials in flight and give up their claims: other processes may run
+        our unfinished trials at once."""
+        for ref in self.pending:
+            self.ray.cancel(ref, force=True)
+        self.study.abandon()

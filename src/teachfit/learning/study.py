@@ -132,6 +132,31 @@ class TrialRecord:
     info: dict[str, float] = field(default_factory=dict)
 
 
+def _study_tags(
+    task: str,
+    skill: str,
+    method: str,
+    seed: int,
+    options: Mapping[str, Any] | None,
+    space: ParamSpace,
+    penalty: float,
+    context: Mapping[str, Any] | None,
+) -> dict[str, Any]:
+    """The tags a study is stored with and must match on resume."""
+    tags: dict[str, Any] = {
+        "task": task,
+        "skill": skill,
+        "method": method,
+        "seed": int(seed),
+        "options": dict(options or {}),
+        "space": space.to_json(),
+        "penalty": penalty,
+    }
+    if context:
+        tags["context"] = dict(context)
+    return tags
+
+
 class Study:
     """Open (create or resume) a tagged study and its learner.
 
@@ -183,52 +208,12 @@ class Study:
         self.where = shown(self.url)
         self.space = space
         self.penalty = float(penalty)
-        tags: dict[str, Any] = {
-            "task": task,
-            "skill": skill,
-            "method": method,
-            "seed": int(seed),
-            "options": dict(options or {}),
-            "space": space.to_json(),
-            "penalty": self.penalty,
-        }
-        if context:
-            tags["context"] = dict(context)
-        self.tags = tags
+        self.tags = _study_tags(task, skill, method, seed, options, space, self.penalty, context)
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self.learner = make_learner(method, space, seed, options)
-        what = f"study database {self.where}"
-        rdb = _retry(
-            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url)),
-            what=what,
-        )
-        serialise_sqlite(rdb.engine)
-        self._rdb = rdb
-        self._optuna = _retry(
-            lambda: optuna.create_study(
-                storage=rdb, study_name=name, direction="minimize", load_if_exists=True
-            ),
-            what=what,
-        )
-        self._dists = {
-            n: FloatDistribution(d.low, d.high, log=d.log) for n, d in space.domains.items()
-        }
-        #: SQLite: id of the last trial read (-1: none yet); None: read all every time
-        self._read_above: int | None = -1 if self.url.startswith("sqlite") else None
-        self._read: list[optuna.trial.FrozenTrial] = []
+        self._open_storage(name)
         finished = self._finished_trials()
-        stored = self._optuna.user_attrs
-        if not finished:
-            # a new study, maybe being tagged by another process at this moment: add the
-            # tags it lacks (one at a time, like that process), then compare them all
-            for k, v in tags.items():
-                if k not in stored:
-                    self._optuna.set_user_attr(k, v)
-            stored = self._optuna.user_attrs
-        diff = [k for k in tags if stored.get(k) != tags[k]]
-        if diff:
-            what = "; ".join(f"{k}: stored {stored.get(k)!r}, asked {tags[k]!r}" for k in diff)
-            raise StudyMismatchError(f"study {name!r} in {self.where} differs: {what}")
+        self._tag_or_compare(name, bool(finished))
         if finished and not resume:
             raise LearningError(
                 f"study {name!r} in {self.where} already has {len(finished)} trials: resume it "
@@ -246,6 +231,45 @@ class Study:
         self._elsewhere: dict[str, Candidate] = {}  # claimed by other processes
         self._others = 0  # live claims of other processes, unfinished
         self._synced = time.monotonic()
+
+    def _open_storage(self, name: str) -> None:
+        """Connect to the storage and create (or load) the Optuna study ``name`` in it."""
+        what = f"study database {self.where}"
+        rdb = _retry(
+            lambda: optuna.storages.RDBStorage(self.url, engine_kwargs=engine_kwargs(self.url)),
+            what=what,
+        )
+        serialise_sqlite(rdb.engine)
+        self._rdb = rdb
+        self._optuna = _retry(
+            lambda: optuna.create_study(
+                storage=rdb, study_name=name, direction="minimize", load_if_exists=True
+            ),
+            what=what,
+        )
+        self._dists = {
+            n: FloatDistribution(d.low, d.high, log=d.log) for n, d in self.space.domains.items()
+        }
+        #: SQLite: id of the last trial read (-1: none yet); None: read all every time
+        self._read_above: int | None = -1 if self.url.startswith("sqlite") else None
+        self._read: list[optuna.trial.FrozenTrial] = []
+
+    def _tag_or_compare(self, name: str, has_trials: bool) -> None:
+        """Tag a study without trials with the tags it lacks, then compare the stored tags
+        with :attr:`tags`: a difference is a :class:`StudyMismatchError`."""
+        tags = self.tags
+        stored = self._optuna.user_attrs
+        if not has_trials:
+            # a new study, maybe being tagged by another process at this moment: add the
+            # tags it lacks (one at a time, like that process), then compare them all
+            for k, v in tags.items():
+                if k not in stored:
+                    self._optuna.set_user_attr(k, v)
+            stored = self._optuna.user_attrs
+        diff = [k for k in tags if stored.get(k) != tags[k]]
+        if diff:
+            what = "; ".join(f"{k}: stored {stored.get(k)!r}, asked {tags[k]!r}" for k in diff)
+            raise StudyMismatchError(f"study {name!r} in {self.where} differs: {what}")
 
     def _finished_trials(self) -> list[optuna.trial.FrozenTrial]:
         # read the database itself, not Optuna's cache of it: the cache skips trials that

@@ -110,11 +110,37 @@ def build(controller: str = "adaptive") -> Skill:
     (``"adaptive"``) to the learned ones."""
     learned = dict(LEARNED) | controller_params(controller)
     params = SkillParams(dict(CONTEXT), learned)
-    fast = dict(
+    fast = _fast()
+    roi = LateralAbove("roi")
+    nodes = _reach_nodes(fast, roi) + _insert_nodes(fast, roi)
+    transitions = _transitions()
+    recovery = _recovery(fast)
+    return Skill(
+        name=NAME,
+        nodes=nodes,
+        transitions=transitions,
+        start="approach",
+        params=params,
+        success=DepthAbove("depth"),
+        error=TimeAbove("t_max", scope="skill") | ForceAbove("f_max", axis="norm"),
+        pre=~ForceAbove("f_contact", axis="norm"),
+        recovery=recovery,
+        doc="the skill paper's peg-in-hole (Johannsmeier et al. 2019): approach, contact, "
+        "lateral move until constrained, align, insert with oscillations",
+    )
+
+
+def _fast() -> dict[str, str]:
+    """The speed and acceleration limits of a free motion, by parameter name."""
+    return dict(
         v_max="v_max", a_max="a_max", w_max="w_max", dw_max="dw_max", speed_factor="speed_factor"
     )
-    roi = LateralAbove("roi")
-    nodes = (
+
+
+def _reach_nodes(fast: dict[str, str], roi: LateralAbove) -> tuple[Node, ...]:
+    """``approach``, ``contact`` and ``lateral``: from the approach pose down onto the surface
+    and sideways until the part is caught by the hole (``roi``: left the region of interest)."""
+    return (
         Node(
             "approach",
             MoveTo(
@@ -151,6 +177,12 @@ def build(controller: str = "adaptive") -> Skill:
             TimeAbove("t_lateral") | roi,
             "sideways until constrained",
         ),
+    )
+
+
+def _insert_nodes(fast: dict[str, str], roi: LateralAbove) -> tuple[Node, ...]:
+    """``align`` and ``insert``: upright into the hole orientation, then pushed in."""
+    return (
         Node(
             "align",
             MoveTo(
@@ -180,6 +212,10 @@ def build(controller: str = "adaptive") -> Skill:
             "push with oscillations",
         ),
     )
+
+
+def _transitions() -> tuple[Transition, ...]:
+    """approach -> contact -> lateral -> (constrained) align -> insert."""
     constrained = Any_(
         (
             TimeAbove("t_settle") & ForceAbove("f_lateral", axis="-x"),
@@ -187,30 +223,21 @@ def build(controller: str = "adaptive") -> Skill:
             TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
         )
     )
-    transitions = (
+    return (
         Transition("approach", "contact", Done() & RemainingBelow(0.001)),
         Transition("contact", "lateral", ForceAbove("f_contact", axis="+z")),
         Transition("lateral", "align", constrained),
         Transition("align", "insert", Done()),
     )
-    recovery = Node(
+
+
+def _recovery(fast: dict[str, str]) -> Node:
+    """Retract ``retract_height`` up from wherever the error happened."""
+    return Node(
         "retract",
         MoveTo(goal=(0.0, 0.0, "retract_height"), relative=True, stiffness=_STIFF_FREE, **fast),
         TimeAbove(1.0),
         "retract upwards",
-    )
-    return Skill(
-        name=NAME,
-        nodes=nodes,
-        transitions=transitions,
-        start="approach",
-        params=params,
-        success=DepthAbove("depth"),
-        error=TimeAbove("t_max", scope="skill") | ForceAbove("f_max", axis="norm"),
-        pre=~ForceAbove("f_contact", axis="norm"),
-        recovery=recovery,
-        doc="the skill paper's peg-in-hole (Johannsmeier et al. 2019): approach, contact, "
-        "lateral move until constrained, align, insert with oscillations",
     )
 
 

@@ -16,6 +16,8 @@ All lengths are in metres, in the frame of the body the geom is attached to (z u
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 
@@ -70,8 +72,37 @@ def valley_wedge(
     half = (angle1 - angle0) / 2.0
     mid = angle0 + half
     u = np.array([np.cos(mid), np.sin(mid)])
+    poly = _wedge_outline(c, angle0, angle1, r_hole / np.cos(half), half_width)
+
+    def depth_along(p: np.ndarray) -> float:
+        return float((p - c) @ u)
+
+    crease = _crease(poly, depth_along, valley_radius) if z_floor > z_entry else []
+    valley = (r_hole, z_entry, z_floor, valley_radius)
+    verts = [(p[0], p[1], _valley_top(depth_along(p), *valley)) for p in poly]
+    verts += [(p[0], p[1], z_floor) for p in crease]
+    verts += [(p[0], p[1], z_bottom) for p in poly]
+    return np.unique(np.round(np.asarray(verts), 12), axis=0)
+
+
+def _valley_top(
+    d: float, r_hole: float, z_entry: float, z_floor: float, valley_radius: float
+) -> float:
+    """Height (m) of the valley top at distance ``d`` (m) from the centre along the bisector:
+    ``z_entry`` at ``r_hole`` rising linearly to ``z_floor`` at ``valley_radius``, flat beyond."""
+    if z_floor <= z_entry or valley_radius <= r_hole:
+        return z_floor
+    slope = (z_floor - z_entry) / (valley_radius - r_hole)
+    return min(z_floor, z_entry + slope * (d - r_hole))
+
+
+def _wedge_outline(
+    c: np.ndarray, angle0: float, angle1: float, inner: float, half_width: float
+) -> list[np.ndarray]:
+    """The wedge's x-y outline (m) in order: out along the ray at ``angle0`` from distance
+    ``inner`` to the square's edge, the square's corners between the rays, back in along the
+    ray at ``angle1``."""
     rays = [np.array([np.cos(a), np.sin(a)]) for a in (angle0, angle1)]
-    inner = r_hole / np.cos(half)
     poly = [c + inner * rays[0], c + _square_exit(rays[0], half_width) * rays[0]]
     for k in range(4):  # square corners strictly between the two rays
         corner_ang = np.pi / 4 + k * np.pi / 2
@@ -81,26 +112,20 @@ def valley_wedge(
                 c + half_width * np.sqrt(2.0) * np.array([np.cos(corner_ang), np.sin(corner_ang)])
             )
     poly += [c + _square_exit(rays[1], half_width) * rays[1], c + inner * rays[1]]
+    return poly
 
-    def depth_along(p: np.ndarray) -> float:
-        return float((p - c) @ u)
 
-    def top(p: np.ndarray) -> float:
-        if z_floor <= z_entry or valley_radius <= r_hole:
-            return z_floor
-        slope = (z_floor - z_entry) / (valley_radius - r_hole)
-        return min(z_floor, z_entry + slope * (depth_along(p) - r_hole))
-
+def _crease(
+    poly: list[np.ndarray], depth_along: Callable[[np.ndarray], float], valley_radius: float
+) -> list[np.ndarray]:
+    """Where the outline's edges cross ``depth_along == valley_radius`` (m): the points of the
+    line where the valley plane meets the flat floor."""
     crease = []
-    if z_floor > z_entry:  # where the valley plane meets the flat floor
-        for a, b in zip(poly, poly[1:] + poly[:1], strict=True):
-            da, db = depth_along(a) - valley_radius, depth_along(b) - valley_radius
-            if da * db < 0:
-                crease.append(a + (b - a) * da / (da - db))
-    verts = [(p[0], p[1], top(p)) for p in poly]
-    verts += [(p[0], p[1], z_floor) for p in crease]
-    verts += [(p[0], p[1], z_bottom) for p in poly]
-    return np.unique(np.round(np.asarray(verts), 12), axis=0)
+    for a, b in zip(poly, poly[1:] + poly[:1], strict=True):
+        da, db = depth_along(a) - valley_radius, depth_along(b) - valley_radius
+        if da * db < 0:
+            crease.append(a + (b - a) * da / (da - db))
+    return crease
 
 
 def disc_segment(
