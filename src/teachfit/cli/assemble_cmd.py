@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, cast
 
 import typer
 from rich.table import Table
@@ -16,7 +16,13 @@ from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, writ
 from teachfit.cli.run_end import end_run, exit_if_faulted, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.batch import Finished, keeping, run_batch_keeping
+from teachfit.execution.batch import run_batch_keeping
+
+if TYPE_CHECKING:
+    from teachfit.bench.assembly import Rows
+    from teachfit.demonstrations.dataset import Demonstration
+    from teachfit.execution.assembly import AssemblyTrial
+    from teachfit.execution.plan_contact import PlanTrial
 
 _UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "deg": 0.017453292519943295, "rad": 1.0}
 
@@ -36,6 +42,7 @@ def register(app: typer.Typer, bench_app: typer.Typer) -> None:
 
 
 @guarded
+# Long (> 60 lines) only by its options' declarations: the body checks, runs the trials, prints
 def assemble(
     task: Annotated[
         str, typer.Option(help="task: peg2d, socket3d, puzzle, key, peg; l-groove, tenon")
@@ -74,58 +81,20 @@ def assemble(
 
     Exit status 1 when the robot stopped a trial (each reason is printed); a run cut short
     (Ctrl-C) prints and logs the trials that finished; see the README."""
-    from teachfit.metrics.stats import summarize
-    from teachfit.robot.registry import ROBOTS
+    from teachfit.execution.assembly import run_assembly_job
+    from teachfit.execution.assembly_run import PLANNED_PARTS, assembly_setup, shown_trial
 
-    video = render
-    err = parse_quantity(hole_error)
-    yaw = parse_quantity(yaw_error, "deg", "--yaw-error")
-    if robot not in ROBOTS:
-        raise TeachfitError(f"unknown robot {robot!r}; robots: {', '.join(sorted(ROBOTS))}")
-    if demo is not None and task not in ("l-groove", "tenon"):
-        from teachfit.cli.plan_cmd import _load_demo
-
-        _load_demo(str(demo))  # a bad file is named first
-        raise TeachfitError(f"--demo {demo}: only l-groove and tenon plan from a demonstration")
-    task_name = task
-    if task not in ("l-groove", "tenon"):
-        from teachfit.cli.geometry_progress import geometry_progress
-        from teachfit.tasks.registry import load_task
-
-        # a bad task (file) before any output; its name is what a model learned on it records
-        # (a task file of a built-in kind is that kind): matched as search run matches it
-        with geometry_progress(f"loading task {task}"):
-            task_name = load_task(task).name
+    err, yaw, task_name = _checked(task, demo, hole_error, yaw_error, robot)
     check_recording_targets(log, rrd)
-    if task in ("l-groove", "tenon"):
+    if task in PLANNED_PARTS:
         ang = parse_quantity(angle_error, "deg", "--angle-error")
         rec = (log, rrd, {"task": task, "demo": demo, "hole_error": hole_error,
                "angle_error": angle_error, "trials": trials, "seed": seed})  # fmt: skip
-        _assemble_plan(task, demo, err, ang, trials, seed, plot, video, rec)
+        _assemble_plan(task, demo, err, ang, trials, seed, plot, render, rec)
         return
-    from teachfit.execution.assembly import assembly_jobs, run_assembly_job
-    from teachfit.models.search_model import SearchModel
-    from teachfit.skills.library import get_skill
-    from teachfit.skills.params import read_params_toml
-
-    if trials < 1:
-        raise TeachfitError(f"--trials must be >= 1, got {trials}")
-    model = SearchModel.load(search, task=task_name) if search is not None else None
-    if model is not None and skill != "peg-in-hole":
-        raise TeachfitError(f"the learned search recovers the peg-in-hole skill, not {skill!r}")
-    method = "joined" if model is not None else "skill"
-    learned: dict[str, float] = {}
-    if params is not None:
-        from teachfit.execution.assembly import method_skill
-
-        sk = method_skill(method, model, skill, controller)
-        learned = read_params_toml(params, sk.params, sk.users())
-    else:
-        get_skill(skill, controller)  # a bad --skill fails before any trial
-    jobs = assembly_jobs(
-        task, [method], [err], trials, model, seed=seed, yaw_error=yaw, skill=skill,
-        controller=controller, learned=tuple(sorted(learned.items())), robot=robot,
-        keep_log=any(v is not None for v in (plot, video, log, rrd)),
+    model, method, jobs = assembly_setup(
+        (task, task_name), search, skill, params, controller, err, trials, seed=seed,
+        yaw_error=yaw, robot=robot, keep_log=any(v is not None for v in (plot, render, log, rrd)),
     )  # fmt: skip
     what = "skill with learned-search recovery" if model else f"{skill} alone (no --search)"
     console.print(f"{task}: {what}; taught hole off by {err * 1e3:g} mm; {trials} trial(s)")
@@ -136,6 +105,54 @@ def assemble(
     if not out:
         console.print("no trial finished")
         return end_run(finished, what="trial")
+    faulted = _report_trials(out)
+    if log is not None or rrd is not None:
+        info = ("assemble", task, robot, seed, f"{method} {skill} {controller}")
+        opts = {
+            "task": task, "search": search, "skill": skill, "hole_error": hole_error,
+            "yaw_error": yaw_error, "trials": trials, "params": params,
+            "controller": controller, "seed": seed, "robot": robot,
+        }  # fmt: skip
+        write_recordings(log, rrd, [t.result for t in out], info, opts)
+    if (plot is None and render is None) or not finished.complete:
+        return end_run(finished, faulted, "trial")
+    _trial_figures(shown_trial(out), task, plot, render, robot)
+    exit_if_faulted(faulted)
+
+
+def _checked(
+    task: str, demo: str | None, hole_error: str, yaw_error: str, robot: str
+) -> tuple[float, float, str]:
+    """``assemble``'s options checked before any output: the taught-hole and yaw errors (m,
+    rad) and the task's name (a task file of a built-in kind is that kind)."""
+    from teachfit.execution.assembly_run import PLANNED_PARTS
+    from teachfit.robot.registry import ROBOTS
+
+    err = parse_quantity(hole_error)
+    yaw = parse_quantity(yaw_error, "deg", "--yaw-error")
+    if robot not in ROBOTS:
+        raise TeachfitError(f"unknown robot {robot!r}; robots: {', '.join(sorted(ROBOTS))}")
+    if demo is not None and task not in PLANNED_PARTS:
+        from teachfit.cli.plan_cmd import _load_demo
+
+        _load_demo(str(demo))  # a bad file is named first
+        raise TeachfitError(f"--demo {demo}: only l-groove and tenon plan from a demonstration")
+    if task in PLANNED_PARTS:
+        return err, yaw, task
+    from teachfit.cli.geometry_progress import geometry_progress
+    from teachfit.tasks.registry import load_task
+
+    # a bad task (file) before any output; its name is what a model learned on it records
+    # (a task file of a built-in kind is that kind): matched as search run matches it
+    with geometry_progress(f"loading task {task}"):
+        return err, yaw, load_task(task).name
+
+
+def _report_trials(out: list[AssemblyTrial]) -> bool:
+    """The table of the finished trials, their success and the reason of each the robot
+    stopped; whether the robot faulted in any."""
+    from teachfit.metrics.stats import summarize
+
     _print_trials(
         "taught offset (mm)",
         [
@@ -146,18 +163,13 @@ def assemble(
     s = summarize([t.success for t in out], [t.time for t in out])
     searched = sum("search" in t.nodes for t in out)
     console.print(f"success {s}; the search ran in {searched}/{len(out)} trial(s)")
-    faulted = report_faults(((t.index, *t.reason.partition(": ")[::2]) for t in out), "trial")
-    if log is not None or rrd is not None:
-        info = ("assemble", task, robot, seed, f"{method} {skill} {controller}")
-        opts = {
-            "task": task, "search": search, "skill": skill, "hole_error": hole_error,
-            "yaw_error": yaw_error, "trials": trials, "params": params,
-            "controller": controller, "seed": seed, "robot": robot,
-        }  # fmt: skip
-        write_recordings(log, rrd, [t.result for t in out], info, opts)
-    if (plot is None and video is None) or not finished.complete:
-        return end_run(finished, faulted, "trial")
-    pick = next((t for t in out if "search" in t.nodes and t.success), out[0])
+    return report_faults(((t.index, *t.reason.partition(": ")[::2]) for t in out), "trial")
+
+
+def _trial_figures(
+    pick: AssemblyTrial, task: str, plot: Path | None, video: Path | None, robot: str
+) -> None:
+    """``--plot`` (phases over time) and ``--render`` (a video) of trial ``pick``."""
     assert pick.result is not None
     if plot is not None:
         from teachfit.viz.assembly_figures import plot_phases
@@ -171,7 +183,6 @@ def assemble(
         with console.status("rendering"):
             path = render_motion(get_task(task), log.t, log.pos, log.quat, video, robot=robot)
         console.print(f"video of trial {pick.index} -> {path}")
-    exit_if_faulted(faulted)
 
 
 @guarded
@@ -205,7 +216,7 @@ def bench_assembly(
     ] = "skill,search,open-loop,joined",
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
-    from teachfit.bench.assembly import bench_inputs, bench_plan_task, bench_task, losses
+    from teachfit.bench.assembly import bench_inputs, bench_task
     from teachfit.execution.assembly import METHODS
 
     errs = [parse_quantity(e) for e in errors.split(",") if e.strip()]
@@ -216,16 +227,7 @@ def bench_assembly(
         raise TeachfitError(f"--methods: choose from {', '.join(METHODS)} (got {methods!r})")
     for name in names:
         if name in ("l-groove", "tenon"):
-            with progress_bar() as bar:
-                job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
-                rows, meas = bench_plan_task(name, trials, seed, lambda j=job: bar.advance(j))
-            for m, pts in rows.items():
-                console.print(
-                    f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
-                    f"inserted {pts[0][1]} (end time); measured success {meas[m]}/{trials}"
-                )
-            for line in losses(rows):
-                console.print(f"  [yellow]joined does not beat[/] {line}")
+            _bench_planned(name, trials, seed)
             continue
         with progress_bar() as bar:
             job = bar.add_task(f"{name}: demonstrations, then trials")
@@ -233,23 +235,46 @@ def bench_assembly(
                 name, errs, trials, seed, workers, lambda j=job: bar.advance(j),
                 model=model, learned=learned, methods=chosen,
             )  # fmt: skip
-        table = Table(title=f"{name}: success [Wilson 95 %], median time", title_justify="left")
-        table.add_column("error (mm)", justify="right")
-        for method in rows:
-            table.add_column(method)
-        for i, e in enumerate(errs):
-            table.add_row(f"{e * 1e3:g}", *(str(rows[m][i][1]) for m in rows))
-        console.print(table)
-        for line in losses(rows) if "joined" in rows else ():
-            console.print(f"  [yellow]joined does not beat[/] {line}")
-        for line in losses(rows, "joined-learned") if learned else ():
-            console.print(f"  [yellow]joined-learned does not beat[/] {line}")
+        _print_bench(name, rows, errs, bool(learned))
         if plot is not None:
             from teachfit.viz.assembly_figures import plot_success_by_error
 
             path = plot.with_name(f"{plot.stem}-{name}{plot.suffix}")
             title = f"{name}: success against the taught-hole error, {trials} trials, seed {seed}"
             console.print(f"figure -> {plot_success_by_error(rows, path, title)}")
+
+
+def _bench_planned(name: str, trials: int, seed: int) -> None:
+    """``bench assembly`` on a planned part: open loop vs joined, one line each."""
+    from teachfit.bench.assembly import bench_plan_task, losses
+
+    with progress_bar() as bar:
+        job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
+        rows, meas = bench_plan_task(name, trials, seed, lambda j=job: bar.advance(j))
+    for m, pts in rows.items():
+        console.print(
+            f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
+            f"inserted {pts[0][1]} (end time); measured success {meas[m]}/{trials}"
+        )
+    for line in losses(rows):
+        console.print(f"  [yellow]joined does not beat[/] {line}")
+
+
+def _print_bench(name: str, rows: Rows, errs: list[float], learned: bool) -> None:
+    """``bench assembly``'s table of a peg-type task and where the joined skill loses."""
+    from teachfit.bench.assembly import losses
+
+    table = Table(title=f"{name}: success [Wilson 95 %], median time", title_justify="left")
+    table.add_column("error (mm)", justify="right")
+    for method in rows:
+        table.add_column(method)
+    for i, e in enumerate(errs):
+        table.add_row(f"{e * 1e3:g}", *(str(rows[m][i][1]) for m in rows))
+    console.print(table)
+    for line in losses(rows) if "joined" in rows else ():
+        console.print(f"  [yellow]joined does not beat[/] {line}")
+    for line in losses(rows, "joined-learned") if learned else ():
+        console.print(f"  [yellow]joined-learned does not beat[/] {line}")
 
 
 def _print_trials(error_col: str, rows: list[tuple[Any, str, str, Sequence[str]]]) -> None:
@@ -280,51 +305,53 @@ def _assemble_plan(
     ``rec``: the run log and Rerun targets and the options they record."""
     import numpy as np
 
-    from teachfit.execution.plan_contact import (
-        PAPER_ROBOT,
-        PlanTrial,
-        plan_path,
-        run_plan_trials,
-        timed_path,
-        trial_cell,
-    )
-    from teachfit.metrics.stats import summarize
+    from teachfit.execution.assembly_run import capture_ranges, planned_path
+    from teachfit.execution.assembly_run import run_plan_trials_keeping as run_trials
 
     if trials < 1:
         raise TeachfitError(f"--trials must be >= 1, got {trials}")
-    lo_t, lo_r = min(0.0005, err), min(np.radians(0.5), ang)
-    ranges = {"translation": (lo_t, err), "rotation": (lo_r, ang)}
+    ranges = capture_ranges(err, ang)
     d = None
     if demo is not None:
         from teachfit.cli.plan_cmd import _load_demo
 
-        d = _load_demo(str(demo))
+        d = cast("Demonstration", _load_demo(str(demo)))
         if getattr(d, "task", part) != part:
             raise TeachfitError(f"{demo}: a demonstration of {d.task!r}, not {part!r}")
     with console.status("planning"):
-        plan = plan_path(part, d, seed)  # type: ignore[arg-type]
-    if not plan.success:
-        raise TeachfitError(f"no plan for {part}: {plan.message}")
-    path = timed_path(part, plan)
+        plan, path = planned_path(part, d, seed)
+    (lo_t, _), (lo_r, _) = ranges["translation"], ranges["rotation"]
     console.print(
         f"{part}: plan in {plan.time_s:.2f} s with {plan.used_key_poses}/{plan.candidates} key "
         f"poses ({'demo ' + str(demo) if demo else 'synthetic demo'}), {path.duration:.1f} s "
         f"path; capture error {lo_t * 1e3:g}-{err * 1e3:g} mm, "
         f"{np.degrees(lo_r):g}-{np.degrees(ang):g} deg"
     )
-    finished: Finished[PlanTrial] = Finished(total=trials)
-    with keeping(finished), progress_bar() as bar:
+    with progress_bar() as bar:
         job = bar.add_task("executing in contact", total=trials)
-
-        def done(trial: PlanTrial) -> None:
-            finished.add(trial)
-            bar.advance(job)
-
-        run_plan_trials(part, path, trials, seed, on_trial=done, **ranges)
+        finished = run_trials(part, path, trials, seed, lambda: bar.advance(job), **ranges)
     out = finished.items
     if not out:
         console.print("no trial finished")
         return end_run(finished, what="trial")
+    faulted = _report_plan_trials(part, out)
+    if rec[0] is not None or rec[1] is not None:
+        info = ("assemble", part, "floating", seed, "plan in contact + seating")
+        write_recordings(rec[0], rec[1], [t.result for t in out], info, rec[2])
+    if not finished.complete:
+        return end_run(finished, faulted, "trial")
+    _plan_figures(out[0], plot, video, part, seed, ranges)
+    exit_if_faulted(faulted)
+
+
+def _report_plan_trials(part: str, out: list[PlanTrial]) -> bool:
+    """The table of a planned part's finished trials, their success beside the paper's robot
+    and the reason of each the robot stopped; whether the robot faulted in any."""
+    import numpy as np
+
+    from teachfit.execution.plan_contact import PAPER_ROBOT
+    from teachfit.metrics.stats import summarize
+
     _print_trials(
         "error (mm, deg)",
         [
@@ -344,18 +371,24 @@ def _assemble_plan(
         f"success {s}; ground truth {truth}/{len(out)}; the paper's robot, open loop: {ok}/{n}"
     )
     rows = ((t.index, t.result.outcome.value, t.result.reason) for t in out)
-    faulted = report_faults(rows, "trial")
-    if rec[0] is not None or rec[1] is not None:
-        info = ("assemble", part, "floating", seed, "plan in contact + seating")
-        write_recordings(rec[0], rec[1], [t.result for t in out], info, rec[2])
-    if not finished.complete:
-        return end_run(finished, faulted, "trial")
-    pick = out[0]
+    return report_faults(rows, "trial")
+
+
+def _plan_figures(
+    pick: PlanTrial,
+    plot: Path | None,
+    video: Path | None,
+    part: str,
+    seed: int,
+    ranges: dict[str, tuple[float, float]],
+) -> None:
+    """``--plot`` (phases over time) and ``--render`` (a video in its cell) of trial 0."""
     if plot is not None:
         from teachfit.viz.assembly_figures import plot_phases
 
         console.print(f"phases of trial 0 -> {plot_phases(pick.result, plot)}")
     if video is not None:
+        from teachfit.execution.plan_contact import trial_cell
         from teachfit.viz.video import render_motion
 
         log = pick.result.log
@@ -363,4 +396,3 @@ def _assemble_plan(
         with console.status("rendering"):
             path_mp4 = render_motion(cell, log.t, log.pos, log.quat, video)
         console.print(f"video of trial 0 -> {path_mp4}")
-    exit_if_faulted(faulted)

@@ -23,8 +23,7 @@ from teachfit.cli.common import (
 from teachfit.cli.recording import show_run_log
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import DatasetError, TeachfitError
-from teachfit.demonstrations.column_map import ColumnMap, bare
-from teachfit.demonstrations.csv_import import read_csv_log
+from teachfit.demonstrations.column_map import bare
 from teachfit.demonstrations.dataset import (
     append_dataset,
     check_appendable,
@@ -36,8 +35,8 @@ from teachfit.demonstrations.dataset import (
 from teachfit.demonstrations.export import export_csv
 from teachfit.demonstrations.frames import FrameTransform
 from teachfit.demonstrations.importing import ImportOptions, ImportResult, build_demos
+from teachfit.demonstrations.log_reading import LogSource, read_robot_log
 from teachfit.demonstrations.plausibility import CHECKS
-from teachfit.demonstrations.rosbag_import import is_bag, read_bag
 from teachfit.demonstrations.segment import Segmenter
 from teachfit.execution.recording import is_run_log
 from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
@@ -132,6 +131,7 @@ def _option(flag: str, build: Callable[..., T], *args: Any) -> T:
 
 @app.command("import")
 @guarded
+# Long (> 60 lines) only by its options' declarations: the body checks, reads, imports, prints
 def import_(
     log: Annotated[
         Path, typer.Argument(help="robot log: CSV, ROS 1 .bag, ROS 2 bag folder, .db3 or .mcap")
@@ -188,42 +188,12 @@ def import_(
         raise TeachfitError(f"--out {out} is a folder: give a file name such as {out / 'demos.h5'}")
     _not_an_input(out, log, columns)
     frame = None if transform is None else _option("--transform", FrameTransform.parse, transform)
-    if is_bag(log):
-        if pose_topic is None:
-            raise TeachfitError(f"{log} is a bag: give --pose-topic (and --wrench-topic)")
-        if rate is not None:
-            raise TeachfitError(f"{log} is a bag: its header stamps give the time, drop --rate")
-        raw = read_bag(
-            log, pose_topic, wrench_topic, wrench_sign=wrench_sign, child_frame=child_frame
-        )
-    else:
-        bag_only = {
-            "--pose-topic": pose_topic,
-            "--wrench-topic": wrench_topic,
-            "--child-frame": child_frame,
-            "--wrench-sign": None if wrench_sign == 1 else 1,
-        }
-        given = [option for option, value in bag_only.items() if value is not None]
-        if given:
-            raise TeachfitError(
-                f"{given[0]} is for ROS bags; {log} is read as CSV with the map {columns}"
-                + (" (set wrench_sign there)" if given[0] == "--wrench-sign" else "")
-            )
-        the_map = ColumnMap.from_toml(columns, rate_hz=rate)
-        frame = frame or the_map.transform
-        raw = read_csv_log(log, the_map)
+    source = LogSource(columns, rate, pose_topic, wrench_topic, wrench_sign, child_frame)
+    raw, frame = read_robot_log(log, source, frame)
     segmenter = None
     if segment is not None:
-        segmenter = _option(
-            "--segment",
-            Segmenter,
-            segment,
-            window,
-            force_threshold,
-            force_off,
-            min_duration,
-            marker_value,
-        )
+        cut = (segment, window, force_threshold, force_off, min_duration, marker_value)
+        segmenter = _option("--segment", Segmenter, *cut)
     accepted = frozenset(accept or ()) | ({"all"} if accept_implausible else set())
     options = ImportOptions(transform=frame, accept=accepted, segmenter=segmenter)
     result = build_demos(raw, task=task, name=name or log.stem, options=options)

@@ -17,10 +17,10 @@ from teachfit.cli.run_end import end_run, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
-from teachfit.execution.batch import Finished, keeping
 
 if TYPE_CHECKING:
     from teachfit.execution.search import SearchRun
+    from teachfit.tasks.base import Task
 
 search_app = typer.Typer(
     help="Plan and run search trajectories learned from blind demonstrations (Ehlers et al. 2019).",
@@ -136,6 +136,7 @@ def plan(
 
 @search_app.command("run")
 @guarded
+# Long (> 60 lines) only by its options' declarations: the body checks, runs the searches, prints
 def run(
     ctx: typer.Context,
     task: Annotated[str, o.task()] = "peg2d",
@@ -171,7 +172,7 @@ def run(
     cut short (lost connection, Ctrl-C) prints and logs what finished; see the README.
     """
     points = o.pick(points, n)
-    from teachfit.execution.search import run_protocol
+    from teachfit.execution.search_runs import demo_start_pose, run_protocol_keeping
     from teachfit.models.search_model import SearchModel
     from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
@@ -179,34 +180,19 @@ def run(
     check_recording_targets(log, rrd)
     the_task = load_task(task)
     model = SearchModel.load(model_file, task=the_task.name)
-    demo_start = None
-    if demo is not None:
-        from teachfit.demonstrations.dataset import read_demo
-
-        d = read_demo(demo)
-        if d.task != the_task.name:
-            raise TeachfitError(
-                f"--demo {demo} is a {d.task!r} demonstration, not {the_task.name!r}"
-            )
-        demo_start = d.start_pose
-    elif protocol == "table1":
+    demo_start = None if demo is None else demo_start_pose(demo, the_task.name)
+    if demo is None and protocol == "table1":
         console.print(
             "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
             "the hole; without --demo a nominal demonstration start is assumed"
         )
     the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime))
-    finished: Finished[SearchRun] = Finished(total=starts)
-    with keeping(finished):
-        try:
-            with progress_bar() as bar:
-                job = bar.add_task(f"{method} from {starts} starts", total=starts)
-                run_protocol(
-                    the_robot, the_task, model, method, points, starts, protocol, seed,
-                    passes=passes, feedforward=feedforward, demo_start=demo_start,
-                    on_done=lambda run: (finished.add(run), bar.advance(job)),
-                )  # fmt: skip
-        finally:
-            the_robot.close()
+    with progress_bar() as bar:
+        job = bar.add_task(f"{method} from {starts} starts", total=starts)
+        finished = run_protocol_keeping(
+            the_robot, the_task, model, method, points, starts, protocol, seed, passes=passes,
+            feedforward=feedforward, demo_start=demo_start, progress=lambda: bar.advance(job),
+        )  # fmt: skip
     runs = finished.items
     n_pts = f", N = {points}" if method == "tshix" else ""
     title = f"{method}{n_pts} on {the_task.name} ({protocol} starts, seed {seed})"
@@ -216,13 +202,17 @@ def run(
     elif log is not None or rrd is not None:
         console.print("no run log written")
     if plot is not None and runs and finished.complete:
-        from teachfit.viz.figures import plot_executions
-
-        paths = [(r.result.log.pos, r.result.success) for r in runs]
-        title = f"{method}{n_pts}, seed {seed}, {protocol} starts"
-        plot_executions(paths, plot, the_task, title=title)
-        console.print(f"figure -> {plot}")
+        _plot_runs(runs, plot, the_task, f"{method}{n_pts}, seed {seed}, {protocol} starts")
     end_run(finished, faulted)
+
+
+def _plot_runs(runs: list[SearchRun], plot: Path, task: Task, title: str) -> None:
+    """``--plot``: the executed paths over the hole, successes marked."""
+    from teachfit.viz.figures import plot_executions
+
+    paths = [(r.result.log.pos, r.result.success) for r in runs]
+    plot_executions(paths, plot, task, title=title)
+    console.print(f"figure -> {plot}")
 
 
 def _print_runs(runs: list[SearchRun], title: str) -> bool:

@@ -15,7 +15,6 @@ from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, writ
 from teachfit.cli.run_end import end_run, report_faults
 from teachfit.cli.tables import print_table
 from teachfit.core.atomic import atomic_write_text
-from teachfit.execution.batch import run_batch_keeping
 
 if TYPE_CHECKING:
     from teachfit.execution.engine import ExecutionResult
@@ -121,7 +120,7 @@ def run(
     Exit status: 0, or 1 when the robot stopped an execution (each reason is printed); a run
     cut short (lost connection, Ctrl-C) prints and logs what finished; see the README."""
     from teachfit.core.errors import SkillError
-    from teachfit.execution.recording import Episode
+    from teachfit.execution.skill_runs import hole_estimate_error, run_starts, start_episodes
     from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
     from teachfit.skills.library import get_skill
     from teachfit.tasks.registry import load_task
@@ -136,26 +135,19 @@ def run(
     learned = _learned(params, setup)
     trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host, realtime))
     try:
-        est = setup.task2world.inverse().compose(the_task.hole2world)
+        est = hole_estimate_error(setup)
         console.print(
             f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate "
             f"off by ({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, yaw {est.rz:+.3f} rad"
         )
         with console.status(f"running {starts} execution(s)"):
-            finished = run_batch_keeping(
-                lambda i: trial.run(learned, setup.starts[i], setup.frame(i)), range(starts), 0
-            )
-        traces = finished.items
-        faulted = _report(trial, traces)
-        episodes = [
-            Episode.of_skill(tr, setup.skill, st)
-            for tr, st in zip(traces, setup.starts, strict=False)
-        ]
+            finished = run_starts(trial, learned, starts)
+        faulted = _report(trial, finished.items)
         info = ("skill", the_task, robot, seed, f"{skill} {controller}")
-        _record(log, rrd, episodes, info, ctx.params)
+        _record(log, rrd, start_episodes(setup, finished.items), info, ctx.params)
         if finished.complete:
             figures = (plot, render, render_start, (fps, width, height))
-            _figures(trial, traces, figures, f"{controller} controller, seed {seed}")
+            _figures(trial, finished.items, figures, f"{controller} controller, seed {seed}")
         end_run(finished, faulted)
     finally:
         trial.robot.close()
