@@ -130,3 +130,19 @@ def test_the_prose_speaks_of_the_project_not_of_work_sessions() -> None:
         if word.search(line)
     ]
     assert not hits, f"work sessions named in {hits}"
+
+
+def test_the_code_names_the_papers_by_their_authors_and_no_work_sessions() -> None:
+    """Docstrings, comments and tests say "Ehlers et al. 2019", not the jargon "seed A"."""
+    jargon = re.compile(r"\b(seed [ABC]|seed_[abc])\b|\bsession \d", re.IGNORECASE)
+    files = [*sorted((ROOT / "src").rglob("*.py")), *sorted((ROOT / "tests").rglob("*.py"))]
+    files += [*sorted((ROOT / "benchmarks").glob("*.py")), ROOT / "README.md"]
+    this = Path(__file__).resolve()
+    hits = [
+        f"{path.relative_to(ROOT)}:{n}"
+        for path in files
+        if path.resolve() != this
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1)
+        if jargon.search(line)
+    ]
+    assert not hits, f"jargon in {hits}"

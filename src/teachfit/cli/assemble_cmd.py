@@ -1,4 +1,4 @@
-"""``teachfit assemble`` and ``teachfit bench assembly``: the three seeds joined."""
+"""``teachfit assemble`` and ``teachfit bench assembly``: the three methods joined."""
 
 from __future__ import annotations
 

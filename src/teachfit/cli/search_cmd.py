@@ -1,4 +1,4 @@
-"""``teachfit learn search`` and ``teachfit search ...``: seed A's method from the CLI."""
+"""``teachfit learn search`` and ``teachfit search ...``: Ehlers et al.'s method from the CLI."""
 
 from __future__ import annotations
 

@@ -1,9 +1,9 @@
-"""Execute learned search trajectories (seed A): search frame -> world set-points + GMR
+"""Execute learned search trajectories (Ehlers et al. 2019): search frame -> world set-points + GMR
 feed-forward -> impedance runner, and the batch protocols used by the CLI and benchmarks.
 
 The search frame has its origin at the start pose; its axes are the world's (positions are
-only translated) and ``rz`` adds to the start's yaw, as in seed A where each demonstration is
-translated so that its first pose is the origin.
+only translated) and ``rz`` adds to the start's yaw, as in Ehlers et al. 2019 where each
+demonstration is translated so that its first pose is the origin.
 """
 
 from __future__ import annotations
@@ -46,8 +46,8 @@ def search_setpoints(
     """World set-points for a search trajectory started at ``start``.
 
     With ``model``, the feed-forward wrench is the GMR conditional mean of the action given the
-    planned step (seed A, Sec. III-C), mapped onto the searched wrench components; its x-y
-    force is projected onto the step's x-y direction, never below ``friction_floor`` (N)
+    planned step (Ehlers et al. 2019, Sec. III-C), mapped onto the searched wrench components; its
+    x-y force is projected onto the step's x-y direction, never below ``friction_floor`` (N)
     while moving (:func:`along_motion`).
     """
     states = np.asarray(traj.states, dtype=float)
@@ -136,12 +136,12 @@ def plan_search(
     ``length`` (m, rz weighted by the planner's length scale) or as a TSHIX pass through
     ``n_points`` samples; ``"ergodic-opt"`` then lowers its ergodic metric by trajectory
     optimisation (:func:`~teachfit.trajectories.ergodic_opt.optimise_ergodic`). ``sampling``
-    is TSHIX's sampler (``"qmc"`` or seed A's i.i.d. ``"random"``). The baselines span the
+    is TSHIX's sampler (``"qmc"`` or Ehlers et al.'s i.i.d. ``"random"``). The baselines span the
     exploration distribution's 2-sigma radius (and, for rz, its 2-sigma rz range).
 
     ``passes > 1`` (TSHIX only) appends re-sampled passes of ``n_points`` fresh samples, each
-    starting where the previous one ends (seed A's re-sampling): the runner stops at insertion,
-    so a pass is only executed when every pass before it failed.
+    starting where the previous one ends (Ehlers et al.'s re-sampling): the runner stops at
+    insertion, so a pass is only executed when every pass before it failed.
     """
     _check_plan(method, n_points, passes)
     if method == "tshix":
@@ -318,9 +318,9 @@ def run_protocol(
     config: FollowConfig | None = None,
     on_done: Callable[[SearchRun], None] | None = None,
 ) -> list[SearchRun]:
-    """Seed A's protocol: ``n_starts`` starts of the task's ``protocol`` (drawn with ``seed``;
-    Table I's lie halfway between ``demo_start`` and the hole), a ``method`` search from each,
-    TSHIX planned with :func:`~teachfit.execution.batch.episode_rng` ``(seed, i)`` (an ergodic
+    """Ehlers et al.'s protocol: ``n_starts`` starts of the task's ``protocol`` (drawn with
+    ``seed``; Table I's lie halfway between ``demo_start`` and the hole), a ``method`` search from
+    each, TSHIX planned with :func:`~teachfit.execution.batch.episode_rng` ``(seed, i)`` (an ergodic
     trajectory is deterministic: planned once); ``on_done`` after each run."""
     if n_starts < 1:
         raise TeachfitError(f"number of starts must be >= 1, got {n_starts}")

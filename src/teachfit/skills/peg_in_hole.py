@@ -1,4 +1,5 @@
-"""The peg-in-hole skill of seed B (Sec. III-A, Fig. 3) and its context from a task.
+"""The peg-in-hole skill of Johannsmeier et al. 2019 (Sec. III-A, Fig. 3) and its context from a
+task.
 
 Task frame: the *estimated* hole frame (origin at the estimated hole entry, z out of the
 surface); the lateral move runs along its +x. Five primitives:
@@ -246,8 +247,8 @@ def _recovery(fast: dict[str, str]) -> Node:
 class HoleContext:
     """What the task context gives the skill: the estimated hole frame, the true goal,
     context parameter values, learned parameters the task fixes (``fixed``: name -> value,
-    e.g. the key's initial tilt, which seed B does not learn) and learned parameters it
-    bounds tighter (``domains``: name -> domain, e.g. the key's largest rotational
+    e.g. the key's initial tilt, which Johannsmeier et al. 2019 does not learn) and learned
+    parameters it bounds tighter (``domains``: name -> domain, e.g. the key's largest rotational
     amplitude; ``bound``: who bounds them and how to widen them, for error messages)."""
 
     hole2world_est: Pose
@@ -259,7 +260,8 @@ class HoleContext:
 
 
 #: error of the hole-pose estimate when a task has no ``estimated_hole`` of its own
-#: (standard deviations: x, y (m), z (m), rz (rad)) -- a taught pose, seed B: < 1 mm
+#: (standard deviations: x, y (m), z (m), rz (rad)) -- a taught pose, Johannsmeier et al. 2019: < 1
+#: mm
 HOLE_ERROR = (0.0007, 0.0002, 0.02)
 
 
@@ -310,9 +312,9 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
 
 
 def default_starts(task: Task, n: int, rng: np.random.Generator) -> list[Pose]:
-    """``n`` slightly different start poses above the hole: the task's own seed-B starts
-    (``skill_starts(rng)``, four, or its ``"skill"`` protocol for other ``n``) if it has them,
-    else 25 mm above the surface at +-4 mm around the true hole (corners of a square, 1 mm
+    """``n`` slightly different start poses above the hole: the task's own Johannsmeier et al.
+    starts (``skill_starts(rng)``, four, or its ``"skill"`` protocol for other ``n``) if it has
+    them, else 25 mm above the surface at +-4 mm around the true hole (corners of a square, 1 mm
     jitter), yaw jitter +-0.05 rad where the yaw matters."""
     own = getattr(task.protocol, "skill_starts", None)
     if callable(own):
