@@ -193,6 +193,8 @@ def _kill_pool(pool: ProcessPoolExecutor) -> None:
         proc.terminate()
 
 
+# Long (> 60 lines) by its docstring, which states the claim protocol; the pool loop is
+# _PoolRun.
 def run_study(
     study: Study,
     objective: Objective,

@@ -45,6 +45,8 @@ def _check_data(x: np.ndarray, what: str) -> np.ndarray:
     return x
 
 
+# Long (> 60 lines) by its numpydoc docstring; the body (the BIC loop over component counts)
+# is one step.
 def fit_regularised_gmm(
     x: np.ndarray,
     abs_floor: np.ndarray,

@@ -175,6 +175,7 @@ def ergodic_metric(
     )
 
 
+# Long (> 60 lines) by its numpydoc docstring; the integration is _smc_path.
 def ergodic_trajectory(
     exploration: ExplorationDistribution,
     *,

@@ -70,6 +70,8 @@ def ergodic_cost_and_gradient(
     return e, grad * w[:, None] / size
 
 
+# Long (> 60 lines) by its docstring; the cost is _Cost, the body sets it up and
+# re-times the result.
 def optimise_ergodic(
     initial: SearchTrajectory,
     exploration: ExplorationDistribution,
