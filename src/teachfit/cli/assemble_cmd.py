@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, cast
 
@@ -232,7 +233,7 @@ def bench_assembly(
         with progress_bar() as bar:
             job = bar.add_task(f"{name}: demonstrations, then trials")
             rows = bench_task(
-                name, errs, trials, seed, workers, lambda j=job: bar.advance(j),
+                name, errs, trials, seed, workers, partial(bar.advance, job),
                 model=model, learned=learned, methods=chosen,
             )  # fmt: skip
         _print_bench(name, rows, errs, bool(learned))
@@ -250,7 +251,7 @@ def _bench_planned(name: str, trials: int, seed: int) -> None:
 
     with progress_bar() as bar:
         job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
-        rows, meas = bench_plan_task(name, trials, seed, lambda j=job: bar.advance(j))
+        rows, meas = bench_plan_task(name, trials, seed, partial(bar.advance, job))
     for m, pts in rows.items():
         console.print(
             f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
@@ -299,7 +300,7 @@ def _assemble_plan(
     seed: int,
     plot: Path | None,
     video: Path | None,
-    rec: tuple[Path | None, Path | None, dict[str, object]] = (None, None, {}),
+    rec: tuple[Path | None, Path | None, Mapping[str, object]] = (None, None, {}),
 ) -> None:
     """demonstration -> plan -> path executed in contact -> seating skill, over trials;
     ``rec``: the run log and Rerun targets and the options they record."""

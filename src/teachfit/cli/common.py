@@ -64,7 +64,7 @@ WidthOpt = Annotated[int, count_option("video width (pixels)", low=16, high=7680
 HeightOpt = Annotated[int, count_option("video height (pixels)", low=16, high=4320)]
 
 
-def robot_options(host: str | None, realtime: bool = True) -> dict[str, object]:
+def robot_options(host: str | None, realtime: bool = True) -> dict[str, Any]:
     """The ``make_robot`` options the CLI's ``--host``/``--no-realtime`` give (none for
     simulated robots)."""
     return {} if host is None else {"host": host, "realtime": realtime}

@@ -78,7 +78,8 @@ def record(
         arm = make_robot(robot, the_task, **robot_options(host, realtime))
         try:
             console.print("guide the arm; Ctrl-C ends the recording")
-            demos, discarded = [record_demonstration(arm, the_task.name, duration)], []
+            demos = [record_demonstration(arm, the_task.name, duration)]
+            discarded: list[str] = []
         finally:
             arm.close()
     else:

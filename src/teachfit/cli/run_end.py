@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import signal
 from collections.abc import Iterable
+from typing import Any
 
 import typer
 from rich.markup import escape
@@ -80,7 +81,7 @@ def _stop_line(finished: Finished[object], what: str) -> tuple[str, int]:
     return f"{head}: {exc}", status
 
 
-def end_run(finished: Finished[object], faulted: bool = False, what: str = "execution") -> None:
+def end_run(finished: Finished[Any], faulted: bool = False, what: str = "execution") -> None:
     """End the command as the module docstring says, after its table and its ``--log``.
 
     Returns when the run completed and ``faulted`` is false (status 0); raises

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Literal
 
 import numpy as np
 import typer
@@ -57,7 +57,7 @@ def learn_search(
     tasks = {d.task for d in demo_list}
     if len(tasks) != 1:
         raise TeachfitError(f"{demos} mixes tasks {sorted(tasks)}; learn one task at a time")
-    n_comp: int | str = components if components == "bic" else int(components)
+    n_comp: int | Literal["bic"] = "bic" if components == "bic" else int(components)
     model = SearchModel.fit(
         demo_list,
         tasks.pop(),

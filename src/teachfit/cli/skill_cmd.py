@@ -75,11 +75,10 @@ def show(
     lrn = Table(title="learned parameters", title_justify="left")
     for col in ("name", "default", "low", "high", "unit", "meaning"):
         lrn.add_column(col)
-    for name, p in sk.params.learned.items():
-        scale = " (log)" if p.domain.log else ""
-        lrn.add_row(
-            name, _num(p.default), _num(p.domain.low), _num(p.domain.high) + scale, p.unit, p.doc
-        )
+    for name, lp in sk.params.learned.items():
+        scale = " (log)" if lp.domain.log else ""
+        dom = lp.domain
+        lrn.add_row(name, _num(lp.default), _num(dom.low), _num(dom.high) + scale, lp.unit, lp.doc)
     print_table(lrn)
     if toml is not None:
         atomic_write_text(toml, skill_to_toml(sk), "skill file")

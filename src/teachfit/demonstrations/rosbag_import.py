@@ -245,6 +245,7 @@ def _read_streams(
     from rosbags.typesys import Stores, get_typestore
 
     where = str(path)
+    damaged: tuple[type[BaseException], ...] = (AnyReaderError, *_bag_errors())
     try:
         with AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
             poses = _read_topic(reader, pose_topic, POSE_TYPES, where, child_frame)
@@ -252,7 +253,7 @@ def _read_streams(
             if wrench_topic is not None:
                 wrenches = _read_topic(reader, wrench_topic, (WRENCH_TYPE,), where, None)
             generation = "ros2" if reader.is2 else "ros1"
-    except (AnyReaderError, *_bag_errors()) as exc:
+    except damaged as exc:
         text = " ".join(str(exc).split())[:200] or type(exc).__name__
         raise DatasetError(
             f"cannot read as a ROS bag ({text}): a bag cut short or damaged while recording can "

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -178,7 +179,7 @@ def _plan_ergodic(
     samples), optimised for ``"ergodic-opt"``."""
     if length is None:
         planner = TshixPlanner.from_model(model, sampling=sampling)
-        length = planner.plan(n_points, rng).path_length(planner.length_scale)
+        length = planner.plan(n_points, rng).path_length(cast(float, planner.length_scale))
     traj = ergodic_trajectory(
         model.exploration,
         speed=model.speed,
@@ -265,7 +266,7 @@ def _tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
     return TiltConfig(
         angle=angle,
         retry_angle=None if jam_free is None or jam_free >= angle else float(jam_free),
-        drop_depth=0.5 * float(task.search_hold_depth),
+        drop_depth=0.5 * float(getattr(task, "search_hold_depth", 0.0)),
         lateral_reach=p.peg_diameter + p.clearance,
         stall_lag=wedge_lag(angle, p.friction, load, stiffness),
         off_depth=tilted_drop(angle, p.peg_diameter, p.clearance) + p.hole_chamfer + OFF_MARGIN,

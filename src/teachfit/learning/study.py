@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import optuna
-from optuna.distributions import FloatDistribution
+from optuna.distributions import BaseDistribution, FloatDistribution
 from optuna.exceptions import StorageInternalError
 from sqlalchemy.exc import DBAPIError
 
@@ -247,7 +247,7 @@ class Study:
             ),
             what=what,
         )
-        self._dists = {
+        self._dists: dict[str, BaseDistribution] = {
             n: FloatDistribution(d.low, d.high, log=d.log) for n, d in self.space.domains.items()
         }
         #: SQLite: id of the last trial read (-1: none yet); None: read all every time
@@ -284,7 +284,8 @@ class Study:
         # SQLite serialises its writers (BEGIN IMMEDIATE) and trials are stored finished, so
         # trial ids become visible in order: read only those above the last one seen. (A full
         # read costs ~1 ms per stored trial, once a second: ~15 % of a learning run's CPU.)
-        new = _retry(lambda: self._rdb._get_trials(sid, None, set(), self._read_above))
+        above = self._read_above
+        new = _retry(lambda: self._rdb._get_trials(sid, None, set(), above))
         if any(t.state != complete for t in new):  # written by something else: read it all
             self._read_above, self._read = None, []
             return self._finished_trials()

@@ -34,6 +34,7 @@ its square).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TypedDict
 
 import numpy as np
 
@@ -131,14 +132,24 @@ def build(controller: str = "adaptive") -> Skill:
     )
 
 
-def _fast() -> dict[str, str]:
+class _Speeds(TypedDict):
+    """A free motion's speed and acceleration limits, as the parameters that set them."""
+
+    v_max: str
+    a_max: str
+    w_max: str
+    dw_max: str
+    speed_factor: str
+
+
+def _fast() -> _Speeds:
     """The speed and acceleration limits of a free motion, by parameter name."""
-    return dict(
+    return _Speeds(
         v_max="v_max", a_max="a_max", w_max="w_max", dw_max="dw_max", speed_factor="speed_factor"
     )
 
 
-def _reach_nodes(fast: dict[str, str], roi: LateralAbove) -> tuple[Node, ...]:
+def _reach_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
     """``approach``, ``contact`` and ``lateral``: from the approach pose down onto the surface
     and sideways until the part is caught by the hole (``roi``: left the region of interest)."""
     return (
@@ -181,7 +192,7 @@ def _reach_nodes(fast: dict[str, str], roi: LateralAbove) -> tuple[Node, ...]:
     )
 
 
-def _insert_nodes(fast: dict[str, str], roi: LateralAbove) -> tuple[Node, ...]:
+def _insert_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
     """``align`` and ``insert``: upright into the hole orientation, then pushed in."""
     return (
         Node(
@@ -232,7 +243,7 @@ def _transitions() -> tuple[Transition, ...]:
     )
 
 
-def _recovery(fast: dict[str, str]) -> Node:
+def _recovery(fast: _Speeds) -> Node:
     """Retract ``retract_height`` up from wherever the error happened."""
     return Node(
         "retract",
@@ -276,8 +287,10 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
         return pose
     s_xy, s_z, s_rz = HOLE_ERROR
     yaw_matters = "rz" in getattr(task, "search_dims", ()) or getattr(task, "rz_period", 0) > 0
+    dx, dy = rng.normal(0.0, s_xy, 2)
     err = Pose.from_xyz_rz(
-        *rng.normal(0.0, s_xy, 2),
+        dx,
+        dy,
         rng.normal(0.0, s_z),
         rng.normal(0.0, s_rz) if yaw_matters else 0.0,
     )
