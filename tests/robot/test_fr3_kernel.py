@@ -6,6 +6,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from teachfit.control import compiled
 from teachfit.core.state import ImpedanceCommand
 from teachfit.robot.fr3 import FR3Robot, kernel
 from teachfit.tasks import get_task
@@ -71,3 +72,10 @@ def test_the_robot_keeps_each_executions_joint_torques(task):
     assert first[1].shape == (3, 7) and second[1].shape == (5, 7)
     np.testing.assert_allclose(second[0], np.arange(1, 6) * 0.01, atol=1e-9)
     np.testing.assert_allclose(second[1][-1], robot.joint_torques)
+
+
+def test_the_routines_sit_where_the_compiled_law_calls_them():
+    fns = kernel.routines()
+    assert fns[compiled.SUB_QUAT].__name__ == "mju_subQuat"
+    assert fns[compiled.ROT_VEC_QUAT].__name__ == "mju_rotVecQuat"
+    assert fns[compiled.QUAT_INTEGRATE].__name__ == "mju_quatIntegrate"

@@ -1,6 +1,7 @@
 """Control laws a robot runs in its own loop: Cartesian impedance (Ehlers et al. 2019 eqs. 8-9) and
 adaptive impedance (Johannsmeier et al. 2019), chosen by a
-:data:`~teachfit.core.control.ControllerSpec`."""
+:data:`~teachfit.core.control.ControllerSpec`. Both laws are written once more, compiled, in
+:mod:`teachfit.control.compiled`, which the simulated robots' kernels call."""
 
 from __future__ import annotations
 

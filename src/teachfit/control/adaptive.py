@@ -28,7 +28,11 @@ states the compliance it needs and adaptation only stiffens where errors persist
 cleared by :meth:`AdaptiveImpedance.reset`.
 
 The law is written by hand: it is a handful of element-wise updates specific to this
-controller, not something a library provides.
+controller, not something a library provides. This class is the reference and the law of the
+real Franka's loop and of the simulated FR3; the floating tool runs the same adaptation compiled
+(:func:`teachfit.control.compiled.adapt`, a test checks both agree). The FR3 keeps this one:
+its trajectories would change in the last bits with the compiled one (numpy's matrix product
+and :mod:`teachfit.core.geometry` against plain loops and MuJoCo's quaternion routines).
 """
 
 from __future__ import annotations

@@ -9,6 +9,10 @@ last command with its desired twist, so commands may arrive slower than the 1 kH
 The commanded wrench is clipped to ``max_force`` / ``max_torque``; the desired speeds to
 ``max_speed`` / ``max_ang_speed``. A robot turns the wrench into joint torques (``J^T f``) or,
 for the floating tool, applies it directly.
+
+The classes here are the reference and the law of the real Franka's loop; the simulated robots
+run the same law compiled (:func:`teachfit.control.compiled.fixed_law`), with MuJoCo's
+quaternion routines for :mod:`teachfit.core.geometry`'s (tests check both agree).
 """
 
 from __future__ import annotations

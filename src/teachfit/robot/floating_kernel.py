@@ -8,19 +8,22 @@ call.
 
 This reuses the FR3 kernel's pattern and parts (:mod:`teachfit.robot.fr3.kernel`): MuJoCo's C
 routines through ``ctypes`` on the bindings' own ``libmujoco`` with the model and data
-pointers, and its compiled fixed-gain law :func:`~teachfit.robot.fr3.kernel.fixed_law` (the
-set-point extrapolation and expiry of :class:`teachfit.control.impedance.SetpointError`).
-The adaptive law of :class:`teachfit.control.AdaptiveImpedance` (its module docstring has the
-equations) runs on top: the fixed-gain law with the command's ``K``, ``D`` and ``F_d`` and no
-clipping gives ``K e + D de + F_d`` and the errors, then the adaptation and the adaptive terms
-are added and the sum is clipped. The kernel works on the law objects' own buffers, so their
-state (adapted ``F_ff``, ``K_a``, set-point clock) is what the Python law would hold; a test
-checks that both paths give the same trajectory.
+pointers. The laws are the control layer's compiled ones (:mod:`teachfit.control.compiled`,
+which also names the scalar slots of ``sc``), the same the FR3's tick calls: the fixed-gain
+law :func:`~teachfit.control.compiled.fixed_law` (the set-point extrapolation and expiry of
+:class:`teachfit.control.impedance.SetpointError`) and, for the adaptive law of
+:class:`teachfit.control.AdaptiveImpedance` (its module docstring has the equations),
+:func:`~teachfit.control.compiled.adapt` on top: the fixed-gain law with the command's ``K``,
+``D`` and ``F_d`` and no clipping gives ``K e + D de + F_d`` and the errors, then the
+adaptation and the adaptive terms are added and the sum is clipped. The kernel works on the law
+objects' own buffers, so their state (adapted ``F_ff``, ``K_a``, set-point clock) is what the
+Python law would hold; a test checks that both paths give the same trajectory.
 
 numba caches the machine code on disk (``cache=True``): the first process after a change to
 this file compiles it (about a minute on the busy 2-core machine), later ones load it. The
-cache is keyed on this file only: after an edit of the FR3 kernel's functions used here, touch
-this file (or clear its ``__pycache__``) so that they are compiled in again.
+cache is keyed on this file only: after an edit of the compiled laws or of the FR3 kernel's
+functions used here, touch this file (or clear its ``__pycache__``) so that they are compiled
+in again.
 """
 
 from __future__ import annotations
@@ -35,18 +38,16 @@ import numba
 import numpy as np
 
 from teachfit.control import AdaptiveImpedance, CartesianImpedance
+from teachfit.control import compiled as c
 from teachfit.robot.fr3 import kernel as k
 
 _P = ctypes.c_size_t
 APPLY_FT = 13  # index of mj_applyFT in :func:`routines`
-# scalar slots after the FR3 kernel's: adaptive damping ratio and the real wrench limits
-XI, CLIP_F, CLIP_T = k.N_SCALARS, k.N_SCALARS + 1, k.N_SCALARS + 2
-N_SCALARS = k.N_SCALARS + 3
 
 
-#: indices of the routines :func:`run` calls (with :func:`~teachfit.robot.fr3.kernel.fixed_law`):
+#: indices of the routines :func:`run` calls (with :func:`~teachfit.control.compiled.fixed_law`):
 #: mju_subQuat, mju_rotVecQuat, mju_quatIntegrate, mj_step, mj_applyFT
-USED = frozenset({6, 7, 8, 12, APPLY_FT})
+USED = frozenset({c.SUB_QUAT, c.ROT_VEC_QUAT, c.QUAT_INTEGRATE, 12, APPLY_FT})
 
 
 @cache
@@ -56,27 +57,6 @@ def routines() -> tuple:
     on each call (~1.6 µs each, per 10 ms command), an integer costs nothing."""
     apply_ft = k._fn("mj_applyFT", _P, _P, _P, _P, _P, ctypes.c_int, _P)
     return tuple(f if i in USED else 0 for i, f in enumerate((*k.routines(), apply_ft)))
-
-
-@numba.njit(cache=True)
-def _adapt(ad, err, derr, w, sc) -> None:  # noqa: ANN001
-    """Adaptation of ``F_ff`` and ``K_a`` (one period) and the adaptive terms added to ``w``.
-
-    ``ad``: (alpha, beta, gamma_a, gamma_b, kappa, dF step, dK step, F_max, F_ff, K_a,
-    K room, K_cmd diagonal, its square root, 2 sqrt m), all (6,).
-    """
-    alpha, beta, gamma_a, gamma_b, kappa, df_step, dk_step, f_max = ad[:8]
-    ff, ka, k_room, k0, sqrt_k0, sqrt_m2 = ad[8:]
-    xi = sc[XI]
-    for i in range(6):
-        eps = kappa[i] * err[i] + derr[i]
-        step = min(max(alpha[i] * (eps - gamma_a[i] * ff[i]), -df_step[i]), df_step[i])
-        ff[i] = min(max(ff[i] + step, -f_max[i]), f_max[i])
-        dk = min(max(beta[i] * (eps * err[i] - gamma_b[i] * ka[i]), -dk_step[i]), dk_step[i])
-        ka[i] = max(min(ka[i] + dk, k_room[i]), 0.0)
-        damp = (math.sqrt(k0[i] + ka[i]) - sqrt_k0[i]) * sqrt_m2[i] * xi
-        w[i] += ka[i] * err[i] + damp * derr[i] + ff[i]
-    k.clip_wrench(w, sc[CLIP_F], sc[CLIP_T])
 
 
 @numba.njit(cache=True)
@@ -95,27 +75,27 @@ def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, ft, f_adr):  # noqa: A
     noise, coef, ft_out, ft_z, gauge = ft
     kmat, dmat, ff, xd, qd, vd, err, derr, qtmp, rtmp, w = law
     for tick in range(n):
-        fns[7](k._addr(angvel), k._addr(angvel_local), k._addr(quat))
+        fns[c.ROT_VEC_QUAT](c.addr(angvel), c.addr(angvel_local), c.addr(quat))
         for i in range(3):
             twist[i] = linvel[i]
             twist[i + 3] = angvel[i]
-        k.fixed_law(
+        c.fixed_law(
             fns, t, pos, quat, twist, kmat, dmat, ff, xd, qd, vd, sc, err, derr, qtmp, rtmp, w
         )  # noqa: E501
         if adaptive:
-            _adapt(ad, err, derr, w, sc)
+            c.adapt(ad, err, derr, w, sc)
         total = 0.0
         for i in range(6):
             total += w[i]
         if not math.isfinite(total):
             return tick
         qfrc[:] = 0.0
-        fns[APPLY_FT](m, d, k._addr(w), k._addr(w) + 24, k._addr(point), body, k._addr(qfrc))
+        fns[APPLY_FT](m, d, c.addr(w), c.addr(w) + 24, c.addr(point), body, c.addr(qfrc))
         fns[12](m, d)  # mj_step
         for i in range(6):
             gauge[i] = sdata[f_adr + i] + noise[tick, i]
         k._biquad(coef, gauge, ft_out, ft_z)
-        t += sc[k.DT]  # as mj_step advances d->time
+        t += sc[c.DT]  # as mj_step advances d->time
     return n
 
 
@@ -137,8 +117,8 @@ class FloatingKernel:
         self.m_ptr, self.d_ptr = model._address, data._address
         self.data, self.body, self.state = data, body, state
         self.law = law
-        self.sc = np.zeros(N_SCALARS)
-        self.sc[k.DT] = float(model.opt.timestep)
+        self.sc = np.zeros(c.N_SCALARS)
+        self.sc[c.DT] = float(model.opt.timestep)
         self.adaptive = isinstance(law, AdaptiveImpedance)  # the exact class: see supports
         e = law._error  # the law's own buffers: the kernel updates them in place
         bufs = (e._xd, e._qd, e._vd, e.err, e.derr, e._qtmp, e._rtmp, np.zeros(6))
@@ -163,19 +143,19 @@ class FloatingKernel:
         the compiled loop."""
         law, sc = self.law, self.sc
         e = law._error
-        sc[k.T0], sc[k.EXPIRY] = e._t0, e._expiry
-        sc[k.SPINNING], sc[k.LAPSED] = float(e._spinning), float(e.lapsed)
+        sc[c.T0], sc[c.EXPIRY] = e._t0, e._expiry
+        sc[c.SPINNING], sc[c.LAPSED] = float(e._spinning), float(e.lapsed)
         if isinstance(law, AdaptiveImpedance):
             lim = law.impedance_limits
-            sc[k.MAX_F] = sc[k.MAX_T] = np.inf
-            sc[CLIP_F], sc[CLIP_T], sc[XI] = lim.max_force, lim.max_torque, law._xi
+            sc[c.MAX_F] = sc[c.MAX_T] = np.inf
+            sc[c.CLIP_F], sc[c.CLIP_T], sc[c.XI] = lim.max_force, lim.max_torque, law._xi
         else:
-            sc[k.MAX_F], sc[k.MAX_T] = law.limits.max_force, law.limits.max_torque
+            sc[c.MAX_F], sc[c.MAX_T] = law.limits.max_force, law.limits.max_torque
         done = run(
             n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
             self.adaptive, self.state, self.law_bufs, self.ad, sc, ft, f_adr,
         )  # fmt: skip
-        e._t0, e._expiry = float(sc[k.T0]), float(sc[k.EXPIRY])
-        e._spinning, e.lapsed = bool(sc[k.SPINNING]), bool(sc[k.LAPSED])
+        e._t0, e._expiry = float(sc[c.T0]), float(sc[c.EXPIRY])
+        e._spinning, e.lapsed = bool(sc[c.SPINNING]), bool(sc[c.LAPSED])
         law.last_wrench = self.law_bufs[-1].copy()
         return int(done)

@@ -10,11 +10,14 @@ model and data pointers of the Python objects; the arithmetic between them is pl
 numba caches the machine code on disk (``cache=True``), so only the first process compiles.
 
 The law and the torque map are those of :mod:`teachfit.robot.fr3.control` (the module
-docstring there has the equations); the fixed-gain Cartesian law is the one of
-:class:`teachfit.control.CartesianImpedance` (set-point extrapolation and expiry as in its
-``SetpointError``), compiled here so that a whole :meth:`FR3Robot.step` of ``n`` ticks is one
-call; a test checks both give the same torques. Other laws (the adaptive one) run in Python
-between :func:`tick_pre` and :func:`tick_post`.
+docstring there has the equations); the fixed-gain Cartesian law is the compiled
+:func:`teachfit.control.compiled.fixed_law` (the one of
+:class:`teachfit.control.CartesianImpedance`, set-point extrapolation and expiry included),
+called here so that a whole :meth:`FR3Robot.step` of ``n`` ticks is one call; a test checks
+both give the same torques. Other laws (the adaptive one) run in Python between
+:func:`tick_pre` and :func:`tick_post`. The scalar slots of ``sc`` are named once in
+:mod:`teachfit.control.compiled` (re-exported here); numba's cache is keyed on this file only:
+after an edit there, touch this file so that the law is compiled in again.
 """
 
 from __future__ import annotations
@@ -27,6 +30,27 @@ import mujoco
 import numba
 import numpy as np
 
+# the scalar slots of ``sc`` (one layout for both kernels, in the control layer); the FR3's
+# modules read them here: T0 ... MAX_T and the law are :mod:`teachfit.control.compiled`'s
+from teachfit.control.compiled import (  # noqa: F401
+    ALPHA,
+    D_NULL,
+    DT,
+    DTAU,
+    EXPIRY,
+    INV_DT,
+    K_NULL,
+    LAPSED,
+    MAX_F,
+    MAX_T,
+    N_SCALARS,
+    NOISE_I,
+    SPINNING,
+    T0,
+    USE_FT,
+    fixed_law,
+)
+from teachfit.control.compiled import addr as _addr
 from teachfit.core.errors import TeachfitError
 
 _P = ctypes.c_size_t  # pointers travel as integers (same register as a pointer on x86-64 / arm64)
@@ -50,7 +74,9 @@ def _fn(name: str, *argtypes: object, restype: object = None) -> object:
 
 @cache
 def routines() -> tuple:
-    """The MuJoCo C routines the kernel calls, in the order the kernel's ``fns`` takes them."""
+    """The MuJoCo C routines the kernel calls, in the order the kernel's ``fns`` takes them
+    (the law's quaternion routines at :mod:`teachfit.control.compiled`'s ``SUB_QUAT``,
+    ``ROT_VEC_QUAT`` and ``QUAT_INTEGRATE``)."""
     i, d = ctypes.c_int, ctypes.c_double
     return (
         _fn("mj_step1", _P, _P),
@@ -82,16 +108,6 @@ _MONOTONIC = 1  # CLOCK_MONOTONIC on Linux
 # status codes returned with the number of ticks done
 OK, LIMIT, NOISE_EMPTY = 0, 1, 2
 
-# scalar slots of the ``sc`` array: set-point clock, gains, limits, filter constants
-T0, EXPIRY, SPINNING, LAPSED, MAX_F, MAX_T, K_NULL, D_NULL, DTAU, ALPHA, INV_DT, USE_FT = range(12)
-NOISE_I, DT = 12, 13
-N_SCALARS = 14
-
-
-@numba.njit(cache=True, inline="always")
-def _addr(a: np.ndarray) -> int:
-    return a.ctypes.data
-
 
 @numba.njit(cache=True)
 def kinematics(fns, m, d, site, jac, xmat, quat, twist, qvel):  # noqa: ANN001, ANN201
@@ -104,52 +120,6 @@ def kinematics(fns, m, d, site, jac, xmat, quat, twist, qvel):  # noqa: ANN001, 
         for j in range(nv):
             s += jac[i, j] * qvel[j]
         twist[i] = s
-
-
-@numba.njit(cache=True)
-def fixed_law(fns, t, pos, quat, twist, kmat, dmat, ff, xd, qd, vd, sc, err, derr, qtmp, rtmp, w):  # noqa: ANN001, ANN201, E501
-    """``w = K e + D de + f_ff``, clipped: :class:`teachfit.control.CartesianImpedance`."""
-    dt = t - sc[T0]
-    if t > sc[EXPIRY]:  # hold the set-point where the expired command left it
-        dt = sc[EXPIRY] - sc[T0]
-        for i in range(3):
-            xd[i] += vd[i] * dt
-        if sc[SPINNING] != 0.0:
-            fns[8](_addr(qd), _addr(vd) + 24, dt)
-        vd[:] = 0.0
-        sc[SPINNING], sc[T0], sc[EXPIRY], sc[LAPSED] = 0.0, t, np.inf, 1.0
-        dt = 0.0
-    for i in range(3):
-        err[i] = xd[i] - pos[i]
-        err[i] += vd[i] * dt
-    q_target = qd
-    if sc[SPINNING] != 0.0:
-        qtmp[:] = qd
-        fns[8](_addr(qtmp), _addr(vd) + 24, dt)
-        q_target = qtmp
-    fns[6](_addr(rtmp), _addr(q_target), _addr(quat))
-    fns[7](_addr(err) + 24, _addr(rtmp), _addr(quat))
-    for i in range(6):
-        derr[i] = vd[i] - twist[i]
-    for i in range(6):
-        s = 0.0
-        for j in range(6):
-            s += kmat[i, j] * err[j]
-        r = 0.0
-        for j in range(6):
-            r += dmat[i, j] * derr[j]
-        w[i] = s + r + ff[i]
-    clip_wrench(w, sc[MAX_F], sc[MAX_T])
-
-
-@numba.njit(cache=True, inline="always")
-def clip_wrench(w, max_f, max_t) -> None:  # noqa: ANN001
-    """Scale force and torque of ``w`` (6,) in place to norms of at most ``max_f``, ``max_t``."""
-    for lo, cap in ((0, max_f), (3, max_t)):
-        norm = np.sqrt(w[lo] * w[lo] + w[lo + 1] * w[lo + 1] + w[lo + 2] * w[lo + 2])
-        if norm > cap:
-            for i in range(lo, lo + 3):
-                w[i] *= cap / norm
 
 
 @numba.njit(cache=True)
