@@ -257,7 +257,7 @@ class FR3Robot:
         law, fns, m_ptr, d_ptr, site = ctl.law, ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.site
         dat = ctl.dat
         bufs, obs, lim = ctl.ctl_bufs(), self._obs_bufs, self._limits
-        block = len(obs[6])
+        block = len(self.observer.noise)  # obs[6], rows of the noise block
         pos, quat, v, w = ctl.pos, ctl.quat, ctl.twist[:3], ctl.twist[3:]
         for _ in range(n):
             if sc[kernel.NOISE_I] >= block:

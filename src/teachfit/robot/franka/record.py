@@ -85,7 +85,7 @@ def record_kinesthetic(
         ImpedanceCommand(
             pos=start.pos,
             quat=start.quat,
-            stiffness=0.0,
+            stiffness=np.zeros(6),  # none: the person guides the arm
             damping=np.asarray(damping, dtype=float),
             expires_after=1e9,
         )
