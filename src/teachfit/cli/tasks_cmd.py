@@ -81,7 +81,7 @@ def _vec(text: str | None, what: str) -> tuple[float, float, float] | None:
         values = ()
     if len(values) != 3:
         raise TaskError(f"{what} wants three numbers 'X,Y,Z', got {text!r}")
-    return values  # type: ignore[return-value]
+    return values
 
 
 @tasks_app.command("new")
