@@ -377,7 +377,7 @@ class _InsertRun(PrimitiveRun):
         out.stiffness[:] = self.k
 
 
-PRIMITIVES: dict[str, type[Primitive]] = {c.kind: c for c in (MoveTo, Move, Insert)}
+PRIMITIVES: dict[str, type[MoveTo | Move | Insert]] = {c.kind: c for c in (MoveTo, Move, Insert)}
 
 
 def primitive_from_toml(data: Mapping[str, Any]) -> Primitive:
@@ -387,7 +387,7 @@ def primitive_from_toml(data: Mapping[str, Any]) -> Primitive:
         raise SkillError(f"unknown primitive {kind!r}; known: {sorted(PRIMITIVES)}")
     cls = PRIMITIVES[kind]
     known = {f.name for f in fields(cls)}
-    kwargs = {
+    kwargs: dict[str, Any] = {  # raw TOML values
         k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k != "primitive"
     }
     unknown = sorted(set(kwargs) - known)
