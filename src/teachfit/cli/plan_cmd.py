@@ -21,7 +21,7 @@ from teachfit.cli.tables import print_table
 from teachfit.core.errors import PlanningError, TeachfitError
 
 if TYPE_CHECKING:
-    from teachfit.bench.planning import TaskBench
+    from teachfit.bench.planning import PlanningBenchConfig, TaskBench
     from teachfit.demonstrations.dataset import Demonstration
     from teachfit.plans.planner import MotionPlanner, PlanResult
     from teachfit.tasks.parts import Assembly
@@ -283,19 +283,19 @@ def bench_planning_cmd(
         console.print(f"markdown appended to {path}")
 
 
-def _variant_sweep(cfg: object, n: int) -> str:
+def _variant_sweep(cfg: PlanningBenchConfig, n: int) -> str:
     """Run and print the variant sweep; its markdown table."""
     from teachfit.bench import planning_variants as pv
     from teachfit.plans.planner import PlannerConfig
 
-    planner = PlannerConfig(planner=cfg.planner, te=cfg.te, max_checks=cfg.max_checks)  # type: ignore[attr-defined]
-    tasks = cfg.tasks  # type: ignore[attr-defined]
+    planner = PlannerConfig(planner=cfg.planner, te=cfg.te, max_checks=cfg.max_checks)
+    tasks = cfg.tasks
     with progress_bar() as bar:
-        job = bar.add_task("variants", total=len(tasks) * n * cfg.seeds)  # type: ignore[attr-defined]
+        job = bar.add_task("variants", total=len(tasks) * n * cfg.seeds)
         results = pv.run_variants(
             tasks,
             n,
-            cfg.seeds,  # type: ignore[attr-defined]
+            cfg.seeds,
             planner,
             progress=lambda label, _done: bar.update(job, advance=1, description=label),
         )

@@ -75,7 +75,7 @@ def _as_result(value: object) -> TrialResult:
         return value
     if isinstance(value, tuple) and len(value) == 2:
         return TrialResult(float(value[0]), bool(value[1]))
-    return TrialResult(float(value))  # type: ignore[arg-type]
+    return TrialResult(float(value))  # type: ignore[arg-type]  # float() rejects non-numbers
 
 
 def evaluate(objective: Objective, params: Mapping[str, float]) -> tuple[TrialResult | None, str]:

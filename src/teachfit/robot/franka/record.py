@@ -93,7 +93,7 @@ def record_kinesthetic(
     tapped = hasattr(robot, "tap") and hasattr(robot, "untap")
     samples: list[RobotState] = [start]
     if tapped:
-        robot.tap(every)  # type: ignore[attr-defined]
+        robot.tap(every)  # type: ignore[attr-defined]  # hasattr-checked above
     try:
         last = start
         while duration is None or last.t - start.t < duration:
@@ -104,7 +104,7 @@ def record_kinesthetic(
         return _pack(_collect(robot, samples, tapped), start.t, True, "")
     except RobotFault as fault:
         rec = _pack(_collect(robot, samples, tapped), start.t, False, str(fault))
-        fault.recording = rec  # type: ignore[attr-defined]
+        fault.recording = rec  # type: ignore[attr-defined]  # attached for the caller
         raise
     samples = _collect(robot, samples, tapped)
     robot.command(ImpedanceCommand.hold(samples[-1].pose))  # stay where the person left it
@@ -113,5 +113,5 @@ def record_kinesthetic(
 
 def _collect(robot: Robot, samples: list[RobotState], tapped: bool) -> list[RobotState]:
     if tapped:
-        samples += [s for s in robot.untap() if s.t > samples[0].t]  # type: ignore[attr-defined]
+        samples += [s for s in robot.untap() if s.t > samples[0].t]  # type: ignore[attr-defined]  # tapped
     return samples
