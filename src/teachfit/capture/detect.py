@@ -110,10 +110,10 @@ def detect_markers(
     corners, ids, _ = detector.detectMarkers(grey)
     if ids is None:
         return []
-    ids = ids.reshape(-1).tolist()
+    id_list = ids.reshape(-1).tolist()
     out = []
-    for c, i in zip(corners, ids, strict=True):
-        if i in known and ids.count(i) == 1:
+    for c, i in zip(corners, id_list, strict=True):
+        if i in known and id_list.count(i) == 1:
             pts = np.asarray(c, dtype=float).reshape(4, 2)
             if intrinsics is not None:
                 pts = refine_edges(grey, pts, *intrinsics)

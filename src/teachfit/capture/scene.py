@@ -69,7 +69,7 @@ def camera_K(width: int, height: int, fovy_deg: float) -> np.ndarray:
     return np.array([[f, 0.0, (width - 1) / 2.0], [0.0, f, (height - 1) / 2.0], [0.0, 0.0, 1.0]])
 
 
-def _floats(values: np.ndarray) -> str:
+def _floats(values: np.ndarray | Sequence[float]) -> str:
     return " ".join(f"{v:.9g}" for v in np.asarray(values, dtype=float).reshape(-1))
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -23,7 +24,7 @@ from teachfit.capture.rig import Rig
 from teachfit.capture.temporal import FilterConfig, PoseFilter
 from teachfit.core.errors import CaptureError
 from teachfit.core.geometry import rotation_to_wxyz
-from teachfit.demonstrations.dataset import Demonstration
+from teachfit.demonstrations.dataset import Demonstration, MetaValue
 
 __all__ = ["STATUS", "Track", "TrackConfig", "Tracker", "track_frames"]
 
@@ -79,7 +80,7 @@ class Track:
         """Number of frames T."""
         return int(self.t.shape[0])
 
-    def to_demonstration(self, task: str, name: str = "", **meta: object) -> Demonstration:
+    def to_demonstration(self, task: str, name: str = "", **meta: MetaValue) -> Demonstration:
         """The valid frames as a demonstration (``frame="G"``, ``child_frame="L"``,
         ``source="captured"``); ``meta`` records the frame counts, the dropped frames' indices
         and each kept sample's predicted error (mm)."""
@@ -91,7 +92,7 @@ class Track:
             )
         T = self.L2G[keep]
         quat = rotation_to_wxyz(Rotation.from_matrix(T[:, :3, :3]))  # w >= 0
-        info = {
+        info: dict[str, MetaValue] = {
             "frames_total": self.n_frames,
             "frames_valid": int(keep.size),
             "dropped_frames": [float(i) for i in np.flatnonzero(~self.valid)],
@@ -150,9 +151,10 @@ class Tracker:
         for part, mk in self.parts.items():
             pd = [d for d in dets if d.marker_id in mk]
             self.seen[part] += bool(pd)
-            poses[part] = fuse_part(pd, self.rig, mk, self.cfg.fusion, self.prior[part])
-            self.prior[part] = None if poses[part] is None else poses[part].part2rig
-        row = {
+            pose = fuse_part(pd, self.rig, mk, self.cfg.fusion, self.prior[part])
+            poses[part] = pose
+            self.prior[part] = None if pose is None else pose.part2rig
+        row: dict[str, Any] = {
             "L2G": np.full((4, 4), np.nan),
             "std_mm": np.nan,
             "std_deg": np.nan,

@@ -4,8 +4,9 @@
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, TypedDict, Unpack
 
 import numpy as np
 import typer
@@ -18,7 +19,10 @@ from teachfit.cli.tables import print_table
 from teachfit.core.errors import CaptureError
 
 if TYPE_CHECKING:
-    from teachfit.bench.capture import CaptureBench
+    from rich.progress import TaskID
+
+    from teachfit.bench.capture import AccuracyRow, CaptureBench
+    from teachfit.capture.synth import SynthConfig
     from teachfit.capture.track import Track
     from teachfit.demonstrations.dataset import Demonstration
 
@@ -147,7 +151,21 @@ def _print_truth_errors(track: Track, truth: Path) -> Demonstration:
     return truth_demo
 
 
-def _synth_config(cameras: int, resolution: list[str] | None, **kw: object):
+class _SynthOptions(TypedDict, total=False):
+    """The :class:`~teachfit.capture.synth.SynthConfig` fields the commands set."""
+
+    distance: float
+    noise: float
+    blur: float
+    lighting: float
+    stride: int
+    max_frames: int | None
+    crf: int
+
+
+def _synth_config(
+    cameras: int, resolution: list[str] | None, **kw: Unpack[_SynthOptions]
+) -> SynthConfig:
     from teachfit.capture.synth import SynthConfig
 
     res = [_pair(r, "--resolution") for r in (resolution or [])]
@@ -211,7 +229,7 @@ def synth(
         console.print(f"{key:8s} {path}")
 
 
-def _filter_note(rows: list, stride: int) -> None:
+def _filter_note(rows: Sequence[AccuracyRow], stride: int) -> None:
     """Say why the rows with and without the temporal filter agree, where they do."""
     from teachfit.capture.temporal import FilterConfig, adaptive_alpha
 
@@ -278,7 +296,7 @@ def bench_capture_cmd(
         3, ["1920x1080"], noise=noise, blur=blur, lighting=lighting, stride=stride, crf=crf
     )
     with tempfile.TemporaryDirectory() as tmp, progress_bar() as bar:
-        jobs: dict[str, int] = {}
+        jobs: dict[str, TaskID] = {}
 
         def tick(label: str, done: int, total: int) -> None:
             if label not in jobs:

@@ -25,7 +25,8 @@ from teachfit.core.params import LearningError
 if TYPE_CHECKING:
     from teachfit.bench.learning import LearningBench
     from teachfit.learning.launch import Launch
-    from teachfit.learning.study import TrialRecord
+    from teachfit.learning.objective import SkillObjective
+    from teachfit.learning.study import Study, TrialRecord
 
 _CONTROLLER = typer.Option(help="controller: adaptive (learns its meta-parameters) or impedance")
 _TASK_PARAM = o.TASK_PARAM
@@ -111,7 +112,10 @@ def learn_skill(
 
 
 def _run_and_report(
-    launch: Launch, out: Path | None, figures: tuple[Path | None, ...], title: str
+    launch: Launch,
+    out: Path | None,
+    figures: tuple[Path | None, Path | None, Path | None],
+    title: str,
 ) -> None:
     """Run the trials with a progress bar, then report the best; Ctrl-C stops cleanly."""
     from teachfit.learning.launch import run_learning
@@ -164,8 +168,8 @@ def _run_and_report(
 
 
 def _report_best(
-    st: object,
-    obj: object,
+    st: Study,
+    obj: SkillObjective,
     out: Path | None,
     plot: Path | None,
     traces: Path | None,
@@ -174,8 +178,8 @@ def _report_best(
 ) -> None:
     from teachfit.viz import learning_figures as lf
 
-    recs = st.trials()  # type: ignore[attr-defined]
-    best = st.best()  # type: ignore[attr-defined]
+    recs = st.trials()
+    best = st.best()
     ok = sum(r.feasible for r in recs)
     rate = best.info.get("success_rate", float("nan"))
     console.print(
@@ -184,7 +188,7 @@ def _report_best(
         f"({100 * rate:.0f} % of its executions succeeded); {ok}/{len(recs)} "
         "trials feasible"
     )
-    space = obj.space  # type: ignore[attr-defined]
+    space = obj.space
     table = Table(title="best parameters", title_justify="left")
     for col in ("name", "value", "low", "high"):
         table.add_column(col)
@@ -197,19 +201,19 @@ def _report_best(
 
         head = f"best of {title}: cost {best.cost:.4f} s, trial {best.number + 1}"
         path = write_params_toml(out, best.params, head)
-        task = obj.task  # type: ignore[attr-defined]
+        task = obj.task
         console.print(
             f"parameters -> {path} (run them: teachfit skill run --task {task} --params {path})"
         )
     if plot is not None:
         console.print(f"learning curve -> {lf.plot_study_curve(recs, plot, title)}")
     if traces is not None:
-        learned = obj.trial().setup.skill.params.learned  # type: ignore[attr-defined]
+        learned = obj.trial().setup.skill.params.learned
         units = {name: p.unit for name, p in learned.items()}
         path = lf.plot_param_traces(recs, space, traces, title, units)
         console.print(f"parameter traces -> {path}")
     if best_plot is not None:
-        outcome = obj.outcome(best.params)  # type: ignore[attr-defined]
+        outcome = obj.outcome(best.params)
         k = next((i for i, s in enumerate(outcome.successes) if s), 0)
         path = lf.plot_best_execution(outcome.traces[k], best_plot)
         console.print(f"best execution -> {path}")
@@ -445,6 +449,10 @@ def _bench_random(
     with progress_bar() as bar:
         job = bar.add_task("random parameters", total=len(tasks) * experiments * trials)
         for task in tasks:
+
+            def advance(_r: TrialRecord, t: str = task) -> None:
+                bar.update(job, advance=1, description=t)
+
             rates.append(
                 lr.random_rate(
                     task,
@@ -454,7 +462,7 @@ def _bench_random(
                     seed=seed,
                     overrides=dict(_overrides(task_param)),
                     workers=workers,
-                    on_trial=lambda _r, t=task: bar.update(job, advance=1, description=t),
+                    on_trial=advance,
                 )
             )
     extra = "".join(f" --task-param {p}" for p in task_param or [])

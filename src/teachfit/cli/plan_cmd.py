@@ -21,8 +21,10 @@ from teachfit.cli.tables import print_table
 from teachfit.core.errors import PlanningError, TeachfitError
 
 if TYPE_CHECKING:
-    from teachfit.bench.planning import TaskBench
+    from teachfit.bench.planning import PlanningBenchConfig, TaskBench
+    from teachfit.demonstrations.dataset import Demonstration
     from teachfit.plans.planner import MotionPlanner, PlanResult
+    from teachfit.tasks.parts import Assembly
 
 __all__ = [
     "app",
@@ -96,14 +98,14 @@ def demo_synth(
     console.print(f"wrote {out}")
 
 
-def _assembly(task: str, items: list[str] | None, path: Path | None) -> object:
+def _assembly(task: str, items: list[str] | None, path: Path | None) -> Assembly:
     """The task's parts with the ``--task-params`` file and ``--task-param`` overrides."""
     from teachfit.tasks.registry import build_assembly
 
     return build_assembly(task, **dict(o.task_overrides(items, PlanningError, path)))
 
 
-def _load_demo(spec: str) -> object:
+def _load_demo(spec: str) -> Demonstration:
     from teachfit.demonstrations.dataset import read_dataset, read_demo
 
     if ":" in Path(spec).name:
@@ -156,7 +158,7 @@ def plan(
         raise PlanningError("give exactly one of --demo FILE and --no-demo")
     asm = _assembly(task, task_param, task_params)
     mp = MotionPlanner(asm, PlannerConfig(planner=planner, te=te, max_checks=max_checks))
-    result = mp.plan(None if no_demo else _load_demo(demo), seed=seed)
+    result = mp.plan(None if demo is None else _load_demo(demo), seed=seed)  # no_demo
     status = "[green]success[/green]" if result.success else "[red]failure[/red]"
     console.print(
         f"{status}: {result.message}; planning {result.time_s:.3f} s "
@@ -177,7 +179,7 @@ def plan(
 
 
 def _write_path_media(
-    asm: object, mp: MotionPlanner, result: PlanResult, strip: Path | None, render: Path | None
+    asm: Assembly, mp: MotionPlanner, result: PlanResult, strip: Path | None, render: Path | None
 ) -> None:
     """The planned path as a strip of poses (png) and as a video, where asked for."""
     if strip is not None:
@@ -281,19 +283,19 @@ def bench_planning_cmd(
         console.print(f"markdown appended to {path}")
 
 
-def _variant_sweep(cfg: object, n: int) -> str:
+def _variant_sweep(cfg: PlanningBenchConfig, n: int) -> str:
     """Run and print the variant sweep; its markdown table."""
     from teachfit.bench import planning_variants as pv
     from teachfit.plans.planner import PlannerConfig
 
-    planner = PlannerConfig(planner=cfg.planner, te=cfg.te, max_checks=cfg.max_checks)  # type: ignore[attr-defined]
-    tasks = cfg.tasks  # type: ignore[attr-defined]
+    planner = PlannerConfig(planner=cfg.planner, te=cfg.te, max_checks=cfg.max_checks)
+    tasks = cfg.tasks
     with progress_bar() as bar:
-        job = bar.add_task("variants", total=len(tasks) * n * cfg.seeds)  # type: ignore[attr-defined]
+        job = bar.add_task("variants", total=len(tasks) * n * cfg.seeds)
         results = pv.run_variants(
             tasks,
             n,
-            cfg.seeds,  # type: ignore[attr-defined]
+            cfg.seeds,
             planner,
             progress=lambda label, _done: bar.update(job, advance=1, description=label),
         )

@@ -8,7 +8,7 @@ column's header beside its value. Wide terminals get the whole table at full wid
 
 from __future__ import annotations
 
-from rich.console import Console
+from rich.console import Console, RenderableType
 from rich.markdown import Markdown
 from rich.measure import Measurement
 from rich.table import Table
@@ -19,7 +19,7 @@ from teachfit.cli.common import console as default_console
 __all__ = ["markdown_table", "print_markdown", "print_table"]
 
 
-def _cells(table: Table) -> list[list[object]]:
+def _cells(table: Table) -> list[list[RenderableType]]:
     columns = table.columns
     return [[col._cells[i] for col in columns] for i in range(table.row_count)]
 
@@ -39,7 +39,7 @@ def print_table(table: Table, console: Console | None = None) -> None:
         grid.add_column(style="bold", no_wrap=True)
         grid.add_column(overflow="fold")
         for head, cell in zip(headers, row, strict=True):
-            grid.add_row(head, cell)  # type: ignore[arg-type]
+            grid.add_row(head, cell)
         con.rule(f"{k + 1}/{table.row_count}", align="left", style="dim")
         con.print(grid)
     if table.caption:

@@ -73,15 +73,17 @@ def tasks_list(xml: Annotated[str | None, _XML] = None) -> None:
 
 
 def _vec(text: str | None, what: str) -> tuple[float, float, float] | None:
-    if text is None:
-        return None
+    return None if text is None else _vec3(text, what)
+
+
+def _vec3(text: str, what: str) -> tuple[float, float, float]:
     try:
         values = tuple(float(v) for v in text.replace(",", " ").split())
     except ValueError:
         values = ()
     if len(values) != 3:
         raise TaskError(f"{what} wants three numbers 'X,Y,Z', got {text!r}")
-    return values  # type: ignore[return-value]
+    return values
 
 
 @tasks_app.command("new")
@@ -106,7 +108,7 @@ def tasks_new(
     from teachfit.cli.geometry_progress import geometry_progress
     from teachfit.tasks.mesh.authoring import new_task_file
 
-    axis = _vec(insertion_axis, "--insertion-axis")
+    axis = _vec3(insertion_axis, "--insertion-axis")
     with geometry_progress("checking and decomposing the parts"):
         path, cell = new_task_file(
             out,
@@ -114,7 +116,7 @@ def tasks_new(
             fixed,
             units,
             _vec(hole_pos, "--hole-pos"),
-            axis,  # type: ignore[arg-type]
+            axis,
             tuple(d.strip() for d in search_dims.split(",")),
             success_depth,
             rz_period,

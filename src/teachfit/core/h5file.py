@@ -23,7 +23,7 @@ import reprlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, overload
 
 import h5py
 import numpy as np
@@ -169,6 +169,14 @@ class H5Reader:
             raise self.error(f"{where} is a {_kind_of(obj)}, not a group")
         return obj
 
+    @overload
+    def dataset(
+        self, parent: h5py.Group, name: str, kinds: str = ..., required: Literal[True] = ...
+    ) -> np.ndarray: ...
+    @overload
+    def dataset(
+        self, parent: h5py.Group, name: str, kinds: str = ..., *, required: bool
+    ) -> np.ndarray | None: ...
     def dataset(
         self, parent: h5py.Group, name: str, kinds: str = "iuf", required: bool = True
     ) -> np.ndarray | None:

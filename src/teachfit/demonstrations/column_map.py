@@ -149,8 +149,8 @@ class ColumnMap:
         if given and len(given) != len(WRENCH_KEYS):
             missing = next(k for k in WRENCH_KEYS if getattr(self, k) is None)
             raise DatasetError(f"give all of {WRENCH_KEYS} or none", column=missing)
-        names = list(self.mapped().values()) + ([self.marker] if self.marker else [])
-        dup = next((n for n in names if names.count(n) > 1), None)
+        columns = list(self.mapped().values()) + ([self.marker] if self.marker else [])
+        dup = next((n for n in columns if columns.count(n) > 1), None)
         if dup is not None:
             raise DatasetError(f"CSV column {dup!r} is mapped to more than one field", column=dup)
         for key in ("time_scale", "length_scale"):

@@ -32,6 +32,7 @@ from typing import Any
 
 import h5py
 import numpy as np
+import numpy.typing as npt
 from scipy.spatial.transform import Rotation, Slerp
 
 from teachfit.core.errors import DatasetError
@@ -61,7 +62,7 @@ TEXT_ATTRS: tuple[tuple[str, str | None], ...] = (
 MetaValue = str | int | float | bool | list[float]
 
 
-def _first_row(bad: np.ndarray) -> int | None:
+def _first_row(bad: npt.ArrayLike) -> int | None:
     """Index of the first True entry of a boolean (T,) mask, or None."""
     rows = np.flatnonzero(bad)
     return int(rows[0]) if rows.size else None
@@ -404,10 +405,8 @@ def _read_group(reader: H5Reader, parent: h5py.Group, key: str) -> Demonstration
     anything is read)."""
     path = reader.path
     group = reader.group(parent, key)
-    arrays = {
-        label: reader.dataset(group, label, required=label != "wrench")
-        for label in ("t", "pos", "quat", "wrench")
-    }
+    arrays = {label: reader.dataset(group, label) for label in ("t", "pos", "quat")}
+    wrench = reader.dataset(group, "wrench", required=False)
     labels = {label: reader.text(group, label, default) for label, default in TEXT_ATTRS}
     try:
         meta = json.loads(labels["meta"])
@@ -415,7 +414,7 @@ def _read_group(reader: H5Reader, parent: h5py.Group, key: str) -> Demonstration
             t=arrays["t"],
             pos=arrays["pos"],
             quat=arrays["quat"],
-            wrench=arrays["wrench"],
+            wrench=wrench,
             task=labels["task"],
             source=labels["source"],
             frame=labels["frame"],
@@ -494,6 +493,12 @@ def read_demos(spec: str | Path) -> list[Demonstration]:
     return [demos[i] for i in picks]
 
 
+def _rate_hz(d: Demonstration) -> float:
+    """The stored ``meta["rate_hz"]`` of an import, else the nearest plain rate of ``d.t``."""
+    rate = d.meta.get("rate_hz")
+    return sampling_rate(d.t) if rate is None or isinstance(rate, list) else float(rate)
+
+
 def dataset_summary(path: str | Path) -> list[dict[str, Any]]:
     """One row per demonstration for a table: index, name, task, source, samples, duration (s),
     rate (Hz: the stored ``meta["rate_hz"]`` of an import, else the nearest plain rate that
@@ -507,7 +512,7 @@ def dataset_summary(path: str | Path) -> list[dict[str, Any]]:
             "source": d.source,
             "samples": d.n_samples,
             "duration": d.duration,
-            "rate": float(d.meta.get("rate_hz", sampling_rate(d.t))),
+            "rate": _rate_hz(d),
         }
         for i, d in enumerate(read_dataset(path))
     ]

@@ -32,7 +32,8 @@ def record_demonstration(
     try:
         rec = record_kinesthetic(robot, duration=duration, rate_hz=rate_hz)
     except RobotFault as exc:
-        rec = getattr(exc, "recording", None)
-        if rec is None or len(rec.t) < 2:
+        partial: KinestheticRecording | None = getattr(exc, "recording", None)
+        if partial is None or len(partial.t) < 2:
             raise
+        rec = partial
     return _demo(rec, task, robot)

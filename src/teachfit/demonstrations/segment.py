@@ -85,6 +85,7 @@ class Segmenter:
                     path=log.path,
                 )
             force = np.linalg.norm(log.wrench[:, :3], axis=1)
+            assert self.force_off_n is not None  # set by __post_init__
             pieces = contact_phases(force, self.force_on_n, float(self.force_off_n))
         else:
             if log.marker is None:

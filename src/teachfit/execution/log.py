@@ -71,7 +71,10 @@ class LogBuffer:
     def freeze(self) -> ExecutionLog:
         k = self.k
         return ExecutionLog(
-            *(a[:k].copy() for a in (self.t, self.pos, self.quat, self.wrench)),
+            self.t[:k].copy(),
+            self.pos[:k].copy(),
+            self.quat[:k].copy(),
+            self.wrench[:k].copy(),
             self.setpoint_pos[:k].copy(),
             self.wrench_ff[:k].copy(),
             self.depth[:k].copy(),

@@ -9,6 +9,7 @@ from typing import Any
 
 import h5py
 import numpy as np
+import numpy.typing as npt
 
 from teachfit.core.geometry import Pose
 from teachfit.core.h5file import H5_ERRORS, H5Reader
@@ -71,7 +72,7 @@ def _untri(value: Any) -> bool | None:
     return None if int(value) < 0 else bool(value)
 
 
-def _put(group: h5py.Group, name: str, data: np.ndarray, dtype: Any = np.float64) -> None:
+def _put(group: h5py.Group, name: str, data: npt.ArrayLike, dtype: Any = np.float64) -> None:
     """A dataset, gzip-compressed when it holds anything (empty ones cannot be chunked)."""
     data = np.asarray(data, dtype=dtype)
     opts = {"compression": "gzip", "compression_opts": 4} if data.size else {}
@@ -148,7 +149,7 @@ def read_episode(reader: H5Reader, parent: h5py.Group, key: str) -> Episode:
         steps=int(a["steps"]),
         detected=_untri(a["detected"]),
         ground_truth_inserted=_untri(a["ground_truth_inserted"]),
-        **{k: float(a[k]) for k in NUMBERS},  # type: ignore[arg-type]
+        **{k: float(a[k]) for k in NUMBERS},
     )
     start = None
     if "start" in a:
@@ -157,8 +158,7 @@ def read_episode(reader: H5Reader, parent: h5py.Group, key: str) -> Episode:
     planned = None
     if "planned" in group:
         p = reader.group(group, "planned")
-        planned = SetpointTrajectory(
-            *_arrays(reader, p, ("t", "pos", "quat", "wrench_ff")), name=reader.text(p, "name")
-        )
+        t, pos, quat, wrench_ff = _arrays(reader, p, ("t", "pos", "quat", "wrench_ff"))
+        planned = SetpointTrajectory(t, pos, quat, wrench_ff, name=reader.text(p, "name"))
     primitives = json.loads(reader.text(group, "primitives"))
     return Episode(result, start, planned, primitives, reader.text(group, "name"))

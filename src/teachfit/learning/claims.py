@@ -31,9 +31,10 @@ import threading
 import time
 import uuid
 import weakref
-from collections.abc import Collection, Iterable, Sequence
+from collections.abc import Callable, Collection, Iterable, Sequence
 from dataclasses import dataclass
 from enum import Enum
+from typing import TypeVar
 
 import sqlalchemy as sa
 from sqlalchemy.engine import Connection, Engine
@@ -173,7 +174,10 @@ class Verdict(Enum):
     BUDGET = "budget"  # the budget is taken by finished and running keys
 
 
-def _retry(fn, attempts: int = 8):  # type: ignore[no-untyped-def]
+_T = TypeVar("_T")
+
+
+def _retry(fn: Callable[[], _T], attempts: int = 8) -> _T | None:
     """Run ``fn()``, retrying a few times on database errors (races creating tables)."""
     for i in range(attempts):
         try:

@@ -71,7 +71,7 @@ def pad(curve: np.ndarray, length: int) -> np.ndarray:
     return np.concatenate([curve, np.full(length - curve.size, curve[-1])])
 
 
-def band(curves: Sequence[Sequence[float]], confidence: float = 0.95) -> Band:
+def band(curves: Sequence[Sequence[float] | np.ndarray], confidence: float = 0.95) -> Band:
     """Mean and ``confidence`` interval of the mean over experiments' curves."""
     arrays = [np.asarray(c, dtype=float).reshape(-1) for c in curves]
     arrays = [a for a in arrays if a.size]

@@ -75,7 +75,7 @@ def _as_result(value: object) -> TrialResult:
         return value
     if isinstance(value, tuple) and len(value) == 2:
         return TrialResult(float(value[0]), bool(value[1]))
-    return TrialResult(float(value))  # type: ignore[arg-type]
+    return TrialResult(float(value))  # type: ignore[arg-type]  # float() rejects non-numbers
 
 
 def evaluate(objective: Objective, params: Mapping[str, float]) -> tuple[TrialResult | None, str]:
@@ -317,16 +317,17 @@ class _PoolRun:
             if alone and self.pending:
                 return
             if alone:
-                cand: Candidate | None = self.suspects.pop(0)
+                cand = self.suspects.pop(0)
             elif len(self.pending) >= self.n:
                 return
             elif self.retry:
                 cand = self.retry.pop(0)
             else:
                 # None: a population waits for its tells, the budget is taken, or exhausted
-                cand = self.study.ask(self.budget)
-                if cand is None:
+                asked = self.study.ask(self.budget)
+                if asked is None:
                     return
+                cand = asked
             if not self._submit(cand, alone):
                 return
 

@@ -44,7 +44,7 @@ def _l_groove_keyframes(asm: Assembly) -> np.ndarray:
         reach = room / np.tan(phi) if phi > 1e-6 else np.inf
         return float(min(reach, x0 + lc / 2 - gap - t * np.sin(phi)))
 
-    frames = [_xyz_rpy(asm.start)]
+    frames: list[np.ndarray | list[float]] = [_xyz_rpy(asm.start)]
     u0 = under_lip(tilt0)
     direction = np.array([np.cos(np.radians(tilt0)), np.sin(np.radians(tilt0))])
     above = np.array([x0 - u0, gap]) + 0.04 * direction

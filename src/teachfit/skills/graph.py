@@ -105,7 +105,8 @@ class Skill:
                 )
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup or (self.recovery is not None and self.recovery.name in names):
-            raise SkillError(f"duplicate node name(s) {dup or [self.recovery.name]}")  # type: ignore[union-attr]
+            clash = (dup or [self.recovery.name]) if self.recovery is not None else dup
+            raise SkillError(f"duplicate node name(s) {clash}")
         if self.start not in names:
             raise SkillError(f"start node {self.start!r} is not a node; nodes: {names}")
         for tr in self.transitions:
@@ -202,7 +203,8 @@ class Skill:
         def build(node: Node) -> CompiledNode:
             try:
                 run = node.primitive.compile(values)
-                err = node.error.compile(values)  # type: ignore[union-attr]
+                assert node.error is not None  # _validate checked every error exit
+                err = node.error.compile(values)
                 trs = tuple(
                     (t.condition.compile(values), index[t.target], t.condition.describe())
                     for t in self.transitions

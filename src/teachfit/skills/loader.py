@@ -161,7 +161,8 @@ def skill_to_dict(skill: Skill) -> dict[str, Any]:
     nodes = {}
     for node in skill.nodes + ((skill.recovery,) if skill.recovery else ()):
         table = node.primitive.to_toml()
-        table["error"] = node.error.to_toml()  # type: ignore[union-attr]
+        assert node.error is not None  # a skill's nodes all have an error exit
+        table["error"] = node.error.to_toml()
         table["doc"] = node.doc
         table["reset_setpoint"] = node.reset_setpoint
         nodes[node.name] = table

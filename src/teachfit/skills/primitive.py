@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import Field, dataclass, fields
 from typing import Any, ClassVar
 
 import numpy as np
@@ -66,6 +66,8 @@ class Primitive(ABC):
     """A primitive spec (see the module docstring)."""
 
     kind: ClassVar[str]
+    #: set by ``@dataclass`` on every concrete kind (what :func:`dataclasses.fields` reads)
+    __dataclass_fields__: ClassVar[dict[str, Field[Any]]]
 
     @abstractmethod
     def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
@@ -78,7 +80,7 @@ class Primitive(ABC):
     def refs(self) -> set[str]:
         """Names of the parameters this primitive uses."""
         out: set[str] = set()
-        for f in fields(self):  # type: ignore[arg-type]
+        for f in fields(self):
             val = getattr(self, f.name)
             for v in val if isinstance(val, tuple) else (val,):
                 if isinstance(v, int | float | str) and not isinstance(v, bool):
@@ -88,7 +90,7 @@ class Primitive(ABC):
 
     def to_toml(self) -> dict[str, Any]:
         out: dict[str, Any] = {"primitive": self.kind}
-        for f in fields(self):  # type: ignore[arg-type]
+        for f in fields(self):
             val = getattr(self, f.name)
             if val is not None:
                 out[f.name] = list(val) if isinstance(val, tuple) else val
@@ -377,7 +379,7 @@ class _InsertRun(PrimitiveRun):
         out.stiffness[:] = self.k
 
 
-PRIMITIVES: dict[str, type[Primitive]] = {c.kind: c for c in (MoveTo, Move, Insert)}
+PRIMITIVES: dict[str, type[MoveTo | Move | Insert]] = {c.kind: c for c in (MoveTo, Move, Insert)}
 
 
 def primitive_from_toml(data: Mapping[str, Any]) -> Primitive:
@@ -387,7 +389,7 @@ def primitive_from_toml(data: Mapping[str, Any]) -> Primitive:
         raise SkillError(f"unknown primitive {kind!r}; known: {sorted(PRIMITIVES)}")
     cls = PRIMITIVES[kind]
     known = {f.name for f in fields(cls)}
-    kwargs = {
+    kwargs: dict[str, Any] = {  # raw TOML values
         k: tuple(v) if isinstance(v, list) else v for k, v in data.items() if k != "primitive"
     }
     unknown = sorted(set(kwargs) - known)

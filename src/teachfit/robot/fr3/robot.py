@@ -24,7 +24,7 @@ import numpy as np
 
 from teachfit.control import make_law
 from teachfit.core.control import ControllerSpec, FixedGainSpec
-from teachfit.core.errors import LimitViolation, RobotFault, SimulationDiverged
+from teachfit.core.errors import ControlError, LimitViolation, RobotFault, SimulationDiverged
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import TeacherHints
@@ -97,7 +97,7 @@ class FR3Robot:
         self._limits = (self.q_min, self.q_max, self.dq_max)
         self._warning_numbers = self.data.warning.number
         self._warnings = 0
-        self._fault: RobotFault | None = None
+        self._fault: RobotFault | ControlError | None = None
         self._cmd: ImpedanceCommand | None = None
         self.q_start = np.array(READY_Q)
         #: commanded joint torques of the last executions, one ``(t, tau)`` pair per reset: t
@@ -257,7 +257,7 @@ class FR3Robot:
         law, fns, m_ptr, d_ptr, site = ctl.law, ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.site
         dat = ctl.dat
         bufs, obs, lim = ctl.ctl_bufs(), self._obs_bufs, self._limits
-        block = len(obs[6])
+        block = len(self.observer.noise)  # obs[6], rows of the noise block
         pos, quat, v, w = ctl.pos, ctl.quat, ctl.twist[:3], ctl.twist[3:]
         for _ in range(n):
             if sc[kernel.NOISE_I] >= block:
@@ -338,7 +338,7 @@ class FR3Robot:
             cause = law_fault(self.ctl.law, float(d.time))
             if cause is not None:
                 self._warnings = count
-                self._fault = cause  # type: ignore[assignment]
+                self._fault = cause
                 raise cause
         if count > self._warnings:
             kinds = [mujoco.mjtWarning(i).name for i, w in enumerate(d.warning) if w.number > 0]

@@ -131,7 +131,7 @@ def check_robot(
         host=host,
         robot_mode=mode,
         q=q,
-        tcp_pos=tuple(float(v) for v in state.pos),  # type: ignore[arg-type]
+        tcp_pos=(float(state.pos[0]), float(state.pos[1]), float(state.pos[2])),
         limits=tuple(params.limits.rows()),
         timing=timing,
     )

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -115,7 +115,7 @@ class FrankaRobot:
         self.params = params or FrankaParams()
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
         self._realtime = pf.RealtimeConfig.kEnforce if realtime else pf.RealtimeConfig.kIgnore
-        self._robot = None
+        self._robot: Any = None  # a pylibfranka.Robot (untyped) once connected
         self._connect()
         # the control thread must get the GIL within a fraction of a tick when the caller's
         # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
@@ -321,7 +321,7 @@ class FrankaRobot:
             self._connect()
         else:
             try:
-                self._robot.automatic_error_recovery()  # type: ignore[union-attr]
+                self._robot.automatic_error_recovery()
             except Exception as exc:  # noqa: BLE001 - any failure here is a robot fault
                 raise fault_from(exc, self._loop.robot) from exc
         self._start()
@@ -329,7 +329,7 @@ class FrankaRobot:
     def _start(self) -> None:
         """Start a control loop holding the current pose."""
         try:
-            first = self._robot.read_once()  # type: ignore[union-attr]
+            first = self._robot.read_once()
         except Exception as exc:  # noqa: BLE001
             raise fault_from(exc, self._loop.robot) from exc
         self.robot_mode = str(first.robot_mode).split(".")[-1]

@@ -13,6 +13,7 @@ caller after each ``step``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -63,6 +64,14 @@ def _pack(
     )
 
 
+@runtime_checkable
+class _Tapping(Protocol):
+    """A robot that samples its state in its control thread (the Franka driver)."""
+
+    def tap(self, every: int) -> None: ...
+    def untap(self) -> list[RobotState]: ...
+
+
 def record_kinesthetic(
     robot: Robot,
     duration: float | None = None,
@@ -85,33 +94,33 @@ def record_kinesthetic(
         ImpedanceCommand(
             pos=start.pos,
             quat=start.quat,
-            stiffness=0.0,
+            stiffness=np.zeros(6),  # none: the person guides the arm
             damping=np.asarray(damping, dtype=float),
             expires_after=1e9,
         )
     )
-    tapped = hasattr(robot, "tap") and hasattr(robot, "untap")
+    tapper = robot if isinstance(robot, _Tapping) else None
     samples: list[RobotState] = [start]
-    if tapped:
-        robot.tap(every)  # type: ignore[attr-defined]
+    if tapper is not None:
+        tapper.tap(every)
     try:
         last = start
         while duration is None or last.t - start.t < duration:
             last = robot.step(every)
-            if not tapped:
+            if tapper is None:
                 samples.append(last)
     except KeyboardInterrupt:
-        return _pack(_collect(robot, samples, tapped), start.t, True, "")
+        return _pack(_collect(tapper, samples), start.t, True, "")
     except RobotFault as fault:
-        rec = _pack(_collect(robot, samples, tapped), start.t, False, str(fault))
-        fault.recording = rec  # type: ignore[attr-defined]
+        rec = _pack(_collect(tapper, samples), start.t, False, str(fault))
+        fault.recording = rec  # type: ignore[attr-defined]  # attached for the caller
         raise
-    samples = _collect(robot, samples, tapped)
+    samples = _collect(tapper, samples)
     robot.command(ImpedanceCommand.hold(samples[-1].pose))  # stay where the person left it
     return _pack(samples, start.t, False, "")
 
 
-def _collect(robot: Robot, samples: list[RobotState], tapped: bool) -> list[RobotState]:
-    if tapped:
-        samples += [s for s in robot.untap() if s.t > samples[0].t]  # type: ignore[attr-defined]
+def _collect(tapper: _Tapping | None, samples: list[RobotState]) -> list[RobotState]:
+    if tapper is not None:
+        samples += [s for s in tapper.untap() if s.t > samples[0].t]
     return samples

@@ -36,10 +36,14 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterable
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from teachfit.core.errors import ConnectionLost
+
+if TYPE_CHECKING:
+    from _typeshed import ReadableBuffer
 
 HOST = "127.0.0.1"
 ROBOT_PORT = 1337
@@ -48,29 +52,29 @@ READY = "TEACHFIT-FRANKY-SIM-READY"
 _original_bind = socket.socket.bind
 
 
-def _loopback_bind(self: socket.socket, address: object) -> None:
+def _loopback_bind(self: socket.socket, address: tuple[Any, ...] | str | ReadableBuffer) -> None:
     if self.family in (socket.AF_INET, socket.AF_INET6) and isinstance(address, tuple):
         host = address[0]
         if host in ("", "0.0.0.0", "::"):
             address = (HOST, *address[1:]) if self.family == socket.AF_INET else address
         elif not ipaddress.ip_address(socket.gethostbyname(host)).is_loopback:
             raise OSError(f"teachfit franky-sim launcher: refusing to bind {host!r} (not loopback)")
-    _original_bind(self, address)  # type: ignore[arg-type]
+    _original_bind(self, address)
 
 
 def confine_to_loopback() -> None:
     """Make every IPv4 bind of this process use loopback (all-interfaces -> 127.0.0.1)."""
-    socket.socket.bind = _loopback_bind  # type: ignore[method-assign]
+    socket.socket.bind = _loopback_bind  # type: ignore[method-assign, assignment]  # patched
 
 
-def _install_push(sim: object, robot: object, path: Path) -> None:
+def _install_push(sim: Any, robot: Any, path: Path) -> None:
     """Apply the force in ``path`` to the hand each tick and report it as O_F_ext_hat_K."""
     import mujoco
     import numpy as np
     from franky_sim import franka_robot_server
 
-    state = {"force": np.zeros(3), "mtime": None, "tick": 0}
-    model, data = sim.model, sim.data  # type: ignore[attr-defined]
+    state: dict[str, Any] = {"force": np.zeros(3), "mtime": None, "tick": 0}
+    model, data = sim.model, sim.data
     hand = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "robot0_hand")
     ee_offset = np.array([0.0, 0.0, 0.1034])  # hand frame -> franky-sim's EE (TCP) point
 
@@ -94,15 +98,15 @@ def _install_push(sim: object, robot: object, path: Path) -> None:
         data.xfrc_applied[hand, :3] = f
         data.xfrc_applied[hand, 3:] = np.cross(point - data.xipos[hand], f)
 
-    sim.register_pre_step_callback(pre_step)  # type: ignore[attr-defined]
+    sim.register_pre_step_callback(pre_step)
     server_cls = franka_robot_server.FrankaRobotServer
 
-    def state_bytes(self: object) -> bytes:
+    def state_bytes(self: Any) -> bytes:
         f = state["force"]
         ext = (-float(f[0]), -float(f[1]), -float(f[2]), 0.0, 0.0, 0.0)
-        return self.robot_state.replace(O_F_ext_hat_K=ext).pack_state()  # type: ignore[attr-defined]
+        return self.robot_state.replace(O_F_ext_hat_K=ext).pack_state()
 
-    server_cls._get_state_bytes = state_bytes  # type: ignore[method-assign]
+    server_cls._get_state_bytes = state_bytes
     del robot
 
 
@@ -168,9 +172,9 @@ class SimServer:
         self.log: collections.deque[str] = collections.deque(maxlen=200)
         self._ready = threading.Event()
 
-    def _drain(self, out: object) -> None:
+    def _drain(self, out: Iterable[str]) -> None:
         try:
-            for line in out:  # type: ignore[attr-defined]
+            for line in out:
                 self.log.append(line)
                 if line.startswith(READY):
                     self._ready.set()

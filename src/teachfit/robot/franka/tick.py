@@ -24,6 +24,7 @@ import numpy as np
 from teachfit.control.base import Controller
 from teachfit.core.state import RobotState
 from teachfit.robot.franka.frames import FrankaFrames, col_major, skew
+from teachfit.robot.franka.libfranka_types import LibfrankaModel, LibfrankaState
 from teachfit.robot.franka.safety import FrankaLimits, clip_wrench_norm, limit_torque
 
 
@@ -72,26 +73,26 @@ class TorqueTick:
         self.wrench_cmd = np.zeros(6)
 
     # ------------------------------------------------------------------ kinematics
-    def kinematics(self, state: object, model: object) -> None:
+    def kinematics(self, state: LibfrankaState, model: LibfrankaModel) -> None:
         """TCP pose/twist in the world (``pos``, ``quat``, ``lin_vel``, ``ang_vel``) and the
         TCP Jacobian (base frame) from a pylibfranka ``RobotState``."""
-        t_ee = col_major(state.O_T_EE)  # type: ignore[attr-defined]
+        t_ee = col_major(state.O_T_EE)
         r_ee, p_ee = t_ee[:3, :3], t_ee[:3, 3]
         r_tcp = r_ee @ self._r_et
         lever = r_ee @ self._p_et  # EE -> TCP, base frame
         p_tcp = p_ee + lever
-        zj = model.zero_jacobian(state)  # type: ignore[attr-defined]
+        zj = model.zero_jacobian(state)
         jac = np.asarray(zj, dtype=float).reshape(6, 7, order="F")
         jac[:3] -= skew(lever) @ jac[3:]  # v_tcp = v_ee + w x lever
         self.jacobian = jac
-        twist = jac @ np.asarray(state.dq, dtype=float)  # type: ignore[attr-defined]
+        twist = jac @ np.asarray(state.dq, dtype=float)
         self.pos = self._r_wo @ p_tcp + self._t_wo
         self.rot = self._r_wo @ r_tcp
         mujoco.mju_mat2Quat(self._quat, self.rot.reshape(-1))
         self.lin_vel = self._r_wo @ twist[:3]
         self.ang_vel = self._r_wo @ twist[3:]
         if self._k_offset is None:  # EE_T_K is set with set_K, not during control: read once
-            self._k_offset = col_major(state.EE_T_K)[:3, 3].copy()  # type: ignore[attr-defined]
+            self._k_offset = col_major(state.EE_T_K)[:3, 3].copy()
         # K -> TCP lever (base frame), for moving the measured torque to the TCP
         self._k_lever = r_ee @ (self._k_offset - self._p_et)
 
@@ -99,9 +100,9 @@ class TorqueTick:
     def quat(self) -> np.ndarray:
         return self._quat
 
-    def raw_wrench(self, state: object) -> np.ndarray:
+    def raw_wrench(self, state: LibfrankaState) -> np.ndarray:
         """The environment's wrench on the tool at the TCP, world frame, before the bias."""
-        ext = np.asarray(state.O_F_ext_hat_K, dtype=float)  # type: ignore[attr-defined]
+        ext = np.asarray(state.O_F_ext_hat_K, dtype=float)
         f = -ext[:3]  # libfranka: robot on environment -> teachfit: environment on tool
         r = self._k_lever
         t = -ext[3:]
@@ -113,7 +114,7 @@ class TorqueTick:
         out[3:] = self._r_wo @ t
         return out.copy()
 
-    def robot_state(self, t: float, state: object) -> RobotState:
+    def robot_state(self, t: float, state: LibfrankaState) -> RobotState:
         """A teachfit :class:`RobotState` of the last :meth:`kinematics` call."""
         return RobotState(
             t=t,
@@ -125,7 +126,9 @@ class TorqueTick:
         )
 
     # ------------------------------------------------------------------ torques
-    def torques(self, t: float, law: Controller, state: object, model: object) -> np.ndarray:
+    def torques(
+        self, t: float, law: Controller, state: LibfrankaState, model: LibfrankaModel
+    ) -> np.ndarray:
         """Joint torques (7,) for this tick (after :meth:`kinematics`)."""
         w = law.compute(t, self.pos, self._quat, self.lin_vel, self.ang_vel)
         w = clip_wrench_norm(
@@ -134,10 +137,10 @@ class TorqueTick:
         self.wrench_cmd = w
         f_base = np.concatenate([self._r_wo.T @ w[:3], self._r_wo.T @ w[3:]])
         jac = self.jacobian
-        q = np.asarray(state.q, dtype=float)  # type: ignore[attr-defined]
-        dq = np.asarray(state.dq, dtype=float)  # type: ignore[attr-defined]
+        q = np.asarray(state.q, dtype=float)
+        dq = np.asarray(state.dq, dtype=float)
         tau = jac.T @ f_base
-        tau += np.asarray(model.coriolis(state), dtype=float)  # type: ignore[attr-defined]
+        tau += np.asarray(model.coriolis(state), dtype=float)
         posture = self.k_ns * (self.q_rest - q) - self.d_ns * dq
         jjt = jac @ jac.T
         jjt.flat[::7] += 1e-4  # damped: well-posed near singularities

@@ -95,6 +95,7 @@ class Peg2D(Task):
     scene_type = Peg2DScene
     protocol_type = Peg2DProtocol
     params: Peg2DParams
+    scene: Peg2DScene
 
     @property
     def surface_z(self) -> float:

@@ -7,15 +7,35 @@ Both cells' parameters have ``peg_diameter``, ``peg_chamfer``, ``peg_length``, `
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 from teachfit.tasks.params import TaskParams
+
+
+class _RoundPeg(Protocol):
+    """The fields a round-peg cell's parameters have (m; ``n_sectors`` a count)."""
+
+    @property
+    def peg_diameter(self) -> float: ...
+    @property
+    def peg_chamfer(self) -> float: ...
+    @property
+    def peg_length(self) -> float: ...
+    @property
+    def hole_depth(self) -> float: ...
+    @property
+    def success_depth(self) -> float: ...
+    @property
+    def n_sectors(self) -> int: ...
+    def require(self, condition: bool, message: str) -> None: ...
+    def require_reachable(self, success_depth: float, depth: float, hole: str) -> None: ...
 
 
 @dataclass(frozen=True)
 class RoundPegParams(TaskParams):
     """Mixin without fields: :meth:`check_round_peg` for the round-peg cells' parameters."""
 
-    def check_round_peg(self) -> None:
+    def check_round_peg(self: _RoundPeg) -> None:
         """The peg fits its hole, reaches the success depth and stands out of the hole."""
         self.require(
             self.peg_chamfer < self.peg_diameter / 2,

@@ -67,7 +67,8 @@ def new_task_file(
         held_tcp = h.copy()
         held_tcp.apply_transform(grasp_of(spec, h))
         pos = infer_hole(f, held_tcp) / scale
-        spec = dataclasses.replace(spec, hole_pos=tuple(float(round(v, 6)) + 0.0 for v in pos))
+        x, y, z = (float(round(v, 6)) + 0.0 for v in pos)
+        spec = dataclasses.replace(spec, hole_pos=(x, y, z))
     cell = build_cell(spec, parts)
     write_atomic(out, spec_to_toml(spec).encode())
     remember_cell(out, cell)

@@ -170,8 +170,8 @@ def decompose(
         t0 = time.perf_counter()
         boxes = box_pieces(mesh, settings.max_pieces)
         if boxes is not None:
-            pieces = tuple((np.asarray(b.vertices), np.asarray(b.faces)) for b in boxes)
-            return Decomposition(pieces, time.perf_counter() - t0, False, "boxes")
+            box_list = tuple((np.asarray(b.vertices), np.asarray(b.faces)) for b in boxes)
+            return Decomposition(box_list, time.perf_counter() - t0, False, "boxes")
         if settings.method == "boxes":
             raise TaskError(
                 f'{name}: method = "boxes" needs a rectilinear part (every face normal to a '

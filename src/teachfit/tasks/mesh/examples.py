@@ -101,6 +101,13 @@ EXAMPLES: dict[str, Callable[[], tuple[trimesh.Trimesh, trimesh.Trimesh]]] = {
 }
 
 
+def _stl(mesh: trimesh.Trimesh) -> bytes:
+    """``mesh`` as binary STL (trimesh's STL export always gives bytes)."""
+    data = mesh.export(file_type="stl")
+    assert isinstance(data, bytes)
+    return data
+
+
 def write_example(name: str, folder: str | Path) -> Path:
     """Write the example ``name``'s two STL meshes (mm) and its task file into ``folder``;
     return the task file's path. Every file is written atomically."""
@@ -109,7 +116,7 @@ def write_example(name: str, folder: str | Path) -> Path:
     folder = Path(folder)
     held, fixed = EXAMPLES[name]()
     spec = _spec(name, folder)
-    write_atomic(spec.held_mesh, held.export(file_type="stl"))
-    write_atomic(spec.fixed_mesh, fixed.export(file_type="stl"))
+    write_atomic(spec.held_mesh, _stl(held))
+    write_atomic(spec.fixed_mesh, _stl(fixed))
     write_atomic(spec.path, spec_to_toml(spec).encode())
     return spec.path

@@ -111,7 +111,7 @@ class MeshTask(SkillTask):
 
     name = "mesh"
     description = "a user's held part into a user's fixed part, from STL/OBJ/PLY meshes"
-    search_dims: tuple[str, ...] = ("x", "y")
+    search_dims: ClassVar[tuple[str, ...]] = ("x", "y")
     params_type = MeshParams
     scene_type = MeshScene
     protocol_type = MeshProtocol
@@ -121,7 +121,7 @@ class MeshTask(SkillTask):
     def __init__(self, cell: MeshCell, params: MeshParams | None, name: str) -> None:
         self.cell = cell
         self.name = name  # type: ignore[misc]  # the file's path: loadable by every process
-        self.search_dims = cell.spec.search_dims  # type: ignore[misc]
+        self.search_dims = cell.spec.search_dims  # type: ignore[misc]  # the file's dims, per cell
         if cell.spec.rz_period_deg > 0:
             self.rz_period = float(np.radians(cell.spec.rz_period_deg))
         super().__init__(params)

@@ -18,7 +18,7 @@ Frames as in :mod:`teachfit.tasks.base`: world z up, the hole frame at the entry
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 
@@ -73,7 +73,7 @@ class SkillProtocol(Protocol):
     pose."""
 
     task: SkillTask
-    names = ("skill",)
+    names: ClassVar[tuple[str, ...]] = ("skill",)
 
     def teacher_start(self, rng: np.random.Generator) -> Pose:
         """On the surface ``demo_offset`` from the hole in a random direction (hole frame).

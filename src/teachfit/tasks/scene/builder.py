@@ -51,7 +51,7 @@ class SceneBuilder(ABC):
 def fixture_body(scene: SceneXml, yaw: float = 0.0) -> ET.Element:
     """The static body ``fixture`` in the world, turned by ``yaw`` (rad) about world z."""
     kw = {"euler": fmt([0.0, 0.0, yaw])} if yaw else {}
-    return ET.SubElement(scene.worldbody, "body", name="fixture", **kw)
+    return ET.SubElement(scene.worldbody, "body", {}, name="fixture", **kw)
 
 
 def add_geom(
@@ -65,7 +65,7 @@ def add_geom(
     (numbers and arrays are formatted with :func:`~teachfit.tasks.scene.mjcf.fmt`)."""
     values = {k: v if isinstance(v, str) else fmt(v) for k, v in attrs.items()}
     return ET.SubElement(
-        parent, "geom", name=name, material=material, **values, **contact_attrs(contact)
+        parent, "geom", {}, name=name, material=material, **values, **contact_attrs(contact)
     )
 
 
