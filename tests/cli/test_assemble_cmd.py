@@ -85,3 +85,21 @@ def test_bench_assembly_params_are_checked_before_any_trial(tmp_path, peg_model)
     assert res.exit_code == 2 and "bad.toml" in res.output and "Traceback" not in res.output
     res = invoke("bench", "assembly", "--tasks", "peg2d,socket3d", "--search", peg_model)
     assert res.exit_code == 2 and "exactly one peg-type task" in res.output
+
+
+def test_bench_assembly_appends_its_table_as_markdown(tmp_path, monkeypatch):
+    from teachfit.bench import assembly
+    from teachfit.metrics.stats import summarize
+
+    def bench_task(name, errors, trials, *args, **kwargs):
+        ok, none = summarize([True, True, False], [1.5, 2.5, 9.0]), summarize([False], [0.0])
+        return {"skill": [(e, ok) for e in errors], "joined": [(e, none) for e in errors]}
+
+    monkeypatch.setattr(assembly, "bench_task", bench_task)
+    out = tmp_path / "assembly.md"
+    res = invoke("bench", "assembly", "--tasks", "peg2d", "--errors", "0,3", "--markdown", out)
+    assert res.exit_code == 0, res.output
+    text = out.read_text(encoding="utf-8")
+    assert text.startswith("<!-- teachfit-run source=command")
+    assert "| peg2d (10 trials), e (mm) | skill | joined |" in text
+    assert "| 3 | 2/3 [21,94] 2.00 | 0/1 [0,79] |" in text

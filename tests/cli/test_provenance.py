@@ -68,6 +68,15 @@ def test_the_commit_is_the_source_tree_s_and_says_when_it_is_modified(tmp_path) 
     (tmp_path / "f.py").write_text("x = 2\n")
     assert pv.source_commit(tmp_path) == sha + "+dirty"
     assert pv.source_commit(tmp_path / "nowhere") == "unknown"
+    # only the code's own folder counts: a results file beside it changed leaves it clean
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "m.py").write_text("y = 1\n")
+    _git(tmp_path, "add", "pkg/m.py")
+    _git(tmp_path, "commit", "-qm", "pkg")
+    sha = _git(tmp_path, "rev-parse", "--short", "HEAD")
+    assert pv.source_commit(tmp_path / "pkg") == sha
+    (tmp_path / "pkg" / "m.py").write_text("y = 2\n")
+    assert pv.source_commit(tmp_path / "pkg") == sha + "+dirty"
 
 
 def test_a_bench_command_heads_its_markdown(tmp_path) -> None:

@@ -34,3 +34,19 @@ def test_learning_on_a_real_robot_is_not_parallel(tmp_path) -> None:
     res = runner.invoke(app, [*args, "--trials", "1"])
     assert res.exit_code == 2 and "real franka" in res.output
     assert not study.exists()
+
+
+def test_bench_robot_appends_its_figures_as_markdown(tmp_path, monkeypatch) -> None:
+    from teachfit.robot.franka import check
+
+    timing = check.LoopTiming(
+        ticks=10_000, compute_p50=283e-6, compute_p99=485e-6, compute_max=702e-6,
+        overruns=3, missed_packets=1, period=1e-3, wall_rate=809.0,
+    )  # fmt: skip
+    monkeypatch.setattr(check, "bench_loop", lambda *args, **kwargs: timing)
+    out = tmp_path / "robot.md"
+    res = runner.invoke(app, ["bench", "robot", "--host", "127.0.0.1", "--markdown", str(out)])
+    assert res.exit_code == 0, res.output
+    text = out.read_text(encoding="utf-8")
+    assert text.startswith("<!-- teachfit-run source=command")
+    assert "| 283 µs | 485 µs | 702 µs | 3 | 1 | 809 ticks/s |" in text

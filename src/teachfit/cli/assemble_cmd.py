@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping, Sequence
 from functools import partial
@@ -11,7 +12,8 @@ from typing import TYPE_CHECKING, Annotated, Any, cast
 import typer
 from rich.table import Table
 
-from teachfit.cli.common import RobotOpt, console, guarded
+from teachfit.cli import options as o
+from teachfit.cli.common import RobotOpt, append_markdown, console, guarded
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.cli.run_end import end_run, exit_if_faulted, report_faults
@@ -24,6 +26,7 @@ if TYPE_CHECKING:
     from teachfit.demonstrations.dataset import Demonstration
     from teachfit.execution.assembly import AssemblyTrial
     from teachfit.execution.plan_contact import PlanTrial
+    from teachfit.metrics.stats import SuccessSummary
 
 _UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6, "deg": 0.017453292519943295, "rad": 1.0}
 
@@ -215,6 +218,7 @@ def bench_assembly(
             help="methods, comma-separated: skill, search, open-loop, joined (none: only --params)"
         ),
     ] = "skill,search,open-loop,joined",
+    markdown: o.Markdown = None,
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
     from teachfit.bench.assembly import bench_inputs, bench_task
@@ -226,9 +230,10 @@ def bench_assembly(
     chosen = tuple(m.strip() for m in methods.split(",") if m.strip())
     if not set(chosen) <= set(METHODS) or not (chosen or learned):
         raise TeachfitError(f"--methods: choose from {', '.join(METHODS)} (got {methods!r})")
+    md: list[str] = []
     for name in names:
         if name in ("l-groove", "tenon"):
-            _bench_planned(name, trials, seed)
+            md += _bench_planned(name, trials, seed)
             continue
         with progress_bar() as bar:
             job = bar.add_task(f"{name}: demonstrations, then trials")
@@ -237,28 +242,51 @@ def bench_assembly(
                 model=model, learned=learned, methods=chosen,
             )  # fmt: skip
         _print_bench(name, rows, errs, bool(learned))
+        md += ["", *_bench_markdown(name, rows, errs, trials)]
         if plot is not None:
             from teachfit.viz.assembly_figures import plot_success_by_error
 
             path = plot.with_name(f"{plot.stem}-{name}{plot.suffix}")
             title = f"{name}: success against the taught-hole error, {trials} trials, seed {seed}"
             console.print(f"figure -> {plot_success_by_error(rows, path, title)}")
+    if markdown is not None and md:
+        text = "\n".join(md).strip("\n")
+        console.print(f"markdown appended to {append_markdown(markdown, text)}")
 
 
-def _bench_planned(name: str, trials: int, seed: int) -> None:
-    """``bench assembly`` on a planned part: open loop vs joined, one line each."""
+def _bench_markdown(name: str, rows: Rows, errs: list[float], trials: int) -> list[str]:
+    """``bench assembly``'s table of a peg-type task in markdown: each cell successes/trials
+    [Wilson 95 %] and the median time to insertion (s from the start)."""
+
+    def cell(s: SuccessSummary) -> str:
+        t = "" if math.isnan(s.median_time) else f" {s.median_time:.2f}"
+        return f"{s.successes}/{s.trials} [{100 * s.low:.0f},{100 * s.high:.0f}]{t}"
+
+    out = [f"| {name} ({trials} trials), e (mm) | " + " | ".join(rows) + " |"]
+    out.append("| --- " * (len(rows) + 1) + "|")
+    for i, e in enumerate(errs):
+        out.append(f"| {e * 1e3:g} | " + " | ".join(cell(rows[m][i][1]) for m in rows) + " |")
+    return out
+
+
+def _bench_planned(name: str, trials: int, seed: int) -> list[str]:
+    """``bench assembly`` on a planned part: open loop vs joined, one line each (returned
+    as markdown list items too)."""
     from teachfit.bench.assembly import bench_plan_task, losses
 
     with progress_bar() as bar:
         job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
         rows, meas = bench_plan_task(name, trials, seed, partial(bar.advance, job))
-    for m, pts in rows.items():
-        console.print(
-            f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
-            f"inserted {pts[0][1]} (end time); measured success {meas[m]}/{trials}"
-        )
+    lines = [
+        f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
+        f"inserted {pts[0][1]} (end time); measured success {meas[m]}/{trials}"
+        for m, pts in rows.items()
+    ]
+    for line in lines:
+        console.print(line)
     for line in losses(rows):
         console.print(f"  [yellow]joined does not beat[/] {line}")
+    return [f"- {line}" for line in lines]
 
 
 def _print_bench(name: str, rows: Rows, errs: list[float], learned: bool) -> None:

@@ -107,15 +107,17 @@ def _git(root: Path, *args: str) -> str | None:
 
 
 def source_commit(root: Path | None = None) -> str:
-    """Short commit of the git checkout holding teachfit's source (``+dirty`` if its tracked
-    files are modified), or ``unknown`` (an installed wheel, no git)."""
+    """Short commit of the git checkout holding teachfit's source (``+dirty`` if a tracked file
+    under ``root``, the package's own folder by default, is modified: a results file appended
+    by an earlier run does not make the code dirty), or ``unknown`` (an installed wheel, no
+    git)."""
     import teachfit
 
     root = root or Path(teachfit.__file__).resolve().parent
     sha = _git(root, "rev-parse", "--short", "HEAD")
     if not sha:
         return "unknown"
-    status = _git(root, "status", "--porcelain", "--untracked-files=no")
+    status = _git(root, "status", "--porcelain", "--untracked-files=no", "--", ".")
     return sha + ("+dirty" if status else "")
 
 

@@ -4,16 +4,27 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.markup import escape
 from rich.table import Table
 
-from teachfit.cli.common import HostOpt, RobotOpt, console, err_console, guarded
+from teachfit.cli import options as o
+from teachfit.cli.common import (
+    HostOpt,
+    RobotOpt,
+    append_markdown,
+    console,
+    err_console,
+    guarded,
+)
 from teachfit.cli.tables import print_table
 from teachfit.core.errors import TeachfitError
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT
+
+if TYPE_CHECKING:
+    from teachfit.robot.franka.check import LoopTiming
 
 robot_app = typer.Typer(
     help="The robots teachfit drives: list them, check one.", no_args_is_help=True
@@ -85,6 +96,7 @@ def bench_robot(
     ] = 10.0,
     realtime: Annotated[bool, _REALTIME] = True,
     connect_timeout: ConnectTimeoutOpt = CONNECT_TIMEOUT,
+    markdown: o.Markdown = None,
 ) -> None:
     """Tick compute time p50/p99/max and missed deadlines of the 1 kHz loop, through the
     robot's protocol."""
@@ -96,7 +108,31 @@ def bench_robot(
     address = _real(robot, host)
     params = FrankaParams(connect_timeout=connect_timeout)
     with _interruptible(address):
-        bench_loop(address, seconds=seconds, params=params, realtime=realtime, out=console.print)
+        timing = bench_loop(
+            address, seconds=seconds, params=params, realtime=realtime, out=console.print
+        )
+    if markdown is not None:
+        text = _timing_markdown(timing, address)
+        console.print(f"markdown appended to {append_markdown(markdown, text)}")
+
+
+def _timing_markdown(t: LoopTiming, address: str) -> str:
+    """``bench robot``'s figures as a one-row markdown table (times in µs, the 1-minute load
+    average at the end of the run)."""
+    import os
+
+    us = [f"{v * 1e6:.0f} µs" for v in (t.compute_p50, t.compute_p99, t.compute_max)]
+    rate = f"{t.wall_rate:.0f} ticks/s" if t.wall_rate else "-"
+    row = [f"{os.getloadavg()[0]:.1f}", *us, str(t.overruns), str(t.missed_packets), rate]
+    return "\n".join([
+        f"**the 1 kHz loop of the robot at {address}**, {t.ticks} ticks "
+        f"({t.ticks * t.period:.1f} s), through the robot's protocol",
+        "",
+        "| load | tick compute p50 | p99 | max | ticks over "
+        f"{t.period * 1e3:.0f} ms | states never read | wall-clock rate |",
+        "| --- | --- | --- | --- | --- | --- | --- |",
+        "| " + " | ".join(row) + " |",
+    ])  # fmt: skip
 
 
 @contextmanager
