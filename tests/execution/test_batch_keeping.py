@@ -82,3 +82,20 @@ def test_worker_processes_keep_the_results_before_the_job_that_failed() -> None:
     finished = run_batch_keeping(math.sqrt, [4.0, 9.0, -1.0, 16.0, 25.0], workers=2)
     assert finished.items == [2.0, 3.0] and finished.total == 5
     assert isinstance(finished.stop, ValueError)
+
+
+def test_keep_each_keeps_what_a_callback_run_finished_before_it_was_cut() -> None:
+    from teachfit.execution.batch import keep_each
+
+    ticks: list[int] = []
+
+    def run(done: Callable[[int], None]) -> None:
+        for i in range(3):
+            if i == 2:
+                raise KeyboardInterrupt
+            done(i)
+
+    finished = keep_each(5, run, lambda: ticks.append(1))
+    assert finished.items == [0, 1] and finished.total == 5 and len(ticks) == 2
+    assert isinstance(finished.stop, KeyboardInterrupt) and not finished.complete
+    assert keep_each(1, lambda done: done("x")).complete

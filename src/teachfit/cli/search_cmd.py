@@ -172,7 +172,8 @@ def run(
     cut short (lost connection, Ctrl-C) prints and logs what finished; see the README.
     """
     points = o.pick(points, n)
-    from teachfit.execution.search_runs import demo_start_pose, run_protocol_keeping
+    from teachfit.execution.batch import Finished, keep_each
+    from teachfit.execution.search import demo_start_pose, run_protocol
     from teachfit.models.search_model import SearchModel
     from teachfit.robot.registry import make_robot
     from teachfit.tasks.registry import load_task
@@ -187,12 +188,19 @@ def run(
             "the hole; without --demo a nominal demonstration start is assumed"
         )
     the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime))
-    with progress_bar() as bar:
-        job = bar.add_task(f"{method} from {starts} starts", total=starts)
-        finished = run_protocol_keeping(
-            the_robot, the_task, model, method, points, starts, protocol, seed, passes=passes,
-            feedforward=feedforward, demo_start=demo_start, progress=lambda: bar.advance(job),
-        )  # fmt: skip
+    try:
+        with progress_bar() as bar:
+            job = bar.add_task(f"{method} from {starts} starts", total=starts)
+            finished: Finished[SearchRun] = keep_each(
+                starts,
+                lambda done: run_protocol(
+                    the_robot, the_task, model, method, points, starts, protocol, seed,
+                    passes=passes, feedforward=feedforward, demo_start=demo_start, on_done=done,
+                ),
+                lambda: bar.advance(job),
+            )  # fmt: skip
+    finally:
+        the_robot.close()
     runs = finished.items
     n_pts = f", N = {points}" if method == "tshix" else ""
     title = f"{method}{n_pts} on {the_task.name} ({protocol} starts, seed {seed})"

@@ -17,7 +17,7 @@ import numpy as np
 
 from teachfit.core.errors import TeachfitError
 from teachfit.execution.assembly import AssemblyJob, AssemblyTrial, assembly_jobs, method_skill
-from teachfit.execution.batch import Finished, keeping
+from teachfit.execution.batch import Finished, keep_each
 from teachfit.models.search_model import SearchModel
 from teachfit.skills.library import get_skill
 from teachfit.skills.params import read_params_toml
@@ -111,14 +111,10 @@ def run_plan_trials_keeping(
     (:func:`capture_ranges`)."""
     from teachfit.execution.plan_contact import run_plan_trials
 
-    finished: Finished[PlanTrial] = Finished(total=trials)
-    with keeping(finished):
-
-        def done(trial: PlanTrial) -> None:
-            finished.add(trial)
-            progress()
-
-        run_plan_trials(
+    return keep_each(
+        trials,
+        lambda done: run_plan_trials(
             part, path, trials, seed, on_trial=done, translation=translation, rotation=rotation
-        )
-    return finished
+        ),
+        progress,
+    )

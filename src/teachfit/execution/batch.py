@@ -111,3 +111,23 @@ def keeping(finished: Finished[R]) -> Iterator[Finished[R]]:
         yield finished
     except BaseException as exc:  # noqa: BLE001 - kept for the caller, which re-raises or exits
         finished.stop = exc
+
+
+def keep_each(
+    total: int,
+    run: Callable[[Callable[[R], None]], object],
+    progress: Callable[[], None] | None = None,
+) -> Finished[R]:
+    """Call ``run(done)``, a run of ``total`` executions that calls ``done(item)`` as each one
+    finishes, and keep every finished item and what ended the run early (:func:`keeping`);
+    ``progress`` is called after each item."""
+    finished: Finished[R] = Finished(total=total)
+
+    def done(item: R) -> None:
+        finished.add(item)
+        if progress is not None:
+            progress()
+
+    with keeping(finished):
+        run(done)
+    return finished

@@ -338,3 +338,14 @@ def run_protocol(
         if on_done is not None:
             on_done(run)
     return runs
+
+
+def demo_start_pose(demo: str, task: str) -> Pose:
+    """The start pose of the demonstration ``demo`` (``FILE.h5:INDEX``), which must show
+    ``task`` (its name): it anchors Table I's starts."""
+    from teachfit.demonstrations.dataset import read_demo
+
+    d = read_demo(demo)
+    if d.task != task:
+        raise TeachfitError(f"--demo {demo} is a {d.task!r} demonstration, not {task!r}")
+    return d.start_pose
