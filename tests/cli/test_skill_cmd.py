@@ -81,3 +81,22 @@ def test_skill_run_rejects_unknown_or_out_of_domain_params(tmp_path):
     far.write_text("tilt = 1.0\n")
     res = invoke("skill", "run", "--task", "peg2d", "--params", far, "--starts", "1")
     assert res.exit_code == 2 and "'tilt' = 1.0 is outside" in res.output
+
+
+def test_setups_wiring_learn_over_setups_then_run_held_out(tmp_path):
+    """``learn skill --setups`` stores the count with its study (a resume with another count is
+    refused), ``skill run --setups`` runs held-out set-ups and reports them."""
+    db, best = tmp_path / "s.db", tmp_path / "best.toml"
+    quick = ("--task", "peg2d", "--starts", "1", "--workers", "0", "--study", db)
+    res = invoke("learn", "skill", *quick, "--trials", 2, "--setups", 2, "--out", best)
+    assert res.exit_code == 0, res.output
+    assert "1 start(s) x 2 set-ups per trial" in res.output and "--setups 20" in res.output
+    res = invoke("learn", "skill", *quick, "--trials", 3, "--setups", 3, "--resume")
+    assert res.exit_code == 2 and "another study" in res.output
+    res = invoke("skill", "run", "--task", "peg2d", "--params", best, "--starts", 1, "--setups", 2)
+    assert res.exit_code == 0, res.output
+    assert "2 held-out set-ups, 1 start(s) each; taught hole off by" in res.output
+    line = next(ln for ln in res.output.splitlines() if "held-out set-ups with every" in ln)
+    assert "/2 = " in line
+    res = invoke("skill", "run", "--task", "peg2d", "--setups", 0)
+    assert res.exit_code == 2

@@ -67,6 +67,7 @@ def learn_skill(
     controller: Annotated[str, _CONTROLLER] = "adaptive",
     seed: Annotated[int, o.seed("the set-up (hole estimate, starts) and of the learner")] = 0,
     starts: Annotated[int, o.starts("per trial (one execution each)")] = 4,
+    setups: Annotated[int, o.setups("each trial is evaluated on (training stream)")] = 1,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
     out: Annotated[
         Path | None,
@@ -90,23 +91,24 @@ def learn_skill(
 
     req = LearnRequest(
         task, skill, method, trials, study, resume, workers, ray, controller, seed, starts,
-        _overrides(task_param), robot, host or "", realtime,
+        _overrides(task_param), robot, host or "", realtime, setups,
     )  # fmt: skip
     launch = open_learning(req)
     for note in launch.notes:
         console.print(f"note: {note}")
     st, obj, n_w = launch.study, launch.objective, launch.workers
     where = f"Ray at {ray}" if ray else f"{'all cores' if n_w is None else n_w} worker(s)"
+    per = f"{starts} start(s)" + (f" x {setups} set-ups" if setups > 1 else "")
     console.print(
-        f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {starts} start(s) "
-        f"per trial) -> {st.where}; {st.n_restored} trial(s) restored; {where}"
+        f"{method} on [bold]{task}[/] ({obj.space.dim} parameters, {per} per trial) -> "
+        f"{st.where}; {st.n_restored} trial(s) restored; {where}"
     )
     if st.n_finished >= trials:
         console.print(
             f"[yellow]the study already holds {st.n_finished} trial(s) >= --trials "
             f"{trials}[/]: nothing to run; raise --trials to continue"
         )
-    title = f"{method} on {task}, seed {seed}, {starts} start(s) per trial"
+    title = f"{method} on {task}, seed {seed}, {per} per trial"
     figures = (plot, traces, best_plot)
     _run_and_report(launch, out, figures, title)
 
@@ -203,7 +205,8 @@ def _report_best(
         path = write_params_toml(out, best.params, head)
         task = obj.task
         console.print(
-            f"parameters -> {path} (run them: teachfit skill run --task {task} --params {path})"
+            f"parameters -> {path} (run them on set-ups never seen: teachfit skill run --task "
+            f"{task} --params {path} --setups 20)"
         )
     if plot is not None:
         console.print(f"learning curve -> {lf.plot_study_curve(recs, plot, title)}")

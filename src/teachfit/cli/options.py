@@ -108,6 +108,16 @@ def task(choices: str = "a built-in name (teachfit tasks) or a task .toml") -> A
     return typer.Option("--task", help=f"task: {choices}")
 
 
+def setups(what: str = "") -> Any:
+    """``--setups N``: how many set-ups (taught hole pose and starts) drawn from the task's
+    error distribution (:mod:`teachfit.execution.setups`)."""
+    return typer.Option(
+        "--setups",
+        min=1,
+        help="set-ups (taught hole pose with its error, and starts)" + (f" {what}" if what else ""),
+    )
+
+
 def starts(what: str = "") -> Any:
     """``--starts N``: how many start poses."""
     return typer.Option("--starts", min=1, help="start poses" + (f" {what}" if what else ""))

@@ -19,6 +19,7 @@ from teachfit.core.atomic import atomic_write_text
 if TYPE_CHECKING:
     from teachfit.execution.engine import ExecutionResult
     from teachfit.execution.recording import Episode
+    from teachfit.execution.setups import DrawnSetups
     from teachfit.execution.skill_trial import SkillSetup, SkillTrial
     from teachfit.tasks.base import Task
 
@@ -100,7 +101,10 @@ def run(
     ] = None,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
     seed: Annotated[int, o.seed("the hole estimate, the starts and the sensor noise")] = 0,
-    starts: Annotated[int, o.starts("(one execution each)")] = 4,
+    starts: Annotated[int, o.starts("per set-up (one execution each)")] = 4,
+    setups: Annotated[
+        int | None, o.setups("held out: drawn from a stream 'learn skill' never uses")
+    ] = None,
     render: o.Render = None,
     render_start: Annotated[int, typer.Option(help="which execution --render draws")] = 0,
     plot: Annotated[Path | None, o.plot("force and pose over time of each execution")] = None,
@@ -119,29 +123,32 @@ def run(
     Exit status: 0, or 1 when the robot stopped an execution (each reason is printed); a run
     cut short (lost connection, Ctrl-C) prints and logs what finished; see the README."""
     from teachfit.core.errors import SkillError
-    from teachfit.execution.skill_runs import hole_estimate_error, run_starts, start_episodes
-    from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
+    from teachfit.execution.setups import draw_setups
+    from teachfit.execution.skill_runs import run_starts, start_episodes
+    from teachfit.execution.skill_trial import SkillTrial
     from teachfit.skills.library import get_skill
     from teachfit.tasks.registry import load_task
 
     if starts < 1:
         raise SkillError(f"--starts must be >= 1, got {starts}")
-    if render is not None and not 0 <= render_start < starts:
-        raise SkillError(f"--render-start must be within [0, {starts - 1}]")
+    n_runs = starts * (setups or 1)
+    if render is not None and not 0 <= render_start < n_runs:
+        raise SkillError(f"--render-start must be within [0, {n_runs - 1}]")
     check_recording_targets(log, rrd)
     the_task = load_task(task)
-    setup = peg_in_hole_setup(the_task, seed, starts, controller, get_skill(skill, controller))
+    sk = get_skill(skill, controller)
+    drawn = draw_setups(the_task, seed, starts, controller, sk, setups or 1, setups is not None)
+    setup = drawn.setup
     learned = _learned(params, setup)
     trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host, realtime))
     try:
-        est = hole_estimate_error(setup)
-        console.print(
-            f"{setup.skill.name} on {the_task.name} ({controller} controller); hole estimate "
-            f"off by ({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, yaw {est.rz:+.3f} rad"
-        )
-        with console.status(f"running {starts} execution(s)"):
-            finished = run_starts(trial, learned, starts)
+        console.print(f"{setup.skill.name} on {the_task.name} ({controller} controller); "
+                      + describe_setups(drawn))  # fmt: skip
+        with console.status(f"running {n_runs} execution(s)"):
+            finished = run_starts(trial, learned, n_runs)
         faulted = _report(trial, finished.items)
+        if setups is not None:
+            console.print(held_out_summary(drawn, trial, finished.items))
         info = ("skill", the_task, robot, seed, f"{skill} {controller}")
         _record(log, rrd, start_episodes(setup, finished.items), info, ctx.params)
         if finished.complete:
@@ -150,6 +157,41 @@ def run(
         end_run(finished, faulted)
     finally:
         trial.robot.close()
+
+
+def describe_setups(drawn: DrawnSetups) -> str:
+    """How far the taught hole of the set-up(s) is off the true one."""
+    n = len(drawn.setup.starts) // drawn.setups
+    errs = drawn.taught_errors()
+    if drawn.setups == 1:
+        est = errs[0]
+        return (
+            f"hole estimate off by ({est.pos[0] * 1e3:+.2f}, {est.pos[1] * 1e3:+.2f}) mm, "
+            f"yaw {est.rz:+.3f} rad"
+        )
+    off = [float(np.hypot(*e.pos[:2])) * 1e3 for e in errs]
+    return (
+        f"{drawn.setups} held-out set-ups, {n} start(s) each; taught hole off by "
+        f"{min(off):.2f}-{max(off):.2f} mm (median {np.median(off):.2f} mm)"
+    )
+
+
+def held_out_summary(drawn: DrawnSetups, trial: SkillTrial, traces: list[ExecutionResult]) -> str:
+    """Held-out success: set-ups where every start inserted, and executions, with 95 % Wilson
+    intervals."""
+    from teachfit.metrics.stats import wilson_interval
+
+    oks = [trial.metric.evaluate(tr)[0] for tr in traces]
+    per = drawn.per_setup(oks)
+
+    def rate(k: int, n: int) -> str:
+        lo, hi = wilson_interval(k, n)
+        return f"{k}/{n} = {100 * k / max(n, 1):.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]"
+
+    return (
+        f"held-out set-ups with every start inserted: {rate(sum(per), len(per))}; "
+        f"executions: {rate(sum(oks), len(oks))}"
+    )
 
 
 def _learned(params: Path | None, setup: SkillSetup) -> dict[str, float] | None:

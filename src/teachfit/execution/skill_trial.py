@@ -54,12 +54,14 @@ class SkillSetup:
 
 def peg_in_hole_setup(
     task: Task,
-    seed: int = 0,
+    seed: int | tuple[int, ...] = 0,
     n_starts: int = 4,
     controller: str = "adaptive",
     skill: Skill | None = None,
 ) -> SkillSetup:
-    """The peg-in-hole set-up for ``task``: hole estimate and starts drawn from ``seed``."""
+    """The peg-in-hole set-up for ``task``: hole estimate and starts drawn from ``seed`` (an
+    integer or a seed sequence, :func:`numpy.random.default_rng`; several set-ups:
+    :mod:`teachfit.execution.setups`)."""
     rng = np.random.default_rng(seed)
     ctx = peg_in_hole.hole_context(task, rng)
     base = skill if skill is not None else peg_in_hole.build(controller)

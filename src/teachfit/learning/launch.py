@@ -37,7 +37,8 @@ def method_options(method: str, trials: int) -> dict[str, object]:
 class LearnRequest:
     """What ``learn skill`` asks for (see its options): the task and skill, the learner and
     its budget, where the study is stored, where the trials run (``workers``: None = all
-    cores, 0 = this process; ``ray``: ``"local"`` or a cluster's address) and on which robot."""
+    cores, 0 = this process; ``ray``: ``"local"`` or a cluster's address), on which robot, and
+    over how many set-ups each trial is evaluated (``setups``)."""
 
     task: str
     skill: str
@@ -54,6 +55,7 @@ class LearnRequest:
     robot: str = "floating"
     host: str = ""
     realtime: bool = True
+    setups: int = 1
 
 
 @dataclass(frozen=True)
@@ -91,7 +93,7 @@ def open_learning(req: LearnRequest) -> Launch:
         workers = 0  # one arm: trials cannot run in parallel worker processes
     obj = SkillObjective(
         req.task, req.skill, req.controller, req.seed, req.starts, req.overrides, req.robot,
-        req.host, req.realtime,
+        req.host, req.realtime, req.setups,
     )  # fmt: skip
     options = _options(req)
     try:

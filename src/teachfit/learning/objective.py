@@ -45,11 +45,14 @@ class SkillObjective:
     seed : int
         Seed of the experiment's fixed part: hole estimate, start poses, sensor noise.
     n_starts : int
-        Executions per trial (four in the paper).
+        Executions per trial and set-up (four in the paper).
     task_overrides : tuple of (name, value)
         Task parameter overrides, e.g. ``(("hole_pos_sigma", 0.001),)`` (SI units).
     robot : str
         Robot name in :data:`teachfit.robot.registry.ROBOTS`; ``host`` a real robot's address.
+    setups : int
+        Set-ups each trial is evaluated on (:mod:`teachfit.execution.setups`, training stream):
+        the cost is the mean over ``setups x n_starts`` executions.
     """
 
     task: str
@@ -61,10 +64,13 @@ class SkillObjective:
     robot: str = "floating"
     host: str = ""
     realtime: bool = True
+    setups: int = 1
 
     def __post_init__(self) -> None:
         if self.n_starts < 1:
             raise LearningError(f"n_starts must be >= 1, got {self.n_starts}")
+        if self.setups < 1:
+            raise LearningError(f"--setups must be >= 1, got {self.setups}")
         object.__setattr__(self, "task_overrides", tuple(sorted(self.task_overrides)))
 
     # ---------------------------------------------------------------------------- set-up
@@ -72,13 +78,14 @@ class SkillObjective:
         """The :class:`~teachfit.execution.skill_trial.SkillTrial` (built once per process)."""
         found = _CACHE.get(self)
         if found is None:
-            from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
+            from teachfit.execution.setups import draw_setups
+            from teachfit.execution.skill_trial import SkillTrial
             from teachfit.skills.library import get_skill
             from teachfit.tasks.registry import get_task
 
             task = get_task(self.task, **dict(self.task_overrides))
             skill = get_skill(self.skill, self.controller)
-            setup = peg_in_hole_setup(task, self.seed, self.n_starts, self.controller, skill)
+            drawn = draw_setups(task, self.seed, self.n_starts, self.controller, skill, self.setups)
             from teachfit.execution.engine import ExecConfig
 
             # the real robot's own options (checked by its factory)
@@ -90,7 +97,12 @@ class SkillObjective:
             # needs it
             config = None if self.host else ExecConfig(recovery_time=0.0)
             found = SkillTrial(
-                setup, self.controller, robot=self.robot, seed=self.seed, config=config, **options
+                drawn.setup,
+                self.controller,
+                robot=self.robot,
+                seed=self.seed,
+                config=config,
+                **options,
             )
             _CACHE.clear()  # one experiment per worker at a time: keep memory flat
             _CACHE[self] = found
@@ -107,14 +119,18 @@ class SkillObjective:
         return float(self.trial().metric.failure_cost(PENALTY_DISTANCE))
 
     def context(self) -> dict[str, Any]:
-        """JSON-able description stored with a study and compared on resume."""
-        return {
+        """JSON-able description stored with a study and compared on resume (``setups`` only
+        when above one, so that a study stored before the option resumes)."""
+        ctx: dict[str, Any] = {
             "controller": self.controller,
             "robot": self.robot,
             "setup_seed": int(self.seed),
             "n_starts": int(self.n_starts),
             "task_overrides": {k: float(v) for k, v in self.task_overrides},
         }
+        if self.setups > 1:
+            ctx["setups"] = int(self.setups)
+        return ctx
 
     # ---------------------------------------------------------------------------- trials
     def outcome(self, params: Mapping[str, float] | None) -> Any:
