@@ -42,7 +42,9 @@ def test_setups_join_their_starts_each_in_its_own_taught_frame():
     assert all(0 < d < 5 * task.params.hole_pos_sigma * 3 for d in off)
     # reproducible from the seed
     again = draw_setups(task, 0, 2, setups=3)
-    assert all(_same_pose(a, b) for a, b in zip(again.taught2world, drawn.taught2world, strict=True))
+    assert all(
+        _same_pose(a, b) for a, b in zip(again.taught2world, drawn.taught2world, strict=True)
+    )
 
 
 def test_held_out_setups_are_never_training_setups():
