@@ -158,3 +158,20 @@ def test_bench_learning_cli_and_best_execution_figure(tmp_path: Path) -> None:
     obj = SkillObjective("key", n_starts=1)
     trace = obj.outcome(None).traces[0]
     read_png(plot_best_execution(trace, tmp_path / "best.png"), min_px=300)
+
+
+def test_setups_count_every_execution_and_held_out_gets_its_column() -> None:
+    """Trials over two set-ups count 2 x starts executions each; the best parameters then run
+    on held-out set-ups, reported beside the training success."""
+    bench = run_learning_bench(
+        ["peg2d"], ["lhs"], 1, 2, workers=0, n_starts=1, setups=2, held_out=3
+    )
+    (exp,) = bench.experiments
+    (cell,) = bench.cells
+    assert cell.executions == 2 * 2 and len(exp.held_out) == 3
+    assert cell.held_out == 3 and cell.held_out_ok == sum(exp.held_out)
+    text = to_markdown(bench)
+    assert "best on held-out set-ups [95 % Wilson]" in text
+    assert f"| {cell.held_out_ok}/3 = " in text
+    plain = run_learning_bench(["peg2d"], ["lhs"], 1, 1, workers=0, n_starts=1)
+    assert "held-out" not in to_markdown(plain)  # the table keeps its shape without them

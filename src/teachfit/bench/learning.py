@@ -19,7 +19,7 @@ import os
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -72,9 +72,11 @@ class Experiment:
     success_rate: tuple[float, ...]
     best_params: dict[str, float]
     wall_s: float
-    n_starts: int = 1
+    n_starts: int = 1  # executions per trial: starts x set-ups
     #: trials read back from a stored study (not run, nor timed, in this call)
     restored: int = 0
+    #: success of each execution of the best parameters on held-out set-ups (none: not run)
+    held_out: tuple[bool, ...] = ()
 
     @staticmethod
     def from_records(
@@ -147,6 +149,8 @@ class CellStats:
     curve: Band = field(repr=False)
     executions_ok: int = 0
     executions: int = 0
+    held_out_ok: int = 0
+    held_out: int = 0
 
     @staticmethod
     def of(exps: Sequence[Experiment]) -> CellStats:
@@ -176,6 +180,8 @@ class CellStats:
             band([best_so_far(e.costs) for e in exps]),
             sum(e.executions_ok for e in exps),
             sum(len(e.costs) * e.n_starts for e in exps),
+            sum(sum(e.held_out) for e in exps),
+            sum(len(e.held_out) for e in exps),
         )
 
 
@@ -242,7 +248,7 @@ def run_experiment(
             objective.seed,
             study.trials(),
             wall,
-            objective.n_starts,
+            objective.n_starts * objective.setups,  # executions per trial
             study.n_restored,
         )
 
@@ -319,11 +325,14 @@ def run_learning_bench(
     robot: str = "floating",
     ray: str | None = None,
     studies: str | Path | None = None,
+    setups: int = 1,
+    held_out: int = 0,
 ) -> LearningBench:
     """Every task x method x experiment; ``on_trial(label, record)`` reports progress;
     ``ray``: trials on Ray (see :func:`run_experiment`). ``studies``: a folder keeping each
     experiment's study (:func:`study_path`), so that an interrupted grid resumes where it
-    stopped (``None``: throw-away studies)."""
+    stopped (``None``: throw-away studies). ``setups``: set-ups each trial is evaluated on;
+    ``held_out``: held-out set-ups the best parameters of each experiment then run on."""
     if experiments < 1 or trials < 1:
         raise LearningError(f"experiments and trials must be >= 1, got {experiments}, {trials}")
     bad = [m for m in methods if m not in METHODS]
@@ -343,15 +352,17 @@ def run_learning_bench(
                     n_starts=n_starts,
                     task_overrides=ov,
                     robot=robot,
+                    setups=setups,
                 )
                 label = f"{task}/{method} #{e + 1}"
                 cb = None if on_trial is None else (lambda r, lb=label: on_trial(lb, r))
                 db = None if studies is None else study_path(studies, obj, method, trials)
-                mine.append(
-                    run_experiment(
-                        obj, method, trials, workers=workers, on_trial=cb, ray=ray, storage=db
-                    )
+                exp = run_experiment(
+                    obj, method, trials, workers=workers, on_trial=cb, ray=ray, storage=db
                 )
+                if held_out:
+                    exp = replace(exp, held_out=obj.held_out(exp.best_params, held_out))
+                mine.append(exp)
             cells.append(CellStats.of(mine))
             exps.extend(mine)
     n_workers = workers if workers is not None else _cores()

@@ -67,13 +67,24 @@ def _executions(c: CellStats) -> str:
     return f"{c.executions_ok}/{c.executions} = {rate:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]"
 
 
+def _held_out(c: CellStats) -> str:
+    lo, hi = wilson_interval(c.held_out_ok, c.held_out)
+    rate = 100 * c.held_out_ok / max(c.held_out, 1)
+    return f" {c.held_out_ok}/{c.held_out} = {rate:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}] |"
+
+
 def to_markdown(bench: LearningBench) -> str:
-    """The grid as a markdown table (one row per task x method), then the ordering."""
+    """The grid as a markdown table (one row per task x method), then the ordering; a column
+    of the best parameters' executions on held-out set-ups where they were run."""
+    held = any(c.held_out for c in bench.cells)
     head = (
         "| task | method | best cost (s) [95 % CI] | success of best | first feasible "
         "(trial) | solved | executions that succeeded [95 % Wilson] | insertion time (s) | "
-        "robot time to feasible / best / all (min) | wall (s) | trials/s |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|\n"
+        "robot time to feasible / best / all (min) | wall (s) | trials/s |"
+        + (" best on held-out set-ups [95 % Wilson] |" if held else "")
+        + "\n|---|---|---|---|---|---|---|---|---|---|---|"
+        + ("---|" if held else "")
+        + "\n"
     )
     rows = []
     for c in bench.cells:
@@ -84,7 +95,7 @@ def to_markdown(bench: LearningBench) -> str:
             f"{c.n - c.never_feasible}/{c.n} | {_executions(c)} | "
             f"{_f(c.insertion_time, '.3f')} | {_f(c.sim_feasible_min)} / "
             f"{_f(c.sim_best_min)} / {_f(c.sim_total_min)} | {c.wall_s:.1f} | "
-            f"{c.trials_per_s:.2f} |"
+            f"{c.trials_per_s:.2f} |" + (_held_out(c) if held else "")
         )
     return (
         head

@@ -235,6 +235,13 @@ def bench_learning(
     trials: Annotated[int, typer.Option(min=1, help="trials per experiment")] = 60,
     workers: o.Workers = None,
     starts: Annotated[int, o.starts("per trial (one execution each)")] = 4,
+    setups: Annotated[int, o.setups("each trial is evaluated on")] = 1,
+    held_out: Annotated[
+        int,
+        typer.Option(
+            min=0, help="held-out set-ups each experiment's best parameters then run on (0: none)"
+        ),
+    ] = 0,
     controller: Annotated[str, _CONTROLLER] = "adaptive",
     seed: Annotated[int, o.seed("the first experiment (experiment e uses seed + e)")] = 0,
     task_param: Annotated[list[str] | None, _TASK_PARAM] = None,
@@ -300,7 +307,7 @@ def bench_learning(
         return
     res, text = _run_grid(
         task_list, [m for m in methods.split(",") if m], experiments, trials, workers, starts,
-        controller, seed, task_param, robot, ray, out,
+        controller, seed, task_param, robot, ray, out, (setups, held_out),
     )  # fmt: skip
     n_w = workers or os.cpu_count() or 1
     if target:
@@ -323,7 +330,7 @@ def bench_learning(
 def _run_grid(
     task_list: list[str], method_list: list[str], experiments: int, trials: int,
     workers: int | None, starts: int, controller: str, seed: int, task_param: list[str] | None,
-    robot: str, ray: str | None, out: Path | None,
+    robot: str, ray: str | None, out: Path | None, sets: tuple[int, int] = (1, 0),
 ) -> tuple[LearningBench, str]:  # fmt: skip
     """The grid with a progress bar, and its table headed by the command and its costs."""
     import os
@@ -345,12 +352,16 @@ def _run_grid(
             task_list, method_list, experiments, trials, workers=workers, n_starts=starts,
             controller=controller, seed=seed, overrides=dict(_overrides(task_param)),
             on_trial=lambda label, _r: tick(label), robot=robot, ray=ray, studies=out,
+            setups=sets[0], held_out=sets[1],
         )  # fmt: skip
     cpu = cpu_seconds() - cpu0
     extra = "".join(f" --task-param {p}" for p in task_param or [])
+    extra += (f" --setups {sets[0]}" if sets[0] > 1 else "") + (
+        f" --held-out {sets[1]}" if sets[1] else ""
+    )
     done = sum(len(e.costs) for e in res.experiments)
     kept = f", {done - ran[0]} trials resumed from {out}: wall and trials/s count the others"
-    execs = ran[0] * starts
+    execs = ran[0] * starts * sets[0]
     text = (
         f"`teachfit bench learning --tasks {','.join(task_list)} --methods "
         f"{','.join(method_list)} --experiments "

@@ -137,6 +137,21 @@ class SkillObjective:
         """The full :class:`~teachfit.execution.skill_trial.TrialOutcome` (traces with logs)."""
         return self.trial()(params)
 
+    def held_out(self, params: Mapping[str, float] | None, setups: int) -> tuple[bool, ...]:
+        """Success of each execution of ``params`` on ``setups`` held-out set-ups (``n_starts``
+        starts each, :mod:`teachfit.execution.setups`): set-ups no trial was evaluated on."""
+        from teachfit.execution.setups import draw_setups
+        from teachfit.skills.library import get_skill
+
+        tr = self.trial()
+        skill = get_skill(self.skill, self.controller)
+        drawn = draw_setups(
+            tr.setup.task, self.seed, self.n_starts, self.controller, skill, setups, True
+        )
+        s = drawn.setup
+        runs = (tr.run(params, st, s.frame(i)) for i, st in enumerate(s.starts))
+        return tuple(bool(tr.metric.evaluate(r)[0]) for r in runs)
+
     def __call__(self, params: Mapping[str, float]) -> TrialResult:
         out = self.outcome(params)
         tr = self.trial()
