@@ -27,3 +27,30 @@ def test_a_value_beyond_the_task_s_bound_names_the_task() -> None:
     with pytest.raises(SkillError, match=r"task key bounds it: a task parameter widens it"):
         setup.skill.resolve({"a_r": 0.05})
     setup.skill.resolve({"a_r": 0.03})  # inside the bound
+
+
+def test_a_reflex_is_recovered_and_its_execution_run_once_more() -> None:
+    """A safety reflex mid-execution (injected on the simulated arm's 200th tick, once) ends
+    that execution as a robot fault; the trial resets and runs it again, and says so."""
+    from teachfit.core.errors import ReflexFault
+    from teachfit.core.outcome import Outcome
+    from teachfit.execution.skill_trial import SkillTrial
+
+    trial = SkillTrial(peg_in_hole_setup(get_task("peg2d"), seed=0, n_starts=2))
+    robot, step = trial.robot, trial.robot.step
+    ticks = [0]
+
+    def step_with_one_reflex(n: int = 1) -> object:
+        ticks[0] += n
+        if ticks[0] >= 200 and ticks[0] - n < 200:
+            raise ReflexFault("cartesian_reflex: contact force above its threshold")
+        return step(n)
+
+    robot.step = step_with_one_reflex
+    out = trial()
+    assert out.retries == 1 and len(out.traces) == 2
+    assert all(t.outcome is not Outcome.FAULT and not t.reflex for t in out.traces)
+    # the same execution without the retry is the reflex the engine recorded
+    ticks[0] = 0
+    first = trial.run(None, trial.setup.starts[0])
+    assert first.reflex and first.outcome is Outcome.FAULT and "cartesian_reflex" in first.reason

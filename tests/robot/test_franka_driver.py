@@ -209,3 +209,27 @@ def test_gil_switch_interval_is_short_while_connected(franka_sim: object) -> Non
     with FrankaRobot("127.0.0.1", params=_params(), realtime=False):
         assert sys.getswitchinterval() <= 2e-4  # a busy caller cannot stall a tick for 5 ms
     assert sys.getswitchinterval() == before
+
+
+def test_reset_from_inside_a_hole_lifts_along_its_axis_before_moving_sideways(
+    franka_sim: object,
+) -> None:
+    """With a reset cell the TCP leaves the hole straight up (its axis is world z here) to the
+    clearance plane, then moves across; every reset's peak lateral force is kept."""
+    from teachfit.robot.franka.reset_path import ResetCell
+
+    hole = Pose(np.array([0.0, 0.0, 0.07]))
+    cell = ResetCell(hole, clear_height=0.05)  # the clearance plane at z = 0.12
+    params = FrankaParams(frames=_params().frames, reset_cell=cell)
+    with FrankaRobot("127.0.0.1", params=params, realtime=False) as robot:
+        robot.reset(Pose(np.array([0.0, 0.0, 0.08])))  # "inside": below the plane
+        robot.tap(5)
+        robot.reset(Pose(np.array([0.05, 0.0, 0.08])))
+        path = np.array([s.pos for s in robot.untap()])
+        assert robot.reset_guard is not None and len(robot.reset_guard.peaks) == 2
+    lifted = int(np.argmax(path[:, 2] > 0.11))  # first sample near the clearance plane
+    assert lifted > 0 and path[:, 2].max() > 0.115
+    # below it, on the way up, the TCP stayed over the hole (franky-sim's joint friction
+    # leaves the TCP a few mm off a set-point: TOL); the sideways move came after
+    assert np.abs(path[:lifted, 0]).max() < TOL
+    assert path[-1, 0] > 0.05 - TOL

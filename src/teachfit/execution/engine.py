@@ -37,7 +37,7 @@ import time
 import numpy as np
 
 from teachfit.core.control import ControllerSpec
-from teachfit.core.errors import ControlError, RobotFault, SimulationDiverged
+from teachfit.core.errors import ControlError, ReflexFault, RobotFault, SimulationDiverged
 from teachfit.core.geometry import Pose, quat_integrate_into, quat_mul_into
 from teachfit.core.outcome import Outcome
 from teachfit.core.state import ImpedanceCommand
@@ -221,7 +221,7 @@ class _Run:
         self.active = self.nodes[self.idx]
         self.t_enter = 0.0
         self.outcome, self.reason = Outcome.TIMEOUT, f"hard cap of {cfg.max_time:g} s"
-        self.faulted = self.by_error = False
+        self.faulted = self.by_error = self.reflex = False
         self.wall0 = time.perf_counter()
 
     def begin(self, start: Pose, controller: ControllerSpec | None) -> None:
@@ -256,6 +256,7 @@ class _Run:
                 self.advance(self.idx)
             except (RobotFault, ControlError) as exc:
                 self.outcome, self.reason, self.faulted = _fault_outcome(exc), f"{exc}", True
+                self.reflex = isinstance(exc, ReflexFault)
                 return
 
     def _stop_condition(self) -> bool:
@@ -360,6 +361,7 @@ class _Run:
             node_names=self.names,
             steps=self.steps,
             wall_s=time.perf_counter() - self.wall0,
+            reflex=self.reflex,
         )
 
     def _judge_end(self) -> tuple[bool | None, bool | None]:

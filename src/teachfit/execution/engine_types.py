@@ -50,7 +50,8 @@ class ExecutionResult:
     it succeeded; ``remaining`` (m) the TCP's distance to ``goal2world`` at the end (the last
     finite state if the simulation diverged); ``detected`` the task's success detector at the
     end (``None`` without a task); ``ground_truth_inserted`` the simulator's ground truth then
-    (``None`` without a task or after a fault), for benchmarks only.
+    (``None`` without a task or after a fault), for benchmarks only; ``reflex`` whether a
+    safety reflex of the robot stopped it (a real arm's; the next reset recovers).
     """
 
     skill: str
@@ -69,6 +70,7 @@ class ExecutionResult:
     node_names: tuple[str, ...]
     steps: int
     wall_s: float
+    reflex: bool = False
 
     @property
     def success(self) -> bool:

@@ -89,6 +89,7 @@ def write_episode(group: h5py.Group, ep: Episode) -> None:
     for label in NUMBERS:
         group.attrs[label] = float(getattr(r, label))
     group.attrs["steps"] = int(r.steps)
+    group.attrs["reflex"] = bool(r.reflex)
     group.attrs["detected"] = _tri(r.detected)
     group.attrs["ground_truth_inserted"] = _tri(r.ground_truth_inserted)
     group.attrs["nodes"] = json.dumps(list(r.node_names))
@@ -147,6 +148,7 @@ def read_episode(reader: H5Reader, parent: h5py.Group, key: str) -> Episode:
         log=log,
         node_names=tuple(json.loads(reader.text(group, "nodes"))),
         steps=int(a["steps"]),
+        reflex=bool(a.get("reflex", False)),  # logs written before it was kept: no reflex
         detected=_untri(a["detected"]),
         ground_truth_inserted=_untri(a["ground_truth_inserted"]),
         **{k: float(a[k]) for k in NUMBERS},

@@ -80,11 +80,13 @@ def peg_in_hole_setup(
 
 @dataclass(frozen=True)
 class TrialOutcome:
-    """One trial: per-start ``(success, cost)`` and the traces, mean ``cost`` (s)."""
+    """One trial: per-start ``(success, cost)`` and the traces, mean ``cost`` (s); ``retries``
+    the executions run again after a safety reflex stopped the arm (once each)."""
 
     successes: tuple[bool, ...]
     costs: tuple[float, ...]
     traces: tuple[ExecutionResult, ...]
+    retries: int = 0
 
     @property
     def cost(self) -> float:
@@ -153,6 +155,14 @@ class SkillTrial:
             runs = [(st, s.frame(i)) for i, st in enumerate(s.starts)]
         else:
             runs = [(st, None) for st in starts]
-        traces = tuple(self.run(learned, st, fr) for st, fr in runs)
+        traces, retries = [], 0
+        for st, fr in runs:
+            trace = self.run(learned, st, fr)
+            if trace.reflex:  # a reflex stopped the arm: the reset recovers it, one retry
+                retries += 1
+                trace = self.run(learned, st, fr)
+            traces.append(trace)
         scored = [self.metric.evaluate(tr) for tr in traces]
-        return TrialOutcome(tuple(s for s, _ in scored), tuple(c for _, c in scored), traces)
+        return TrialOutcome(
+            tuple(s for s, _ in scored), tuple(c for _, c in scored), tuple(traces), retries
+        )

@@ -11,7 +11,10 @@ Cost (Johannsmeier et al. 2019, Sec. V): the mean over the starts of the learnin
 insertion (s) on success, ``t_max + k_d * remaining distance`` on failure. A trial is
 feasible if any start succeeded. ``info`` carries ``success_rate``, ``sim_s`` (simulated robot
 seconds of all executions; on a simulated robot the recovery retract after a failure is
-skipped, as every execution starts from a reset) and ``wall_s``.
+skipped, as every execution starts from a reset) and ``wall_s``; on a real arm also
+``reflex_retries`` (executions run again after a safety reflex) and ``reset_peak_lateral_n``
+(the largest lateral force, N, while a reset left the hole,
+:mod:`teachfit.robot.franka.reset_path`).
 """
 
 from __future__ import annotations
@@ -153,8 +156,10 @@ class SkillObjective:
         return tuple(bool(tr.metric.evaluate(r)[0]) for r in runs)
 
     def __call__(self, params: Mapping[str, float]) -> TrialResult:
-        out = self.outcome(params)
         tr = self.trial()
+        guard = getattr(tr.robot, "reset_guard", None)  # a real arm's reset force watch
+        seen = len(guard.peaks) if guard is not None else 0
+        out = self.outcome(params)
         period = float(tr.robot.control_period)
         sim_s = sum(t.steps for t in out.traces) * period
         info = {
@@ -162,4 +167,8 @@ class SkillObjective:
             "wall_s": float(sum(t.wall_s for t in out.traces)),
             "sim_s": sim_s,
         }
+        if out.retries:
+            info["reflex_retries"] = float(out.retries)
+        if guard is not None and len(guard.peaks) > seen:
+            info["reset_peak_lateral_n"] = float(max(guard.peaks[seen:]))
         return TrialResult(out.cost, any(out.successes), info)

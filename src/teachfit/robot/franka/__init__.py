@@ -40,7 +40,8 @@ def franka_for_task(
 
     ``host`` the robot's address (required), ``base2world`` where the robot base sits in the
     task world (default :data:`DEFAULT_BASE2WORLD`), ``ee2tcp`` the TCP in libfranka's EE frame
-    (default: the task's held part of ``held_part_length`` with its top at EE).
+    (default: the task's held part of ``held_part_length`` with its top at EE). Resets leave
+    the task's hole along its axis first (:mod:`teachfit.robot.franka.reset_path`).
     """
     if not host:
         raise TeachfitError("robot 'franka' needs host=ADDRESS (the robot's or simulator's IP)")
@@ -54,5 +55,11 @@ def franka_for_task(
         base2world=base2world or DEFAULT_BASE2WORLD,
         ee2tcp=ee2tcp or ee2tcp_for_part(task.scene.held_part_length),
     )
-    params = FrankaParams(limits=limits or FrankaLimits(), frames=frames)
+    from teachfit.robot.franka.reset_path import ResetCell
+
+    hole = task.hole2world
+    # the part's tip 5 mm above the surface around the hole is clear of the fixture
+    clear = float(task.surface_z - hole.pos[2]) + 0.005
+    cell = ResetCell(hole, clear)
+    params = FrankaParams(limits=limits or FrankaLimits(), frames=frames, reset_cell=cell)
     return FrankaRobot(host, controller=controller, params=params, realtime=realtime)

@@ -42,6 +42,7 @@ from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
 from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
 from teachfit.robot.franka.loop import ControlLoop, fault_from
+from teachfit.robot.franka.reset_path import ResetCell, ResetGuard, reset_via_points
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
 
@@ -65,7 +66,8 @@ class FrankaParams:
     the wrench bias averages, ``stop_hold`` (s) the hold before the loop ends on Ctrl-C,
     ``tick_timeout`` (s) without a tick after which the connection counts as lost,
     ``connect_timeout`` (s, wall clock) a connect may take before the robot counts as not
-    answering (:mod:`teachfit.robot.franka.connect`).
+    answering (:mod:`teachfit.robot.franka.connect`), ``reset_cell`` the hole a reset leaves
+    along its axis first (:mod:`teachfit.robot.franka.reset_path`; ``None``: straight lines).
     """
 
     limits: FrankaLimits = field(default_factory=FrankaLimits)
@@ -78,6 +80,7 @@ class FrankaParams:
     stop_hold: float = 0.2
     tick_timeout: float = 1.5
     connect_timeout: float = CONNECT_TIMEOUT
+    reset_cell: ResetCell | None = None
 
 
 class FrankaRobot:
@@ -128,6 +131,9 @@ class FrankaRobot:
         self._loop = ControlLoop(tick, self.params.limits, self.control_period, robot=where)
         #: completed resets (a reset restarts the clock)
         self.resets = 0
+        cell = self.params.reset_cell
+        #: lateral force watch while a reset leaves the hole; its ``peaks`` (N), one per reset
+        self.reset_guard = ResetGuard(cell) if cell is not None else None
         self.robot_mode = "unknown"
         try:
             self._start()
@@ -185,11 +191,9 @@ class FrankaRobot:
         if self._loop.fault is not None or not self._loop.running:
             self._restart()
         stiff = np.asarray(self.params.reset_stiffness, dtype=float)
-        start, lim = self.state().pose, self.params.limits
+        start = self.state().pose
         self._loop.install(self._approach_law(), self._hold(start, stiff))
-        for waypoint in approach_waypoints(start, pose, lim.reset_speed, lim.reset_ang_speed, 0.01):
-            self.command(self._hold(waypoint, stiff))
-            self.step(10)
+        self._move_to(start, pose, stiff)
         self._settle(pose)
         tick = self._loop.tick
         bias = np.zeros(6)
@@ -281,6 +285,22 @@ class FrankaRobot:
             loop.fault = RobotFault("the control loop was stopped (Ctrl-C); reset() to go on")
 
     # ------------------------------------------------------------------ internals
+    def _move_to(self, start: Pose, pose: Pose, stiff: np.ndarray) -> None:
+        """The reset's motion: via points out of the hole along its axis (the lateral force
+        watched on the way out), then to ``pose`` (:mod:`~teachfit.robot.franka.reset_path`)."""
+        lim, guard = self.params.limits, self.reset_guard
+        for leg, end in reset_via_points(start, pose, self.params.reset_cell):
+            for waypoint in approach_waypoints(
+                start, end, lim.reset_speed, lim.reset_ang_speed, 0.01
+            ):
+                self.command(self._hold(waypoint, stiff))
+                state = self.step(10)
+                if guard is not None and leg == "out":
+                    guard.watch(state.wrench)
+            start = end
+        if guard is not None:
+            guard.finish()
+
     def _hold(self, pose: Pose, stiffness: np.ndarray) -> ImpedanceCommand:
         return ImpedanceCommand.hold(pose, stiffness=stiffness, expires_after=1.0)
 
