@@ -64,10 +64,21 @@ WidthOpt = Annotated[int, count_option("video width (pixels)", low=16, high=7680
 HeightOpt = Annotated[int, count_option("video height (pixels)", low=16, high=4320)]
 
 
-def robot_options(host: str | None, realtime: bool = True) -> dict[str, Any]:
-    """The ``make_robot`` options the CLI's ``--host``/``--no-realtime`` give (none for
-    simulated robots)."""
-    return {} if host is None else {"host": host, "realtime": realtime}
+#: ``--confirm``: ask the person at a real robot before each reset
+ConfirmOpt = Annotated[
+    bool,
+    typer.Option(help="real robot: ask on the terminal before each reset (Enter moves, q stops)"),
+]
+
+
+def robot_options(host: str | None, realtime: bool = True, confirm: bool = False) -> dict[str, Any]:
+    """The ``make_robot`` options the CLI's ``--host``/``--no-realtime``/``--confirm`` give
+    (none for simulated robots; ``--confirm`` without ``--host`` is refused)."""
+    if confirm and host is None:
+        raise TeachfitError("--confirm asks before a real robot's resets: give --host with it")
+    if host is None:
+        return {}
+    return {"host": host, "realtime": realtime} | ({"confirm": True} if confirm else {})
 
 
 #: options that name a file or folder a command writes: :func:`guarded` checks them before the

@@ -11,6 +11,7 @@ from rich.table import Table
 
 from teachfit.cli import options as o
 from teachfit.cli.common import (
+    ConfirmOpt,
     HostOpt,
     RealtimeOpt,
     RobotOpt,
@@ -85,13 +86,14 @@ def learn_skill(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    confirm: ConfirmOpt = False,
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.learning.launch import LearnRequest, open_learning
 
     req = LearnRequest(
         task, skill, method, trials, study, resume, workers, ray, controller, seed, starts,
-        _overrides(task_param), robot, host or "", realtime, setups,
+        _overrides(task_param), robot, host or "", realtime, setups, confirm,
     )  # fmt: skip
     launch = open_learning(req)
     for note in launch.notes:

@@ -10,7 +10,15 @@ import typer
 from rich.table import Table
 
 from teachfit.cli import options as o
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import (
+    ConfirmOpt,
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    console,
+    guarded,
+    robot_options,
+)
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.cli.run_end import end_run, report_faults
@@ -158,6 +166,7 @@ def run(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    confirm: ConfirmOpt = False,
     log: LogOpt = None,
     rrd: RrdOpt = None,
     n: o.PointsOld = None,
@@ -187,7 +196,7 @@ def run(
             "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
             "the hole; without --demo a nominal demonstration start is assumed"
         )
-    the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime))
+    the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime, confirm))
     try:
         with progress_bar() as bar:
             job = bar.add_task(f"{method} from {starts} starts", total=starts)

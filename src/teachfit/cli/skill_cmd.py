@@ -10,7 +10,15 @@ import typer
 from rich.table import Table
 
 from teachfit.cli import options as o
-from teachfit.cli.common import HostOpt, RealtimeOpt, RobotOpt, console, guarded, robot_options
+from teachfit.cli.common import (
+    ConfirmOpt,
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    console,
+    guarded,
+    robot_options,
+)
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.cli.run_end import end_run, report_faults
 from teachfit.cli.tables import print_table
@@ -114,6 +122,7 @@ def run(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    confirm: ConfirmOpt = False,
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
@@ -140,7 +149,9 @@ def run(
     drawn = draw_setups(the_task, seed, starts, controller, sk, setups or 1, setups is not None)
     setup = drawn.setup
     learned = _learned(params, setup)
-    trial = SkillTrial(setup, controller, robot=robot, seed=seed, **robot_options(host, realtime))
+    trial = SkillTrial(
+        setup, controller, robot=robot, seed=seed, **robot_options(host, realtime, confirm)
+    )
     try:
         console.print(f"{setup.skill.name} on {the_task.name} ({controller} controller); "
                       + describe_setups(drawn))  # fmt: skip

@@ -56,6 +56,7 @@ class LearnRequest:
     host: str = ""
     realtime: bool = True
     setups: int = 1
+    confirm: bool = False
 
 
 @dataclass(frozen=True)
@@ -83,6 +84,8 @@ def open_learning(req: LearnRequest) -> Launch:
     from teachfit.tasks.registry import get_task
 
     get_task(req.task)  # an unknown task fails here, before any study file is created
+    if req.confirm and not req.host:
+        raise LearningError("--confirm asks before a real robot's resets: give --host with it")
     workers = req.workers
     notes: tuple[str, ...] = ()
     if req.robot in ROBOTS and not ROBOTS[req.robot].simulated:
@@ -93,7 +96,7 @@ def open_learning(req: LearnRequest) -> Launch:
         workers = 0  # one arm: trials cannot run in parallel worker processes
     obj = SkillObjective(
         req.task, req.skill, req.controller, req.seed, req.starts, req.overrides, req.robot,
-        req.host, req.realtime, req.setups,
+        req.host, req.realtime, req.setups, req.confirm,
     )  # fmt: skip
     options = _options(req)
     try:

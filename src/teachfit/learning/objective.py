@@ -56,6 +56,8 @@ class SkillObjective:
     setups : int
         Set-ups each trial is evaluated on (:mod:`teachfit.execution.setups`, training stream):
         the cost is the mean over ``setups x n_starts`` executions.
+    confirm : bool
+        On a real robot, ask on the terminal before each reset (not part of the study).
     """
 
     task: str
@@ -68,6 +70,7 @@ class SkillObjective:
     host: str = ""
     realtime: bool = True
     setups: int = 1
+    confirm: bool = False
 
     def __post_init__(self) -> None:
         if self.n_starts < 1:
@@ -95,6 +98,8 @@ class SkillObjective:
             options: dict[str, Any] = (
                 {"host": self.host, "realtime": self.realtime} if self.host else {}
             )
+            if self.host and self.confirm:
+                options["confirm"] = True  # a person confirms each reset
             # a simulated robot is reset before every execution: the recovery retract after a
             # failure would only cost compute (its robot time is not in the cost), a real one
             # needs it

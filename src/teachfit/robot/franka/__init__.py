@@ -35,13 +35,15 @@ def franka_for_task(
     ee2tcp: Pose | None = None,
     limits: FrankaLimits | None = None,
     realtime: bool = True,
+    confirm: bool = False,
 ) -> Any:
     """A connected :class:`~teachfit.robot.franka.driver.FrankaRobot` for ``task``'s cell.
 
     ``host`` the robot's address (required), ``base2world`` where the robot base sits in the
     task world (default :data:`DEFAULT_BASE2WORLD`), ``ee2tcp`` the TCP in libfranka's EE frame
     (default: the task's held part of ``held_part_length`` with its top at EE). Resets leave
-    the task's hole along its axis first (:mod:`teachfit.robot.franka.reset_path`).
+    the task's hole along its axis first (:mod:`teachfit.robot.franka.reset_path`);
+    ``confirm`` asks on the terminal before each one (:mod:`teachfit.robot.franka.confirm`).
     """
     if not host:
         raise TeachfitError("robot 'franka' needs host=ADDRESS (the robot's or simulator's IP)")
@@ -62,4 +64,9 @@ def franka_for_task(
     clear = float(task.surface_z - hole.pos[2]) + 0.005
     cell = ResetCell(hole, clear)
     params = FrankaParams(limits=limits or FrankaLimits(), frames=frames, reset_cell=cell)
-    return FrankaRobot(host, controller=controller, params=params, realtime=realtime)
+    ask = None
+    if confirm:
+        from teachfit.robot.franka.confirm import terminal_confirm
+
+        ask = terminal_confirm()  # refused here without a terminal, before connecting
+    return FrankaRobot(host, controller=controller, params=params, realtime=realtime, confirm=ask)

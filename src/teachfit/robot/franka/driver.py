@@ -27,6 +27,7 @@ Cartesian impedance approach with our own law.
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -99,6 +100,8 @@ class FrankaRobot:
     realtime : bool
         Enforce libfranka's real-time scheduling check (a real robot needs an RT kernel; the
         simulator and the tests pass ``False``).
+    confirm : callable or None
+        Called with each reset's goal before the arm moves (:mod:`.confirm`); raising stops.
     """
 
     name = "franka"
@@ -110,9 +113,12 @@ class FrankaRobot:
         controller: ControllerSpec | None = None,
         params: FrankaParams | None = None,
         realtime: bool = True,
+        confirm: Callable[[Pose], None] | None = None,
     ) -> None:
         import pylibfranka as pf
 
+        #: asked before each reset with its goal (``--confirm``); raises to stop
+        self.confirm = confirm
         self._pf = pf
         self.host = host
         self.params = params or FrankaParams()
@@ -186,6 +192,8 @@ class FrankaRobot:
         is outside the workspace (nothing moves) or is not reached within the tolerance.
         """
         self.params.limits.check_target(pose.pos, "reset pose")
+        if self.confirm is not None:
+            self.confirm(pose)
         if controller is not None:
             self.controller_spec = controller
         if self._loop.fault is not None or not self._loop.running:
