@@ -123,3 +123,25 @@ def test_failures_are_stored_at_the_penalty_and_gp_bo_resumes(tmp_path: Path) ->
     assert len(trials) == 8 and len({t.key for t in trials}) == 8
     assert [t.outcome for t in trials[6:]] == ["error", "error"]
     assert all(t.cost == 700.0 and not t.feasible for t in trials[6:])
+
+
+def test_a_cell_that_needs_a_person_stops_the_run_and_charges_no_trial(tmp_path: Path) -> None:
+    """A part lost from the grasp (any NeedsAPerson) ends the run at once: the trials before
+    it are stored, the one it interrupted is neither stored as failed nor lost for the resume."""
+    from teachfit.robot.franka.grasp import PartLost
+
+    calls = []
+
+    def drops_the_part(p: dict[str, float]) -> tuple[float, bool]:
+        calls.append(p)
+        if len(calls) == 4:
+            raise PartLost("the part is no longer in the gripper")
+        return rosenbrock(p)
+
+    db = tmp_path / "lost.db"
+    with pytest.raises(PartLost):
+        run_study(open_study(db), drops_the_part, 10, workers=0)
+    stored = open_study(db).trials()
+    assert len(stored) == 3 and all(r.outcome != "error" for r in stored)
+    report = run_study(open_study(db), rosenbrock, 10, workers=0)
+    assert report.finished == 7 and len(open_study(db).trials()) == 10

@@ -21,6 +21,7 @@ from teachfit.cli.common import (
 )
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.tables import print_markdown, print_table
+from teachfit.core.errors import NeedsAPerson
 from teachfit.core.params import LearningError
 
 if TYPE_CHECKING:
@@ -163,6 +164,11 @@ def _run_and_report(
                     "with the same command and --resume"
                 )
                 raise typer.Exit(130)
+        except NeedsAPerson as exc:  # a real arm's cell: the run stops, no trial charged
+            console.print(
+                f"[red]stopped[/]: {exc}; the {st.n_finished} finished trial(s) are stored"
+            )
+            raise typer.Exit(1) from None
         except KeyboardInterrupt:  # a second Ctrl-C / SIGTERM: running trials were dropped
             console.print(
                 f"[red]interrupted again[/]: aborted; the {st.n_finished} finished trial(s) are "

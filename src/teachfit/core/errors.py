@@ -63,6 +63,12 @@ class ConnectionLost(RobotFault):
     """The connection to the robot (or its control loop) was lost."""
 
 
+class NeedsAPerson(RobotFault):
+    """The cell cannot go on without a person: a part lost from the grasp or caught in the
+    hole, a reset declined. A learning run stops at once (its finished trials kept) instead of
+    charging the trial, and the person continues it with ``--resume``."""
+
+
 class SimulationDiverged(RobotFault):
     """The physics simulation produced NaN/inf or MuJoCo raised a warning that invalidates it."""
 

@@ -46,6 +46,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from typing import Any
 
+from teachfit.core.errors import NeedsAPerson
 from teachfit.core.params import LearningError
 from teachfit.learning.base import Candidate, TrialResult
 from teachfit.learning.study import Study, TrialRecord
@@ -79,9 +80,13 @@ def _as_result(value: object) -> TrialResult:
 
 
 def evaluate(objective: Objective, params: Mapping[str, float]) -> tuple[TrialResult | None, str]:
-    """Run one trial; ``(result, "")`` or ``(None, error message)``. Runs in a worker."""
+    """Run one trial; ``(result, "")`` or ``(None, error message)``. Runs in a worker.
+    :class:`~teachfit.core.errors.NeedsAPerson` (a real arm's part lost, a reset declined)
+    is raised on: it stops the run."""
     try:
         result = _as_result(objective(params))
+    except NeedsAPerson:  # the cell, not the trial: the run stops, the trial is not charged
+        raise
     except Exception as exc:  # any failure of the trial is that trial's, not the study's
         return None, f"{type(exc).__name__}: {exc}"
     if not math.isfinite(result.cost):

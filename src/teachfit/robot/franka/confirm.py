@@ -10,11 +10,11 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 
-from teachfit.core.errors import RobotFault, TeachfitError
+from teachfit.core.errors import NeedsAPerson, TeachfitError
 from teachfit.core.geometry import Pose
 
 
-class ResetDeclined(RobotFault):
+class ResetDeclined(NeedsAPerson):
     """The person at the robot declined a reset (``q`` at the ``--confirm`` prompt)."""
 
 

@@ -42,6 +42,7 @@ from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
 from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
+from teachfit.robot.franka.grasp import GraspWatch, connect_gripper
 from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.reset_path import ResetCell, ResetGuard, reset_via_points
 from teachfit.robot.franka.safety import FrankaLimits
@@ -119,6 +120,9 @@ class FrankaRobot:
 
         #: asked before each reset with its goal (``--confirm``); raises to stop
         self.confirm = confirm
+        #: the hand's grasp, checked at each reset (None: no hand answers, ``grasp_note`` why)
+        self.grasp: GraspWatch | None = None
+        self.grasp_note = ""
         self._pf = pf
         self.host = host
         self.params = params or FrankaParams()
@@ -126,6 +130,7 @@ class FrankaRobot:
         self._realtime = pf.RealtimeConfig.kEnforce if realtime else pf.RealtimeConfig.kIgnore
         self._robot: Any = None  # a pylibfranka.Robot (untyped) once connected
         self._connect()
+        self.grasp, self.grasp_note = connect_gripper(pf, host)
         # the control thread must get the GIL within a fraction of a tick when the caller's
         # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
         # delay a tick by up to 5 periods. Process-wide; restored by close().
@@ -192,6 +197,8 @@ class FrankaRobot:
         is outside the workspace (nothing moves) or is not reached within the tolerance.
         """
         self.params.limits.check_target(pose.pos, "reset pose")
+        if self.grasp is not None:
+            self.grasp.check()
         if self.confirm is not None:
             self.confirm(pose)
         if controller is not None:
@@ -223,6 +230,7 @@ class FrankaRobot:
     def close(self) -> None:
         """Finish the control loop (the arm holds where it is) and release the connection."""
         self._loop.finish()
+        self.grasp = None  # drops the gripper's connection
         sys.setswitchinterval(self._switch_interval)
         robot, self._robot = self._robot, None
         if robot is not None:

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from teachfit.core.errors import RobotFault
+from teachfit.core.errors import NeedsAPerson
 from teachfit.core.geometry import Pose
 
 
@@ -64,7 +64,8 @@ class ResetGuard:
     """Watches the lateral force (N, hole frame x-y) while a reset leaves the hole.
 
     :meth:`watch` takes each measured wrench (world frame, force first) of the ``out`` leg;
-    ``peak`` is the largest lateral force seen; ``peaks`` keeps every finished reset's.
+    ``peak`` is the largest lateral force seen; ``peaks`` keeps every finished reset's. Past
+    ``abort_force`` it raises :class:`~teachfit.core.errors.NeedsAPerson`.
     """
 
     cell: ResetCell
@@ -72,14 +73,14 @@ class ResetGuard:
     peaks: list[float] = field(default_factory=list)
 
     def watch(self, wrench_world: np.ndarray) -> None:
-        """Record the lateral force of ``wrench_world``; raise :class:`RobotFault` past
+        """Record the lateral force of ``wrench_world``; raise :class:`NeedsAPerson` past
         ``abort_force``."""
         f_hole = self.cell.hole2world.inverse().rotation.apply(np.asarray(wrench_world)[:3])
         lateral = float(np.hypot(f_hole[0], f_hole[1]))
         self.peak = max(self.peak, lateral)
         if lateral > self.cell.abort_force:
             self.finish()
-            raise RobotFault(
+            raise NeedsAPerson(
                 f"reset stopped leaving the hole: {lateral:.1f} N lateral force (limit "
                 f"{self.cell.abort_force:.0f} N); the part is caught in the hole: free it by hand, "
                 "then run again"
