@@ -127,6 +127,12 @@ def test_two_holes_are_listed_and_chosen_by_number_or_position(tmp_path: Path) -
         with pytest.raises(TaskError, match=rf"--hole {bad}: .* 2 opening\(s\); choose 1 to 2"):
             new_task_file(out, peg, plate, "mm", hole=bad)
         assert not out.exists()
+    out = tmp_path / "both.toml"
+    with pytest.raises(TaskError, match="--hole or --hole-at, not both"):
+        new_task_file(out, peg, plate, "mm", hole=1, hole_at=(0.0, 0.0, 0.0))
+    with pytest.raises(TaskError, match="drop --hole-pos"):
+        new_task_file(out, peg, plate, "mm", hole_pos=(12.0, 0.0, 9.0), hole=1)
+    assert not out.exists()
 
 
 def test_a_bad_hole_number_is_one_line_and_exit_2(tmp_path: Path) -> None:
@@ -175,3 +181,19 @@ def test_yaw_period_from_the_sections(hole, part, deg) -> None:
     clearance = float(walls.distance(part))
     period = rz_period_of(walls, part, _rz_tolerance(walls, part), clearance)
     assert np.degrees(period) == pytest.approx(deg)
+
+
+def test_a_round_peg_in_a_round_bore_may_turn_freely() -> None:
+    from teachfit.tasks.mesh.holes import best_opening
+    from teachfit.tasks.mesh.sections import fit_of
+
+    peg = trimesh.creation.cylinder(radius=0.004, height=0.02, sections=64)
+    peg.apply_translation([0.0, 0.0, 0.01])  # tip at the TCP
+    plate = _box((-0.02, -0.02, 0.0), (0.02, 0.02, 0.009))
+    bore = manifold3d.Manifold.cylinder(0.011, 0.005, 0.005, 64).translate([0.0, 0.0, -0.001])
+    fixed = from_manifold(plate - bore)  # 1 mm clearance per side
+    opening = best_opening(fixed, peg, np.array([0.0, 0.0, -1.0]))
+    assert opening.pos == pytest.approx([0.0, 0.0, 0.009], abs=1e-6)
+    fixed.apply_translation(-opening.pos)
+    fit = fit_of(fixed, peg, 0.005, "t")
+    assert fit.rz_period == 0.0 and fit.stop_depth == pytest.approx(0.009, abs=1e-6)

@@ -159,6 +159,10 @@ def yaw_text(cell: MeshCell) -> str:
     return f"{value} (inferred from the sections{', ' + shape if shape else ''})"
 
 
+def _vec(v: Vec3 | None) -> str:
+    return "inferred" if v is None else "(" + ", ".join(f"{c:g}" for c in v) + ")"
+
+
 def describe(task: MeshTask) -> list[tuple[str, str]]:
     """``(what, value)`` rows of a mesh task: meshes, hole frame, fit, pieces, fidelity."""
     cell, spec = task.cell, task.cell.spec
@@ -173,6 +177,10 @@ def describe(task: MeshTask) -> list[tuple[str, str]]:
         ("fixed mesh", f"{spec.fixed_mesh} ({len(cell.fixed.faces)} triangles)"),
         ("held part size", " x ".join(f"{1e3 * e:.1f}" for e in cell.held.extents) + " mm"),
         ("fixed part size", " x ".join(f"{1e3 * e:.1f}" for e in cell.fixed.extents) + " mm"),
+        (
+            "hole entry (fixed mesh)",
+            f"{_vec(spec.hole_pos)} {spec.units}, insertion axis {_vec(spec.insertion_axis)}",
+        ),
         ("hole entry (world)", " ".join(f"{1e3 * v:.2f}" for v in cell.hole2world.pos) + " mm"),
         ("hole depth", mm(cell.fit.hole_depth)),
         ("aligned part stops at", stop_text(cell)),
