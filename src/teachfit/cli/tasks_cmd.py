@@ -8,13 +8,16 @@ runs the cell checks, ``tasks example`` writes a shipped example.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
 from teachfit.core.errors import TaskError
+
+if TYPE_CHECKING:
+    from teachfit.tasks.mesh.authoring import NewTask
 
 tasks_app = typer.Typer(
     help="Tasks: the built-in ones, and tasks made from your own part meshes.",
@@ -86,6 +89,28 @@ def _vec3(text: str, what: str) -> tuple[float, float, float]:
     return values
 
 
+def _print_new(new: NewTask, units: str) -> None:
+    """What ``tasks new`` found and wrote: the openings (if several), the hole, the depths."""
+    from teachfit.tasks.mesh.authoring import stop_text, yaw_text
+
+    cell = new.cell
+    if len(new.openings) > 1:
+        console.print("openings in the fixed part (choose with --hole N or --hole-at X,Y,Z):")
+        for i, o in enumerate(new.openings):
+            mark = "  <- chosen" if i == new.chosen else ""
+            console.print(f"  {i + 1}: {o.line(cell.spec.scale, units)}{mark}", markup=False)
+    spec = cell.spec
+    console.print(
+        f"hole entry at {spec.hole_pos} {units} in the fixed mesh, insertion axis "
+        f"{spec.insertion_axis}; {cell.fidelity.summary()}",
+        markup=False,
+    )
+    console.print(f"aligned part stops at {stop_text(cell)}", markup=False)
+    share = f"{1e3 * cell.success_depth:.3f} mm"
+    console.print(f"success depth {share}; yaw period {yaw_text(cell)}", markup=False)
+    console.print(f"wrote {new.path}; next: teachfit tasks show {new.path} --plot cell.png")
+
+
 @tasks_app.command("new")
 @guarded
 def tasks_new(
@@ -123,7 +148,7 @@ def tasks_new(
 ) -> None:
     """Write a task file for your own two meshes (hole frame inferred unless given)."""
     from teachfit.cli.geometry_progress import geometry_progress
-    from teachfit.tasks.mesh.authoring import new_task_file, stop_text, yaw_text
+    from teachfit.tasks.mesh.authoring import new_task_file
 
     axis = None if insertion_axis is None else _vec3(insertion_axis, "--insertion-axis")
     with geometry_progress("checking and decomposing the parts"):
@@ -141,22 +166,7 @@ def tasks_new(
             hole,
             _vec(hole_at, "--hole-at"),
         )
-    cell = new.cell
-    if len(new.openings) > 1:
-        console.print("openings in the fixed part (choose with --hole N or --hole-at X,Y,Z):")
-        for i, o in enumerate(new.openings):
-            mark = "  <- chosen" if i == new.chosen else ""
-            console.print(f"  {i + 1}: {o.line(cell.spec.scale, units)}{mark}", markup=False)
-    spec = cell.spec
-    console.print(
-        f"hole entry at {spec.hole_pos} {units} in the fixed mesh, insertion axis "
-        f"{spec.insertion_axis}; {cell.fidelity.summary()}",
-        markup=False,
-    )
-    console.print(f"aligned part stops at {stop_text(cell)}", markup=False)
-    share = f"{1e3 * cell.success_depth:.3f} mm"
-    console.print(f"success depth {share}; yaw period {yaw_text(cell)}", markup=False)
-    console.print(f"wrote {new.path}; next: teachfit tasks show {new.path} --plot cell.png")
+    _print_new(new, units)
 
 
 @tasks_app.command("show")

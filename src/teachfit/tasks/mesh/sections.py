@@ -49,8 +49,10 @@ def _welded(ends: np.ndarray) -> np.ndarray:
     onto it, so the segments join into rings (rounding alone splits points either side of a
     rounding boundary)."""
     pts = ends.reshape(-1, 2)
-    near = cKDTree(pts).query_ball_point(pts, WELD)
-    first = np.array([min(group) for group in near])
+    pairs = cKDTree(pts).query_pairs(WELD, output_type="ndarray")
+    first = np.arange(len(pts))
+    np.minimum.at(first, pairs[:, 1], pairs[:, 0])
+    first = first[first[first]]  # a chain of near points ends on its first
     return pts[first].reshape(ends.shape)
 
 
@@ -194,21 +196,17 @@ def stop_depth_of(fixed: trimesh.Trimesh, held: trimesh.Trimesh, hole_depth: flo
     step = max(1e-4, (top + bottom) / 200)
     length = float(held.vertices[:, 2].max())
     n_held = int(np.ceil(min(length, top + bottom) / step))
-    held_secs = [section(held, (k + 0.5) * step).buffer(-2e-6) for k in range(n_held)]
-    fixed_secs: dict[int, BaseGeometry] = {}
-
-    def fixed_at(i: int) -> BaseGeometry:  # the fixed part's section at (i + 0.5) * step
-        if i not in fixed_secs:
-            fixed_secs[i] = section(fixed, (i + 0.5) * step)
-        return fixed_secs[i]
-
+    held_secs = np.array([section(held, (k + 0.5) * step).buffer(-2e-6) for k in range(n_held)])
+    shapely.prepare(held_secs)
+    n_below, n_above = int(np.ceil(bottom / step)), int(np.ceil(top / step))
+    # fixed_secs[j]: the fixed part's section at (j - n_below + 0.5) * step
+    levels = (np.arange(-n_below, n_above) + 0.5) * step
+    fixed_secs = np.array([section(fixed, float(z)) for z in levels])
     for m in range(int(np.floor(min(bottom, hole_depth) / step)) + 1):
-        for k, sec in enumerate(held_secs):
-            i = k - m  # tip at depth m * step: the held section k lies at (k - m + 0.5) * step
-            if (i + 0.5) * step > top:
-                break
-            if not sec.is_empty and sec.intersects(fixed_at(i)):
-                return float(min(m * step, hole_depth, bottom))
+        # tip at depth m * step: the held section k lies at (k - m + 0.5) * step
+        k = np.arange(min(n_held, m + n_above))
+        if np.any(shapely.intersects(held_secs[k], fixed_secs[k - m + n_below])):
+            return float(min(m * step, hole_depth, bottom))
     return float(min(hole_depth, bottom))
 
 
