@@ -8,13 +8,16 @@ runs the cell checks, ``tasks example`` writes a shipped example.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.table import Table
 
 from teachfit.cli.common import console, guarded
 from teachfit.core.errors import TaskError
+
+if TYPE_CHECKING:
+    from teachfit.tasks.mesh.authoring import NewTask
 
 tasks_app = typer.Typer(
     help="Tasks: the built-in ones, and tasks made from your own part meshes.",
@@ -86,6 +89,28 @@ def _vec3(text: str, what: str) -> tuple[float, float, float]:
     return values
 
 
+def _print_new(new: NewTask, units: str) -> None:
+    """What ``tasks new`` found and wrote: the openings (if several), the hole, the depths."""
+    from teachfit.tasks.mesh.authoring import stop_text, yaw_text
+
+    cell = new.cell
+    if len(new.openings) > 1:
+        console.print("openings in the fixed part (choose with --hole N or --hole-at X,Y,Z):")
+        for i, o in enumerate(new.openings):
+            mark = "  <- chosen" if i == new.chosen else ""
+            console.print(f"  {i + 1}: {o.line(cell.spec.scale, units)}{mark}", markup=False)
+    spec = cell.spec
+    console.print(
+        f"hole entry at {spec.hole_pos} {units} in the fixed mesh, insertion axis "
+        f"{spec.insertion_axis}; {cell.fidelity.summary()}",
+        markup=False,
+    )
+    console.print(f"aligned part stops at {stop_text(cell)}", markup=False)
+    share = f"{1e3 * cell.success_depth:.3f} mm"
+    console.print(f"success depth {share}; yaw period {yaw_text(cell)}", markup=False)
+    console.print(f"wrote {new.path}; next: teachfit tasks show {new.path} --plot cell.png")
+
+
 @tasks_app.command("new")
 @guarded
 def tasks_new(
@@ -96,21 +121,38 @@ def tasks_new(
     hole_pos: Annotated[
         str | None, typer.Option(help="hole entry centre 'X,Y,Z' in the fixed mesh (units)")
     ] = None,
-    insertion_axis: Annotated[str, typer.Option(help="insertion direction 'X,Y,Z'")] = "0,0,-1",
+    insertion_axis: Annotated[
+        str | None,
+        typer.Option(
+            help="insertion direction 'X,Y,Z' (default: any face's openings; -z with --hole-pos)"
+        ),
+    ] = None,
+    hole: Annotated[
+        int | None, typer.Option(help="take opening number N of the list printed (1-based)")
+    ] = None,
+    hole_at: Annotated[
+        str | None, typer.Option(help="take the opening whose entry is nearest 'X,Y,Z' (units)")
+    ] = None,
     search_dims: Annotated[str, typer.Option(help="searched DOF: x,y or x,y,rz")] = "x,y",
     success_depth: Annotated[
-        float | None, typer.Option(help="insertion that counts (units; default 60 % of hole)")
+        float | None,
+        typer.Option(help="insertion that counts (units; default 60 % of where the part stops)"),
     ] = None,
-    rz_period: Annotated[float, typer.Option(help="the part's symmetry about its axis (deg)")] = 0,
+    rz_period: Annotated[
+        float | None,
+        typer.Option(
+            help="the part's symmetry about its axis (deg; 0: any yaw; default: inferred)"
+        ),
+    ] = None,
     overwrite: Annotated[bool, typer.Option(help="replace an existing task file")] = False,
 ) -> None:
     """Write a task file for your own two meshes (hole frame inferred unless given)."""
     from teachfit.cli.geometry_progress import geometry_progress
     from teachfit.tasks.mesh.authoring import new_task_file
 
-    axis = _vec3(insertion_axis, "--insertion-axis")
+    axis = None if insertion_axis is None else _vec3(insertion_axis, "--insertion-axis")
     with geometry_progress("checking and decomposing the parts"):
-        path, cell = new_task_file(
+        new = new_task_file(
             out,
             held,
             fixed,
@@ -121,10 +163,10 @@ def tasks_new(
             success_depth,
             rz_period,
             overwrite,
+            hole,
+            _vec(hole_at, "--hole-at"),
         )
-    pos = cell.spec.hole_pos
-    console.print(f"hole entry at {pos} {units} in the fixed mesh; {cell.fidelity.summary()}")
-    console.print(f"wrote {path}; next: teachfit tasks show {path} --plot cell.png")
+    _print_new(new, units)
 
 
 @tasks_app.command("show")

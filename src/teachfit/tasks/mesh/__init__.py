@@ -1,16 +1,18 @@
 """Tasks built from a user's CAD meshes: a TOML task file naming a held and a fixed part.
 
 :mod:`.spec` (the task file), :mod:`.loading` (meshes and their checks), :mod:`.sections`
-(hole, footprint and clearance from cross-sections), :mod:`.decompose` (convex pieces for
-MuJoCo with ``coacd``, cached by content hash), :mod:`.fidelity` (the clearance the pieces
-keep), :mod:`.cell` (placement), :mod:`.task` (:class:`MeshTask`) and :mod:`.examples`.
+(hole, footprint and clearance from cross-sections), :mod:`.holes` (the openings on any
+face), :mod:`.decompose` (convex pieces for MuJoCo with ``coacd``, cached by content hash),
+:mod:`.fidelity` (the clearance the pieces keep), :mod:`.cell` (placement), :mod:`.task`
+(:class:`MeshTask`) and :mod:`.examples`.
 """
 
 from teachfit.tasks.mesh.cell import MeshCell, build_cell
 from teachfit.tasks.mesh.decompose import CoacdSettings, Decomposition, decompose
 from teachfit.tasks.mesh.examples import EXAMPLES, write_example
 from teachfit.tasks.mesh.fidelity import Fidelity
-from teachfit.tasks.mesh.sections import HoleFit, infer_hole
+from teachfit.tasks.mesh.holes import infer_hole
+from teachfit.tasks.mesh.sections import HoleFit
 from teachfit.tasks.mesh.spec import MeshTaskSpec, read_spec, spec_to_toml
 from teachfit.tasks.mesh.task import MeshParams, MeshTask, load_mesh_task
 

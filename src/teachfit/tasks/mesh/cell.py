@@ -3,8 +3,9 @@
 Placement. The fixed part is turned so that its hole frame's z (opposite the insertion axis)
 is world z and stands on the table (its lowest point at world z = 0), the hole entry centre
 on the world z axis: ``hole2world`` is ``(0, 0, z_entry)``, unturned, as for the built-in
-tasks. The held part hangs in the tool (TCP) frame by its grasp: the TCP at the tip, the
-part's axis +z. Lengths in metres; the file's lengths are scaled by its units.
+tasks. The table (world z = 0) is solid: a part stops on it under a through hole. The held
+part hangs in the tool (TCP) frame by its grasp: the TCP at the tip, the part's axis +z.
+Lengths in metres; the file's lengths are scaled by its units.
 """
 
 from __future__ import annotations
@@ -20,10 +21,14 @@ from teachfit.core.errors import TaskError
 from teachfit.core.geometry import Pose
 from teachfit.tasks.mesh.decompose import CACHE_DIR, CoacdSettings, Decomposition, decompose
 from teachfit.tasks.mesh.fidelity import Fidelity, decomposition_fidelity, require_fidelity
+from teachfit.tasks.mesh.holes import best_opening
 from teachfit.tasks.mesh.loading import load_parts
 from teachfit.tasks.mesh.progress import report
-from teachfit.tasks.mesh.sections import HoleFit, check_entry, fit_of, hole_depth_of, infer_hole
+from teachfit.tasks.mesh.sections import HoleFit, check_entry, fit_of, reach_of
 from teachfit.tasks.mesh.spec import MeshTaskSpec
+
+#: share of the stop depth a task file without ``success_depth`` takes as its success depth
+DEFAULT_SUCCESS_SHARE = 0.6
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,6 +60,15 @@ class MeshCell:
     def fixture_pieces(self) -> list[np.ndarray]:
         """The fixed part's convex pieces' vertices in the world (m)."""
         return self.fixed_pieces.moved(self.fixed2world)
+
+    @property
+    def rz_period_deg(self) -> float:
+        """The held part's yaw symmetry in the hole (deg; 0: any yaw fits): the file's
+        ``rz_period_deg`` if it sets one, else the one inferred from the cross-sections
+        (:func:`~teachfit.tasks.mesh.sections.rz_period_of`)."""
+        if self.spec.rz_period_deg is not None:
+            return float(self.spec.rz_period_deg)
+        return float(np.degrees(self.fit.rz_period))
 
     def held_pieces_tcp(self) -> list[np.ndarray]:
         """The held part's convex pieces' vertices in the TCP frame (m)."""
@@ -109,25 +123,31 @@ def _moved(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
 
 def _hole(
     spec: MeshTaskSpec, fixed: trimesh.Trimesh, held: trimesh.Trimesh
-) -> tuple[np.ndarray, trimesh.Trimesh, float]:
-    """The hole frame in the fixed mesh (given or inferred), the fixed mesh in that frame and
-    the success depth (m)."""
+) -> tuple[np.ndarray, trimesh.Trimesh, float, tuple[float, float]]:
+    """The hole frame in the fixed mesh (given or inferred), the fixed mesh in that frame, the
+    success depth and the hole and stop depths (m). The success depth defaults to
+    :data:`DEFAULT_SUCCESS_SHARE` of where the aligned part stops (the hole's bottom, the table
+    under a through hole, or a shoulder of the part), at most of the held part's length."""
     where = str(spec.path)
+    axis = np.asarray(spec.insertion_axis)
+    x_hint = None if spec.hole_x_axis is None else np.asarray(spec.hole_x_axis)
     if spec.hole_pos is None:
-        pos = infer_hole(fixed, held)
+        opening = best_opening(fixed, held, unit(axis, "insertion_axis", where))
+        pos = opening.pos
+        x_hint = opening.x_axis if x_hint is None else x_hint
     else:
         pos = np.asarray(spec.hole_pos) * spec.scale
-    x_hint = None if spec.hole_x_axis is None else np.asarray(spec.hole_x_axis)
-    hole2fixed = hole_frame(pos, np.asarray(spec.insertion_axis), x_hint, where)
+    hole2fixed = hole_frame(pos, axis, x_hint, where)
     fixed_h = _moved(fixed, np.linalg.inv(hole2fixed))
     check_entry(fixed_h, where)
+    reach = reach_of(fixed_h, held)
     if spec.success_depth is None:
-        depth = 0.6 * min(hole_depth_of(fixed_h), held.vertices[:, 2].max())
+        depth = DEFAULT_SUCCESS_SHARE * min(reach[1], held.vertices[:, 2].max())
     else:
         depth = spec.success_depth * spec.scale
     if depth <= 0:
         raise TaskError(f"{where}: success_depth must be > 0")
-    return hole2fixed, fixed_h, float(depth)
+    return hole2fixed, fixed_h, float(depth), reach
 
 
 def build_cell(
@@ -149,8 +169,8 @@ def build_cell(
     held = _moved(held_raw, part2tcp)
     if held.vertices[:, 2].min() < -1e-6:
         raise TaskError(f"{where}: the grasp puts part of the held mesh below the TCP (tip)")
-    hole2fixed, fixed_h, depth = _hole(spec, fixed_raw, held)
-    fit = fit_of(fixed_h, held, depth, where)
+    hole2fixed, fixed_h, depth, reach = _hole(spec, fixed_raw, held)
+    fit = fit_of(fixed_h, held, depth, where, reach)
     z_entry = -float(fixed_h.vertices[:, 2].min())
     hole2world = Pose(np.array([0.0, 0.0, z_entry]))
     fixed2world = hole2world.matrix @ np.linalg.inv(hole2fixed)

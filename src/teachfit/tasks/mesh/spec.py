@@ -1,5 +1,13 @@
 """The mesh task file: a TOML document naming a user's held and fixed part meshes.
 
+Defaults worth knowing: without ``hole_pos`` the hole is the opening along ``insertion_axis``
+that the held part fits with the least clearance (:mod:`teachfit.tasks.mesh.holes`); without
+``success_depth`` it is 60 % of the depth where the aligned part stops (the hole's bottom, the
+table under a through hole, or a shoulder of the held part; at most 60 % of the held part's
+length); without ``rz_period_deg`` the yaw period is inferred from the cross-sections
+(:func:`~teachfit.tasks.mesh.sections.rz_period_of`: 0 where any yaw fits, e.g. round; 180
+for a rectangle; 90 for a square; 360 for no symmetry). ``teachfit tasks show`` says which.
+
 Every length in the file, and every mesh coordinate, is in the file's ``units`` (``"m"``,
 ``"mm"``, ``"cm"`` or ``"in"``); angles are in degrees. Relative mesh paths resolve against
 the task file's folder. Layout (all but the two meshes optional)::
@@ -18,7 +26,7 @@ the task file's folder. Layout (all but the two meshes optional)::
     [params]
     success_depth = 5             # insertion past the entry that counts
     search_dims = ["x", "y"]      # or ["x", "y", "rz"]
-    rz_period_deg = 90            # the held part's symmetry about its axis (0: none)
+    rz_period_deg = 90            # the held part's symmetry about its axis (0: any yaw fits)
     friction = 0.3
     [protocol]                    # start distributions (see MeshParams)
     demo_offset = 4
@@ -72,7 +80,7 @@ class MeshTaskSpec:
     hole_x_axis: tuple[float, float, float] | None = None
     success_depth: float | None = None
     search_dims: tuple[str, ...] = ("x", "y")
-    rz_period_deg: float = 0.0
+    rz_period_deg: float | None = None
     friction: float = 0.3
     protocol: dict[str, float] = field(default_factory=dict)
     decomposition: dict[str, float | str] = field(default_factory=dict)
@@ -154,6 +162,8 @@ def read_spec(path: str | Path) -> MeshTaskSpec:
     for key in ("success_depth", "rz_period_deg", "friction"):
         if key in params:
             kw[key] = _num(path, params, key, "params")
+    if not 0 <= kw.get("rz_period_deg", 0.0) <= 360:
+        raise _fail(path, "[params] rz_period_deg must be within 0 (any yaw fits) .. 360 deg")
     if "search_dims" in params:
         dims = tuple(params["search_dims"])
         if dims not in SEARCH_DIMS:
@@ -215,7 +225,8 @@ def spec_to_toml(spec: MeshTaskSpec) -> str:
     if spec.success_depth is not None:
         lines.append(f"success_depth = {_toml_value(spec.success_depth)}")
     lines.append(f"search_dims = {_toml_value(list(spec.search_dims))}")
-    lines.append(f"rz_period_deg = {_toml_value(spec.rz_period_deg)}")
+    if spec.rz_period_deg is not None:
+        lines.append(f"rz_period_deg = {_toml_value(spec.rz_period_deg)}")
     lines.append(f"friction = {_toml_value(spec.friction)}")
     for where in ("protocol", "decomposition"):
         table = getattr(spec, where)

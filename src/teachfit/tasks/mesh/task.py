@@ -29,11 +29,13 @@ from teachfit.tasks.mesh.cell import MeshCell, build_cell
 from teachfit.tasks.mesh.spec import read_spec
 from teachfit.tasks.params import doc_field
 from teachfit.tasks.protocols.skill import SkillProtocol, SkillProtocolParams, in_frame
-from teachfit.tasks.scene.builder import SceneBuilder, add_mesh_geom, fixture_body
+from teachfit.tasks.scene.builder import SceneBuilder, add_geom, add_mesh_geom, fixture_body
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml
 
 #: mass of the held part (kg), spread over its convex pieces by volume
 HELD_MASS = 0.05
+#: half extents (m) of the solid table under the fixed part
+TABLE_HALF = (0.5, 0.5, 0.01)
 
 
 @dataclass(frozen=True)
@@ -53,7 +55,10 @@ class MeshParams(SkillProtocolParams):
 
 
 class MeshScene(SceneBuilder):
-    """The fixed part's and the held part's convex pieces as MuJoCo mesh geoms."""
+    """The fixed part's and the held part's convex pieces as MuJoCo mesh geoms, on a solid
+    table: a box :data:`TABLE_HALF` (m) whose top is world z = 0, where the fixed part stands,
+    so a part through a through hole stops on it (the floor plane, which collides with nothing,
+    only shows it)."""
 
     task: MeshTask
 
@@ -65,6 +70,8 @@ class MeshScene(SceneBuilder):
         body = fixture_body(scene)
         for i, verts in enumerate(self.task.cell.fixture_pieces()):
             add_mesh_geom(body, scene, f"fixed_piece_{i}", verts, contact)
+        hx, hy, hz = TABLE_HALF
+        add_geom(body, "table", contact, "grid", type="box", size=[hx, hy, hz], pos=[0, 0, -hz])
 
     def add_held_part(self, body: ET.Element, scene: SceneXml, contact: ContactParams) -> None:
         pieces = self.task.cell.held_pieces_tcp()
@@ -122,8 +129,8 @@ class MeshTask(SkillTask):
         self.cell = cell
         self.name = name  # type: ignore[misc]  # the file's path: loadable by every process
         self.search_dims = cell.spec.search_dims  # type: ignore[misc]  # the file's dims, per cell
-        if cell.spec.rz_period_deg > 0:
-            self.rz_period = float(np.radians(cell.spec.rz_period_deg))
+        if cell.rz_period_deg > 0:
+            self.rz_period = float(np.radians(cell.rz_period_deg))
         super().__init__(params)
         self._check_protocol()
 
@@ -149,6 +156,12 @@ class MeshTask(SkillTask):
     @property
     def hole_depth(self) -> float:
         return self.cell.fit.hole_depth
+
+    @property
+    def stop_depth(self) -> float:
+        """Depth below the entry (m) where the aligned part stops: the hole's bottom, the
+        table under a through hole, or a shoulder of the held part."""
+        return self.cell.fit.stop_depth
 
     @property
     def capture_radius(self) -> float:
