@@ -2,8 +2,10 @@
 
 :mod:`.spec` (the task file), :mod:`.loading` (meshes and their checks), :mod:`.sections`
 (hole, footprint and clearance from cross-sections), :mod:`.decompose` (convex pieces for
-MuJoCo with ``coacd``, cached by content hash), :mod:`.fidelity` (the clearance the pieces
-keep), :mod:`.cell` (placement), :mod:`.task` (:class:`MeshTask`) and :mod:`.examples`.
+MuJoCo: exact boxes (:mod:`.planar`), exact ring sectors for round bores (:mod:`.revolved`),
+else ``coacd``, cached by content hash), :mod:`.fidelity` (the clearance the pieces keep),
+:mod:`.cell` (placement), :mod:`.task` (:class:`MeshTask`), :mod:`.outline` (the hole's
+outline for figures) and :mod:`.examples`.
 """
 
 from teachfit.tasks.mesh.cell import MeshCell, build_cell

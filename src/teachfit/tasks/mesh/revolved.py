@@ -53,6 +53,9 @@ RADIAL_TOL = 2e-6
 MIN_SEGMENTS = 16
 #: most sectors per bore
 MAX_SECTORS = 256
+#: largest half side of a bore's square of sectors, times the bore's radius (kept small: the
+#: part beyond rests on a few boxes instead of on many thin sectors, fewer contacts)
+SQUARE_CAP = 1.25
 #: thinnest wall (fraction of the bore radius) a bore's square must leave around it
 MIN_WALL = 0.05
 
@@ -204,10 +207,10 @@ def _heights(mesh: trimesh.Trimesh, bore: Bore) -> np.ndarray:
 
 def _room(mesh: trimesh.Trimesh, bore: Bore, n: int) -> float | None:
     """Half side (m) of the largest square prism about ``bore`` over its extent that is solid
-    but for the bore (capped at twice its radius); None if the bore is not alone in it or
-    the wall it leaves is thinner than :data:`MIN_WALL` of its radius."""
+    but for the bore (at most :data:`SQUARE_CAP` times its radius); None if the bore is not
+    alone in it or the wall it leaves is thinner than :data:`MIN_WALL` of its radius."""
     r_max = float(bore.radii.max())
-    filled, reach = [], 2 * r_max
+    filled, reach = [], SQUARE_CAP * r_max
     for z in _heights(mesh, bore):
         sec = section(mesh, float(z))
         hole = _bore_ring(sec, bore, float(z))
