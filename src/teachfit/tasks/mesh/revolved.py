@@ -199,7 +199,8 @@ def _bore_ring(sec: shapely.Geometry, bore: Bore, z: float) -> shapely.Polygon |
 def _heights(mesh: trimesh.Trimesh, bore: Bore) -> np.ndarray:
     """Mid-heights between the mesh's vertex levels within the bore's extent: within each
     band between them the sections change shape continuously, so these see every feature."""
-    z = np.unique(mesh.vertices[:, 2])
+    z = np.sort(mesh.vertices[:, 2])
+    z = z[np.concatenate([[True], np.diff(z) > RADIAL_TOL])]  # one per level
     z0, z1 = bore.levels[0], bore.levels[-1]
     z = np.concatenate([[z0], z[(z > z0 + RADIAL_TOL) & (z < z1 - RADIAL_TOL)], [z1]])
     return (z[:-1] + z[1:]) / 2
