@@ -63,6 +63,30 @@ def test_chamfered_countersink_is_one_convex_slab_of_sectors() -> None:
         assert piece.volume == pytest.approx(piece.convex_hull.volume, rel=1e-9)
 
 
+def _cyl(height: float, r0: float, r1: float, x: float, z: float) -> manifold3d.Manifold:
+    return manifold3d.Manifold.cylinder(height, r0, r1, 96).translate([x, 0.0, z])
+
+
+@pytest.mark.parametrize(
+    ("cutter", "n_bores"),
+    [
+        (_cyl(10.0, 4.1, 4.1, 3.0, 4.0), 1),  # blind, off the plate's centre
+        (_cyl(11.0, 4.1, 4.1, 0.0, -1.0) + _cyl(5.0, 6.1, 6.1, 0.0, 6.0), 2),  # counterbore
+        (_cyl(11.0, 4.1, 4.1, 0.0, -1.0) + _cyl(2.0, 5.1, 4.1, 0.0, -1.0), 1),  # bottom chamfer
+        (_cyl(11.0, 4.1, 4.1, -5.0, -1.0) + _cyl(11.0, 4.1, 4.1, 5.0, -1.0), 2),  # 1.8 mm apart
+    ],
+    ids=["blind", "counterbore", "bottom-chamfer", "two-close-bores"],
+)
+def test_other_bores_are_cut_exactly(cutter: manifold3d.Manifold, n_bores: int) -> None:
+    plate = _plate_with(cutter)
+    bores = find_bores(plate)
+    assert bores is not None and len(bores) == n_bores
+    pieces = revolved_pieces(plate, 2e-5, 48)
+    assert pieces is not None
+    total = sum(trimesh.Trimesh(v, f).volume for v, f in pieces)
+    assert 0 <= plate.volume - total < 0.002 * plate.volume
+
+
 def test_bore_along_x_is_found_too() -> None:
     plate = _plate_with(_countersunk(8.2, 0.5))
     plate.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [0, 1, 0]))
