@@ -65,6 +65,15 @@ def _outline(ax: plt.Axes, geom: object, **kw: Any) -> None:
             kw.pop("label", None)
 
 
+def _lines(ax: plt.Axes, geom: BaseGeometry, **kw: Any) -> None:
+    """The (multi)line ``geom`` (m) in mm, labelled once."""
+    for line in getattr(geom, "geoms", [geom]):
+        if not line.is_empty and line.geom_type in ("LineString", "LinearRing"):
+            xy = 1e3 * np.asarray(line.coords)
+            ax.plot(xy[:, 0], xy[:, 1], **kw)
+            kw.pop("label", None)
+
+
 def _piece_sections(task: MeshTask) -> list[BaseGeometry]:
     """The fixed part's pieces cut halfway down to the success depth (hole frame, m)."""
     z = task.cell.hole2world.pos[2] - task.success_depth / 2
@@ -136,8 +145,8 @@ def _zoom(ax: plt.Axes, task: MeshTask, foot: BaseGeometry, walls: BaseGeometry)
     half = 1e3 * max(4 * cell.fit.clearance, 2e-5)
     window = shapely.box(*(mid - half) / 1e3, *(mid + half) / 1e3)
     _fill_pieces(ax, _piece_sections(task), window)
-    _outline(ax, walls.intersection(window), color="k", lw=1.2, label="mesh walls")
-    _outline(ax, foot.intersection(window), color="tab:orange", lw=1.2, label="footprint")
+    _lines(ax, walls.boundary.intersection(window), color="k", lw=1.2, label="mesh walls")
+    _lines(ax, foot.boundary.intersection(window), color="tab:orange", lw=1.2, label="footprint")
     ax.plot(1e3 * np.array([a.x, b.x]), 1e3 * np.array([a.y, b.y]), "r-", lw=1)
     ax.set_xlim(mid[0] - half, mid[0] + half)
     ax.set_ylim(mid[1] - half, mid[1] + half)
