@@ -19,25 +19,37 @@ from teachfit.viz.style import axis_label, end_handles, mark_ends  # noqa: E402
 
 
 def _hole_patch(ax: plt.Axes, task: Task | None, scale: float) -> None:
+    """The task's hole seen from above: a mesh task's real outline (its cross-section), a
+    round-peg cell's circle, else a nominal 4 mm circle; and the hole axis."""
     if task is None:
         return
-    params = getattr(task, "params", None)
-    radius = (
-        (params.peg_diameter + params.clearance) / 2
-        if params is not None and hasattr(params, "peg_diameter") and hasattr(params, "clearance")
-        else 0.002
-    )
     hole = task.hole2world.pos
-    ax.add_patch(
-        Circle(
-            (hole[0] * scale, hole[1] * scale),
-            radius * scale,
-            fill=False,
-            color="k",
-            lw=1.5,
-            label=f"hole, Ø {2e3 * radius:.1f} mm",
+    cell = getattr(task, "cell", None)
+    if cell is not None:  # a mesh task: its hole as its meshes have it
+        from teachfit.tasks.mesh.outline import hole_outline
+
+        outline = hole_outline(cell)
+        xy = outline.xy * scale
+        ax.plot(xy[:, 0], xy[:, 1], color="k", lw=1.5, label=outline.label())
+    else:
+        params = getattr(task, "params", None)
+        radius = (
+            (params.peg_diameter + params.clearance) / 2
+            if params is not None
+            and hasattr(params, "peg_diameter")
+            and hasattr(params, "clearance")
+            else 0.002
         )
-    )
+        ax.add_patch(
+            Circle(
+                (hole[0] * scale, hole[1] * scale),
+                radius * scale,
+                fill=False,
+                color="k",
+                lw=1.5,
+                label=f"hole, Ø {2e3 * radius:.1f} mm",
+            )
+        )
     ax.plot(hole[0] * scale, hole[1] * scale, "k+", ms=10, label="hole axis")
 
 

@@ -2,9 +2,10 @@
 
 :mod:`.spec` (the task file), :mod:`.loading` (meshes and their checks), :mod:`.sections`
 (hole, footprint and clearance from cross-sections), :mod:`.holes` (the openings on any
-face), :mod:`.decompose` (convex pieces for MuJoCo with ``coacd``, cached by content hash),
+face), :mod:`.decompose` (convex pieces for MuJoCo: exact boxes (:mod:`.planar`), exact ring
+sectors for round bores (:mod:`.revolved`), else ``coacd``, cached by content hash),
 :mod:`.fidelity` (the clearance the pieces keep), :mod:`.cell` (placement), :mod:`.task`
-(:class:`MeshTask`) and :mod:`.examples`.
+(:class:`MeshTask`), :mod:`.outline` (the hole's outline for figures) and :mod:`.examples`.
 """
 
 from teachfit.tasks.mesh.cell import MeshCell, build_cell

@@ -4,8 +4,10 @@ MuJoCo collides every mesh geom as its convex hull, so a concave part (a board w
 socket) must be split into convex pieces. ``coacd`` (Wei et al., SIGGRAPH 2022) cuts the mesh
 along planes chosen by a tree search until every piece's concavity is below ``threshold``.
 A convex part (volume within 0.1 % of its hull's) is its own single piece; a rectilinear one
-(every face normal to a mesh axis) is cut exactly into boxes (:mod:`.planar`) unless
-``method = "coacd"``, since coacd's pieces narrow sub-millimetre clearances.
+(every face normal to a mesh axis) is cut exactly into boxes (:mod:`.planar`), and a
+rectilinear one with round bores (chamfered, countersunk) into boxes and ring sectors
+(:mod:`.revolved`), unless ``method = "coacd"``, since coacd's pieces narrow sub-millimetre
+clearances.
 
 The pieces are cached in ``.teachfit-cache/`` beside the task file: an NPZ of the pieces'
 vertices and faces and a JSON of the settings and timing, both named by a SHA-256 of the
@@ -30,18 +32,22 @@ import trimesh
 from teachfit.core.errors import TaskError
 from teachfit.tasks.mesh.loading import write_atomic
 from teachfit.tasks.mesh.planar import box_pieces
+from teachfit.tasks.mesh.revolved import MIN_SEGMENTS, revolved_pieces
 
 CACHE_DIR = ".teachfit-cache"
-METHODS = ("auto", "coacd", "boxes")
+METHODS = ("auto", "coacd", "boxes", "revolved")
 _FORMAT = 1
 
 
 @dataclass(frozen=True)
 class CoacdSettings:
-    """``method``: ``"auto"`` (exact boxes for a rectilinear part, else coacd), ``"coacd"`` or
-    ``"boxes"``; ``coacd.run_coacd`` settings: concavity ``threshold`` (of the part's size,
-    0.01-1), at most ``max_pieces`` convex pieces, sampling ``resolution``,
-    ``mcts_iterations`` of the cutting-plane search, ``seed``."""
+    """``method``: ``"auto"`` (exact boxes for a rectilinear part, boxes and ring sectors for
+    one with round bores, else coacd), ``"coacd"``, ``"boxes"`` or ``"revolved"`` (exact
+    pieces only); ``widening``: most a bore's ring sectors widen it at their corners (m,
+    :func:`~teachfit.tasks.mesh.revolved.sector_count`); ``coacd.run_coacd`` settings:
+    concavity ``threshold`` (of the part's size, 0.01-1), at most ``max_pieces`` convex
+    pieces (boxes too), sampling ``resolution``, ``mcts_iterations`` of the cutting-plane
+    search, ``seed``."""
 
     method: str = "auto"
     threshold: float = 0.03
@@ -49,6 +55,7 @@ class CoacdSettings:
     resolution: int = 1000
     mcts_iterations: int = 60
     seed: int = 0
+    widening: float = 2e-5
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -59,13 +66,18 @@ class CoacdSettings:
             raise TaskError(
                 "[decomposition] needs max_pieces >= 1, resolution >= 100, mcts_iterations >= 10"
             )
+        if not 1e-7 <= self.widening <= 1e-3:
+            raise TaskError(
+                f"[decomposition] widening must be within [1e-7, 1e-3] m, got {self.widening}"
+            )
 
 
 @dataclass(frozen=True)
 class Decomposition:
     """Convex pieces of one mesh (its own frame, m): ``pieces`` as (vertices, faces) pairs;
     ``seconds`` the decomposition's wall time when it was computed, ``cached`` whether it
-    came from the cache now, ``method`` ``"hull"``, ``"boxes"`` or ``"coacd"``."""
+    came from the cache now, ``method`` ``"hull"``, ``"boxes"``, ``"revolved"`` or
+    ``"coacd"``."""
 
     pieces: tuple[tuple[np.ndarray, np.ndarray], ...]
     seconds: float
@@ -93,11 +105,13 @@ def is_convex(mesh: trimesh.Trimesh) -> bool:
 
 
 def mesh_hash(mesh: trimesh.Trimesh, settings: CoacdSettings) -> str:
-    """SHA-256 (hex) of the mesh's coordinates, faces, the settings and the cache format."""
+    """SHA-256 (hex) of the mesh's coordinates, faces, the settings coacd uses and the cache
+    format (``widening``, for the exact pieces only, is left out: older entries stay valid)."""
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(mesh.vertices, dtype="<f8").tobytes())
     h.update(np.ascontiguousarray(mesh.faces, dtype="<i8").tobytes())
-    h.update(json.dumps([asdict(settings), _FORMAT], sort_keys=True).encode())
+    used = {k: v for k, v in asdict(settings).items() if k != "widening"}
+    h.update(json.dumps([used, _FORMAT], sort_keys=True).encode())
     return h.hexdigest()
 
 
@@ -155,6 +169,33 @@ def _load(stem: Path) -> tuple[list[tuple[np.ndarray, np.ndarray]], dict] | None
     return list(zip(verts, faces, strict=True)), meta
 
 
+def _exact(mesh: trimesh.Trimesh, settings: CoacdSettings, name: str) -> Decomposition | None:
+    """Boxes for a rectilinear part, boxes and ring sectors for one with round bores (unless
+    ``method`` names the other), else None; an error if ``method`` asks for what fails."""
+    t0 = time.perf_counter()
+    if settings.method in ("auto", "boxes"):
+        boxes = box_pieces(mesh, settings.max_pieces)
+        if boxes is not None:
+            box_list = tuple((np.asarray(b.vertices), np.asarray(b.faces)) for b in boxes)
+            return Decomposition(box_list, time.perf_counter() - t0, False, "boxes")
+    if settings.method in ("auto", "revolved"):
+        pieces = revolved_pieces(mesh, settings.widening, settings.max_pieces)
+        if pieces is not None:
+            return Decomposition(tuple(pieces), time.perf_counter() - t0, False, "revolved")
+    if settings.method == "boxes":
+        raise TaskError(
+            f'{name}: method = "boxes" needs a rectilinear part (every face normal to a '
+            f'mesh axis) of at most {settings.max_pieces} boxes; use "auto" or "coacd"'
+        )
+    if settings.method == "revolved":
+        raise TaskError(
+            f'{name}: method = "revolved" needs a rectilinear part whose only curved faces are '
+            f"round bores along one mesh axis (at least {MIN_SEGMENTS} facets around) and at "
+            f'most {settings.max_pieces} boxes besides; use "auto" or "coacd"'
+        )
+    return None
+
+
 def decompose(
     mesh: trimesh.Trimesh, settings: CoacdSettings, cache_dir: Path | None, name: str
 ) -> Decomposition:
@@ -167,16 +208,9 @@ def decompose(
         piece = (np.asarray(hull.vertices, dtype=float), np.asarray(hull.faces, dtype=np.int64))
         return Decomposition((piece,), 0.0, False, "hull")
     if settings.method != "coacd":
-        t0 = time.perf_counter()
-        boxes = box_pieces(mesh, settings.max_pieces)
-        if boxes is not None:
-            box_list = tuple((np.asarray(b.vertices), np.asarray(b.faces)) for b in boxes)
-            return Decomposition(box_list, time.perf_counter() - t0, False, "boxes")
-        if settings.method == "boxes":
-            raise TaskError(
-                f'{name}: method = "boxes" needs a rectilinear part (every face normal to a '
-                f'mesh axis) of at most {settings.max_pieces} boxes; use "auto" or "coacd"'
-            )
+        exact = _exact(mesh, settings, name)
+        if exact is not None:
+            return exact
     stem = None
     if cache_dir is not None:
         stem = cache_dir / f"{name}-{mesh_hash(mesh, settings)[:20]}"

@@ -9,6 +9,11 @@
     A USB-A-like plug (12 x 4.5 mm tongue, 12 mm long, under a 16 x 8 mm housing) and a
     70 x 50 x 14 mm receptacle panel with a 12.4 x 4.9 mm pocket 10 mm deep (0.2 mm clearance
     per side). Search x, y, rz; the plug is 2-fold symmetric.
+``round-peg``
+    An 8 mm round peg (no chamfer, 30 mm long) and a 60 x 40 x 9 mm plate with two through
+    bores 26 mm apart: 8.2 mm (0.1 mm clearance per side, the task's hole) and 12.2 mm.
+    Search x, y. Its bores are cut exactly into ring sectors
+    (:mod:`teachfit.tasks.mesh.revolved`).
 
 The meshes are written as binary STL in millimetres beside a task file that declares
 ``units = "mm"`` and leaves the hole frame to be found from the meshes or gives it.
@@ -18,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import manifold3d
 import trimesh
@@ -61,43 +67,63 @@ def usb() -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
     return plug, from_manifold(receptacle)
 
 
+def round_peg() -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
+    """The ``round-peg`` example's peg and plate (mm), 128 facets around each round face."""
+    peg = manifold3d.Manifold.cylinder(30.0, 4.0, 4.0, 128)
+    plate = _box((-30.0, -20.0, 0.0), (30.0, 20.0, 9.0))
+    for x, diameter in ((-12.0, 8.2), (14.0, 12.2)):
+        bore = manifold3d.Manifold.cylinder(11.0, diameter / 2, diameter / 2, 128)
+        plate = plate - bore.translate([x, 0.0, -1.0])
+    return from_manifold(peg), from_manifold(plate)
+
+
+#: each example's mesh files (held, fixed) and the task file's other settings (mm, degrees)
+_SPECS: dict[str, tuple[str, str, dict[str, Any]]] = {
+    "square-peg": (
+        "square_peg.stl",
+        "plate_3holes.stl",
+        {"search_dims": ("x", "y"), "rz_period_deg": 90.0},
+    ),
+    "usb": (
+        "usb_plug.stl",
+        "usb_receptacle.stl",
+        {
+            "hole_pos": (0.0, 0.0, 14.0),
+            "insertion_axis": (0.0, 0.0, -1.0),
+            "hole_x_axis": (1.0, 0.0, 0.0),
+            "search_dims": ("x", "y", "rz"),
+            "rz_period_deg": 180.0,
+        },
+    ),
+    "round-peg": (
+        "round_peg.stl",
+        "plate_2bores.stl",
+        {"hole_pos": (-12.0, 0.0, 9.0), "success_depth": 5.0},
+    ),
+}
+_PROTOCOLS = {
+    "usb": {"demo_offset": 3.0, "table1_radius": 1.5, "start_offset": 1.5, "start_yaw_deg": 1.5}
+}
+
+
 def _spec(name: str, folder: Path) -> MeshTaskSpec:
-    if name == "square-peg":
-        return MeshTaskSpec(
-            path=folder / f"{name}.toml",
-            held_mesh=folder / "square_peg.stl",
-            fixed_mesh=folder / "plate_3holes.stl",
-            units="mm",
-            label=name,
-            search_dims=("x", "y"),
-            rz_period_deg=90.0,
-            success_depth=6.0,
-            protocol={"demo_offset": 4.0, "table1_radius": 2.0, "start_offset": 2.0},
-        )
+    held, fixed, settings = _SPECS[name]
+    protocol = {"demo_offset": 4.0, "table1_radius": 2.0, "start_offset": 2.0}
     return MeshTaskSpec(
         path=folder / f"{name}.toml",
-        held_mesh=folder / "usb_plug.stl",
-        fixed_mesh=folder / "usb_receptacle.stl",
+        held_mesh=folder / held,
+        fixed_mesh=folder / fixed,
         units="mm",
         label=name,
-        hole_pos=(0.0, 0.0, 14.0),
-        insertion_axis=(0.0, 0.0, -1.0),
-        hole_x_axis=(1.0, 0.0, 0.0),
-        search_dims=("x", "y", "rz"),
-        rz_period_deg=180.0,
-        success_depth=6.0,
-        protocol={
-            "demo_offset": 3.0,
-            "table1_radius": 1.5,
-            "start_offset": 1.5,
-            "start_yaw_deg": 1.5,
-        },
+        **{"success_depth": 6.0, **settings},
+        protocol=_PROTOCOLS.get(name, protocol),
     )
 
 
 EXAMPLES: dict[str, Callable[[], tuple[trimesh.Trimesh, trimesh.Trimesh]]] = {
     "square-peg": square_peg,
     "usb": usb,
+    "round-peg": round_peg,
 }
 
 

@@ -61,7 +61,15 @@ PROTOCOL_KEYS = (
     "hole_yaw_sigma_deg",
     "table1_radius",
 )
-DECOMPOSITION_KEYS = ("method", "threshold", "max_pieces", "resolution", "mcts_iterations", "seed")
+DECOMPOSITION_KEYS = (
+    "method",
+    "threshold",
+    "max_pieces",
+    "resolution",
+    "mcts_iterations",
+    "seed",
+    "widening",
+)
 
 
 @dataclass(frozen=True)
