@@ -105,3 +105,16 @@ def test_csv_import_speed_appends_both_readers(monkeypatch, capsys, tmp_path) ->
     assert "**CSV import of 50 rows** (fastest of 1, seed 0)" in body
     assert "| `import_csv` | " in body and "| `numpy.loadtxt` (baseline) | " in body
     assert "| ratio import_csv / loadtxt | " in body
+
+
+def test_search_speed_s_tshix_table_keeps_the_page_s_rows(monkeypatch) -> None:
+    """All ten sizes are measured and printed; the markdown keeps the page's four rows (the
+    timings themselves made up here: the real ones take a minute)."""
+    ss = _script("search_speed")
+    monkeypatch.setattr(ss, "_tshix_row", lambda p, dims, n, r, s: ([f"{len(dims)}", f"{n}"], n))
+    monkeypatch.setattr(ss, "_ergodic_row", lambda dims, tr, ls, r: [f"{len(dims)}", f"{tr}"])
+    tshix, ergodic = ss.tshix_speed(1, 0)
+    assert [line for line in tshix.splitlines() if line[:3] in ("| 2", "| 3")] == [
+        "| 2 | 100 |", "| 2 | 300 |", "| 2 | 500 |", "| 3 | 300 |"
+    ]  # fmt: skip
+    assert ergodic.splitlines()[-2:] == ["| 2 | 300 |", "| 3 | 300 |"]
