@@ -1,7 +1,7 @@
 """Wall time of TSHIX (ours vs LKH via elkai) and of ergodic search, measured in one run.
 
 Usage: ``python benchmarks/search_speed.py [--repeats 5] [--seed 0] [--part all|tshix|tsp]
-[--sizes 100,300,1000,2000] [--instances 3] [--lkh-cache FILE]``
+[--sizes 100,300,1000,2000] [--instances 3] [--lkh-cache FILE] [--markdown FILE]``
 
 For each N = 100..500 TSHIX plans ``repeats`` trajectories from a fixed 2-D exploration
 distribution; the tour length of our open-tour solver is compared with LKH-3 (elkai) on the
@@ -10,6 +10,9 @@ same samples. Then one ergodic trajectory of the TSHIX (N = 300) length is gener
 clustered: 8 clusters of 2 mm spread in a 40 mm square) against LKH-3 on the same points.
 Times are medians of wall-clock seconds (``time.perf_counter``); the open-tour timings are
 the solver's CPU time (``time.process_time``), which a loaded machine disturbs less.
+``--markdown FILE`` appends the tables of the parts run (the TSHIX table at four of its sizes),
+headed with where they came from (``benchmarks/results/search-speed-tshix.md``,
+``search-speed-tsp.md`` feed BENCHMARKS.md).
 """
 
 from __future__ import annotations
@@ -21,10 +24,11 @@ import time
 
 import numpy as np
 
+from teachfit.cli.script_markdown import add_markdown_option, append_table, checked_markdown, table
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.trajectories.ergodic import ergodic_metric, ergodic_trajectory
 from teachfit.trajectories.ergodic_opt import optimise_ergodic
-from teachfit.trajectories.tshix import TshixPlanner, metric_weights
+from teachfit.trajectories.tshix import SearchTrajectory, TshixPlanner, metric_weights
 from teachfit.trajectories.tsp import open_tour
 
 
@@ -36,7 +40,7 @@ def _expl(dims: tuple[str, ...]) -> ExplorationDistribution:
     return ExplorationDistribution(dims, np.ones(1), mean[None], cov[None])
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--seed", type=int, default=0)
@@ -45,67 +49,111 @@ def main() -> None:
     ap.add_argument("--part", choices=("all", "tshix", "tsp"), default="all")
     ap.add_argument("--lkh-cache", help="JSON file keeping LKH's results (family table)")
     ap.add_argument("--only-lkh", action="store_true", help="only fill the LKH cache")
-    args = ap.parse_args()
+    add_markdown_option(ap)
+    args = ap.parse_args(argv)
+    markdown = checked_markdown(ap, args.markdown)
+    if markdown is not None and args.only_lkh and args.part != "tshix":
+        ap.exit(2, "error: --only-lkh makes no family table for --markdown: drop one of them\n")
     open_tour(np.random.default_rng(0).uniform(size=(20, 2)))  # compile the kernel first
+    sizes, tables = [int(v) for v in args.sizes.split(",")], []
     if args.part != "tsp":
-        tshix_speed(args.repeats, args.seed)
+        tables += tshix_speed(args.repeats, args.seed)
     if args.part != "tshix":
-        sizes = [int(v) for v in args.sizes.split(",")]
-        families(args.seed, sizes, args.instances, args.lkh_cache, args.only_lkh)
+        cells = families(args.seed, sizes, args.instances, args.lkh_cache, args.only_lkh)
+        if not args.only_lkh:
+            tables.append(families_markdown(cells, sizes, args.instances))
+    append_table(ap, markdown, "\n\n".join(tables))
 
 
-def tshix_speed(repeats: int, seed: int) -> None:
-    """TSHIX planning time and tour length vs LKH; ergodic trajectories of the same length."""
+#: the (D, N) of the TSHIX table's rows that ``--markdown`` writes (all are printed): the
+#: results page's table
+MARKDOWN_SIZES = {(2, 100), (2, 300), (2, 500), (3, 300)}
+
+
+def tshix_speed(repeats: int, seed: int) -> list[str]:
+    """TSHIX planning time and tour length vs LKH; ergodic trajectories of the same length.
+    Prints both tables as it goes; returns them as markdown (the TSHIX table's rows at
+    :data:`MARKDOWN_SIZES`)."""
     print("TSHIX wall time (median of", repeats, "runs), tour length vs LKH (elkai, RUNS=1)")
     print(
         f"{'dims':>6} {'N':>4} {'TSHIX [ms]':>11} {'TSP ours [ms]':>14} {'LKH [ms]':>9} "
         f"{'ratio med':>9} {'ratio max':>9}"
     )
-    lengths = {}
+    rows, lengths = [], {}
     for dims in (("x", "y"), ("x", "y", "rz")):
-        expl = _expl(dims)
-        planner = TshixPlanner(expl, speed=0.01)
-        w = metric_weights(dims, planner.length_scale)
+        planner = TshixPlanner(_expl(dims), speed=0.01)
         for n in (100, 200, 300, 400, 500):
-            t_plan, t_ours, t_lkh, ratios = [], [], [], []
-            for r in range(repeats):
-                rng = np.random.default_rng(seed + r)
-                t0 = time.perf_counter()
-                tr = planner.plan(n, rng)
-                t_plan.append(time.perf_counter() - t0)
-                t0 = time.perf_counter()
-                ours = open_tour(tr.samples, weights=w, rng=np.random.default_rng(r))
-                t_ours.append(time.perf_counter() - t0)
-                t0 = time.perf_counter()
-                ref = open_tour(tr.samples, weights=w, solver="lkh")
-                t_lkh.append(time.perf_counter() - t0)
-                ratios.append(ours.length / ref.length)
-                if n == 300 and r == 0:
-                    lengths[dims] = (tr, planner.length_scale)
-            print(
-                f"{len(dims):>6} {n:>4} {1e3 * np.median(t_plan):>11.1f} "
-                f"{1e3 * np.median(t_ours):>14.1f} {1e3 * np.median(t_lkh):>9.0f} "
-                f"{np.median(ratios):>9.4f} {np.max(ratios):>9.4f}"
-            )
+            row, tr = _tshix_row(planner, dims, n, repeats, seed)
+            if (len(dims), n) in MARKDOWN_SIZES:
+                rows.append(row)
+            if n == 300:
+                lengths[dims] = (tr, planner.length_scale)
+    title = (
+        "**TSHIX wall time (quasi-random sampling included) and tour length against LKH-3 "
+        f"(elkai, RUNS=1)**; median of {repeats} runs"
+    )
+    head = ("D", "N", "TSHIX total", "our TSP", "LKH (elkai)", "our tour / LKH tour (median / max)")
+    tables = [table(title, head, rows)]
     print("\nErgodic (SMC) trajectory of the TSHIX N=300 length")
-    for dims, (tr, ls) in lengths.items():
-        expl = _expl(dims)
-        length = tr.path_length(ls)
-        times = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            erg = ergodic_trajectory(expl, speed=0.01, length=length, length_scale=ls)
-            times.append(time.perf_counter() - t0)
-        e_tshix = ergodic_metric(tr.states, expl, t=tr.t)
+    rows = [_ergodic_row(dims, tr, ls, repeats) for dims, (tr, ls) in lengths.items()]
+    title = "**Ergodic (spectral multiscale coverage) trajectory of the TSHIX N = 300 length**"
+    opt = "optimised (`ergodic-opt`): metric, time, path longer by"
+    head = ("D", "time", "ergodic metric (TSHIX's)", opt)
+    return [*tables, table(title, head, rows)]
+
+
+def _tshix_row(
+    planner: TshixPlanner, dims: tuple[str, ...], n: int, repeats: int, seed: int
+) -> tuple[list[str], SearchTrajectory]:
+    """One size's medians (printed; returned as a markdown row) and the first run's plan."""
+    w = metric_weights(dims, planner.length_scale)
+    t_plan, t_ours, t_lkh, ratios, plans = [], [], [], [], []
+    for r in range(repeats):
+        rng = np.random.default_rng(seed + r)
         t0 = time.perf_counter()
-        opt = optimise_ergodic(erg, expl, speed=0.01)
-        t_opt = time.perf_counter() - t0
-        print(
-            f"  D={len(dims)} length {length:.3f} m: {np.median(times):.3f} s wall; "
-            f"ergodic metric: ergodic {erg.meta['ergodic_metric']:.4f}, TSHIX {e_tshix:.4f}; "
-            f"optimised {opt.meta['ergodic_metric']:.4f} in {t_opt:.2f} s "
-            f"(length {opt.path_length(ls):.3f} m)"
-        )
+        tr = planner.plan(n, rng)
+        t_plan.append(time.perf_counter() - t0)
+        plans.append(tr)
+        t0 = time.perf_counter()
+        ours = open_tour(tr.samples, weights=w, rng=np.random.default_rng(r))
+        t_ours.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        ref = open_tour(tr.samples, weights=w, solver="lkh")
+        t_lkh.append(time.perf_counter() - t0)
+        ratios.append(ours.length / ref.length)
+    plan, mine, lkh = (1e3 * float(np.median(v)) for v in (t_plan, t_ours, t_lkh))
+    med, top = float(np.median(ratios)), float(np.max(ratios))
+    print(f"{len(dims):>6} {n:>4} {plan:>11.1f} {mine:>14.1f} {lkh:>9.0f} {med:>9.4f} {top:>9.4f}")
+    row = [str(len(dims)), str(n), f"{plan:.1f} ms", f"{mine:.1f} ms", f"{lkh:.0f} ms"]
+    return [*row, f"{med:.3f} / {top:.3f}"], plans[0]
+
+
+def _ergodic_row(dims: tuple[str, ...], tr: SearchTrajectory, ls: float, repeats: int) -> list[str]:
+    """An ergodic trajectory of ``tr``'s length and its optimisation (printed; markdown row)."""
+    expl = _expl(dims)
+    length = tr.path_length(ls)
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        erg = ergodic_trajectory(expl, speed=0.01, length=length, length_scale=ls)
+        times.append(time.perf_counter() - t0)
+    e_tshix = ergodic_metric(tr.states, expl, t=tr.t)
+    t0 = time.perf_counter()
+    opt = optimise_ergodic(erg, expl, speed=0.01)
+    t_opt = time.perf_counter() - t0
+    e_erg, e_opt = erg.meta["ergodic_metric"], opt.meta["ergodic_metric"]
+    print(
+        f"  D={len(dims)} length {length:.3f} m: {np.median(times):.3f} s wall; "
+        f"ergodic metric: ergodic {e_erg:.4f}, TSHIX {e_tshix:.4f}; "
+        f"optimised {e_opt:.4f} in {t_opt:.2f} s (length {opt.path_length(ls):.3f} m)"
+    )
+    longer = 100 * (opt.path_length(ls) / length - 1)
+    return [
+        str(len(dims)),
+        f"{np.median(times):.3f} s",
+        f"{e_erg:.4f} ({e_tshix:.4f})",
+        f"{e_opt:.4f}, {t_opt:.1f} s, {longer:.0f} %",
+    ]
 
 
 def _points(family: str, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -144,38 +192,45 @@ def _lkh_cached(cache_file: str | None, key: str, pts: np.ndarray) -> tuple[floa
     return length, cpu
 
 
+#: a family table cell: our CPU seconds, LKH's CPU seconds, our length / LKH's, per instance
+Cell = tuple[list[float], list[float], list[float]]
+FAMILIES = {"uniform": "uniform", "gaussian": "Gaussian", "clustered": "clustered (8 clusters)"}
+
+
 def families(
     seed: int,
     sizes: list[int],
     instances: int = 3,
     lkh_cache: str | None = None,
     only_lkh: bool = False,
-) -> None:
+) -> dict[tuple[str, int], Cell]:
     """Open tours on uniform, Gaussian and clustered points: ours vs LKH-3 (elkai, RUNS=1).
 
     Per cell, ``instances`` seeded point sets (seed ``(seed, i, n)``); prints the median and
     max of our length / LKH's and the medians of both CPU times (ours: the least of three
-    calls on each instance, which a loaded machine disturbs least)."""
+    calls on each instance, which a loaded machine disturbs least); returns the cells by
+    (family, N)."""
     print(f"\nOpen tour on three point families ({instances} instances; CPU ms; length / LKH)")
     print(
         f"{'family':>10} {'N':>5} {'ours [ms]':>10} {'LKH [s]':>8} {'ratio med':>9} "
         f"{'ratio max':>9}"
     )
+    cells = {}
     for n in sizes:
-        for family in ("uniform", "gaussian", "clustered"):
-            t_ours, t_lkh, ratios = [], [], []
+        for family in FAMILIES:
+            t_ours, t_lkh, ratios = cells[family, n] = [], [], []
             for i in range(instances):
                 pts = _points(family, n, np.random.default_rng((seed, i, n)))
                 ref, cpu = _lkh_cached(lkh_cache, f"{family}/{n}/{seed}/{i}", pts)
                 t_lkh.append(cpu)
                 if only_lkh:
                     continue
-                cpu = []
+                cpus = []
                 for _ in range(3):  # the same tour each time: the least CPU time of three
                     t0 = time.process_time()
                     ours = open_tour(pts)
-                    cpu.append(time.process_time() - t0)
-                t_ours.append(min(cpu))
+                    cpus.append(time.process_time() - t0)
+                t_ours.append(min(cpus))
                 ratios.append(ours.length / ref)
             if only_lkh:
                 print(f"{family:>10} {n:>5} {'':>10} {np.median(t_lkh):>8.1f}", flush=True)
@@ -185,6 +240,38 @@ def families(
                 f"{np.median(t_lkh):>8.1f} {np.median(ratios):>9.4f} {np.max(ratios):>9.4f}",
                 flush=True,
             )
+    return cells
+
+
+def _seconds(t: float) -> str:
+    return f"{1e3 * t:.0f} ms" if t < 1 else f"{t:.1f} s"
+
+
+def _lkh_range(medians: list[float]) -> str:
+    """LKH's median CPU seconds over the families: one figure, or the range."""
+    lo, hi = (f"{v:.1f}" if v < 10 else f"{v:.0f}" for v in (min(medians), max(medians)))
+    return f"{lo} s" if lo == hi else f"{lo}-{hi} s"
+
+
+def families_markdown(cells: dict[tuple[str, int], Cell], sizes: list[int], instances: int) -> str:
+    """The family table: a row per family (ratio median (max), our CPU time), a column per
+    N, and a last row of LKH's CPU time."""
+    rows = []
+    for family, label in FAMILIES.items():
+        row = [label]
+        for n in sizes:
+            t_ours, _, ratios = cells[family, n]
+            spread = f" ({max(ratios):.4f})" if len(ratios) > 1 else ""
+            row.append(f"{np.median(ratios):.4f}{spread}, {_seconds(float(np.median(t_ours)))}")
+        rows.append(row)
+    lkh = [_lkh_range([float(np.median(cells[f, n][1])) for f in FAMILIES]) for n in sizes]
+    rows.append(["LKH-3 CPU (median)", *lkh])
+    title = (
+        f"**Open tour on three point families** ({instances} seeded instances per cell; ours / "
+        "LKH-3 length, median (max); ours: CPU time, least of three calls, median over instances)"
+    )
+    head = ["points", *(f"N = {n}" if i == 0 else str(n) for i, n in enumerate(sizes))]
+    return table(title, head, rows)
 
 
 if __name__ == "__main__":

@@ -49,6 +49,13 @@ def test_one_run_writes_one_header_per_file_and_blocks_split_at_headers(tmp_path
     assert p.command == pv.command_line()
 
 
+def test_a_script_s_command_line_is_what_was_typed(monkeypatch) -> None:
+    monkeypatch.setattr("sys.argv", ["benchmarks/search_speed.py", "--sizes", "100,300", "a b"])
+    assert pv.command_line() == "python benchmarks/search_speed.py --sizes 100,300 'a b'"
+    monkeypatch.setattr("sys.argv", ["/venv/bin/teachfit", "bench", "sim"])
+    assert pv.command_line() == "teachfit bench sim"
+
+
 def _git(root: Path, *args: str) -> str:
     env = {"GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@x", "GIT_COMMITTER_NAME": "t",
            "GIT_COMMITTER_EMAIL": "t@x", "PATH": "/usr/bin:/bin"}  # fmt: skip

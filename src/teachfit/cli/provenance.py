@@ -87,12 +87,15 @@ def new_run() -> None:
 
 
 def command_line() -> str:
-    """The command line as typed (``teachfit ...``); run otherwise (a script, a test runner),
-    the process's own arguments."""
+    """The command line as typed: ``teachfit ...``, a Python script run by its path (one in
+    ``benchmarks/``) as ``python SCRIPT ...``; run otherwise (a test runner), the process's own
+    arguments."""
     argv = sys.argv
     prog = Path(argv[0]) if argv else Path()
     if prog.name == "teachfit" or prog.parts[-2:] == ("teachfit", "__main__.py"):
         return shlex.join(["teachfit", *argv[1:]])
+    if prog.suffix == ".py" and prog.name != "__main__.py":
+        return shlex.join(["python", *argv])
     return shlex.join(argv)
 
 
