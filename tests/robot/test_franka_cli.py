@@ -28,3 +28,17 @@ def test_bench_robot_reports_tick_percentiles(franka_sim: object) -> None:
     assert res.exit_code == 0, res.output
     text = " ".join(res.output.split())
     assert "ticks: 500" in text and "p50" in text and "p99" in text and "missed deadlines" in text
+
+
+def test_assemble_runs_its_trials_on_the_arm_one_at_a_time(franka_sim: object) -> None:
+    arm = ["--robot", "franka", "--host", "127.0.0.1", "--no-realtime"]
+    res = CliRunner().invoke(
+        app, ["assemble", "--task", "peg2d", "--trials", "2", *arm, "--workers", "2"]
+    )
+    assert res.exit_code == 2 and "one at a time" in res.output
+    res = CliRunner().invoke(
+        app, ["assemble", "--task", "peg2d", "--trials", "1", "--hole-error", "0mm", *arm]
+    )
+    assert res.exit_code in (0, 1), res.output  # 1: the arm stopped the trial (printed)
+    assert "peg2d: peg-in-hole alone (no --search)" in res.output
+    assert "1/1" in res.output or "0/1" in res.output

@@ -13,7 +13,16 @@ import typer
 from rich.table import Table
 
 from teachfit.cli import options as o
-from teachfit.cli.common import RobotOpt, append_markdown, console, guarded
+from teachfit.cli.common import (
+    ConfirmOpt,
+    HostOpt,
+    RealtimeOpt,
+    RobotOpt,
+    append_markdown,
+    console,
+    guarded,
+    robot_options,
+)
 from teachfit.cli.progress import progress_bar
 from teachfit.cli.recording import LogOpt, RrdOpt, check_recording_targets, write_recordings
 from teachfit.cli.run_end import end_run, exit_if_faulted, report_faults
@@ -78,6 +87,9 @@ def assemble(
         Path | None, typer.Option("--render", help="video (mp4) of that trial")
     ] = None,
     robot: RobotOpt = "floating",
+    host: HostOpt = None,
+    realtime: RealtimeOpt = True,
+    confirm: ConfirmOpt = False,
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
@@ -85,7 +97,7 @@ def assemble(
 
     Exit status 1 when the robot stopped a trial (each reason is printed); a run cut short
     (Ctrl-C) prints and logs the trials that finished; see the README."""
-    from teachfit.execution.assembly import run_assembly_job
+    from teachfit.execution.assembly import close_robots, run_assembly_job
     from teachfit.execution.assembly_run import PLANNED_PARTS, assembly_setup, shown_trial
 
     err, yaw, task_name = _checked(task, demo, hole_error, yaw_error, robot)
@@ -96,15 +108,22 @@ def assemble(
                "angle_error": angle_error, "trials": trials, "seed": seed})  # fmt: skip
         _assemble_plan(task, demo, err, ang, trials, seed, plot, render, rec)
         return
+    arm = tuple(robot_options(host, realtime, confirm).items())
+    if arm and workers:
+        raise TeachfitError("--workers: a real robot runs its trials one at a time: leave it out")
     model, method, jobs = assembly_setup(
         (task, task_name), search, skill, params, controller, err, trials, seed=seed,
         yaw_error=yaw, robot=robot, keep_log=any(v is not None for v in (plot, render, log, rrd)),
+        robot_options=arm,
     )  # fmt: skip
     what = "skill with learned-search recovery" if model else f"{skill} alone (no --search)"
     console.print(f"{task}: {what}; taught hole off by {err * 1e3:g} mm; {trials} trial(s)")
     with progress_bar() as bar:
         job = bar.add_task("assembling", total=len(jobs))
-        finished = run_batch_keeping(run_assembly_job, jobs, workers, lambda: bar.advance(job))
+        try:
+            finished = run_batch_keeping(run_assembly_job, jobs, workers, lambda: bar.advance(job))
+        finally:
+            close_robots()  # a real arm's connection; simulated ones are rebuilt when needed
     out = finished.items
     if not out:
         console.print("no trial finished")

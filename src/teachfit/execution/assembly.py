@@ -27,6 +27,7 @@ import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache, partial
+from typing import Any
 
 import numpy as np
 
@@ -153,6 +154,8 @@ class AssemblyJob:
     learned: tuple[tuple[str, float], ...] = ()
     robot: str = "floating"
     keep_log: bool = False
+    #: a real robot's options, e.g. ``(("host", "127.0.0.1"), ("realtime", False))``
+    robot_options: tuple[tuple[str, Any], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -178,9 +181,27 @@ def _task(name: str, overrides: tuple[tuple[str, float], ...]) -> Task:
     return get_task(name, **dict(overrides))
 
 
-@cache
-def _robot(name: str, overrides: tuple[tuple[str, float], ...], robot: str) -> Robot:
-    return make_robot(robot, _task(name, overrides), seed=0)
+#: the robots this process built for its trials, by task, overrides, robot and its options
+_ROBOTS: dict[tuple[Any, ...], Robot] = {}
+
+
+def _robot(
+    name: str,
+    overrides: tuple[tuple[str, float], ...],
+    robot: str,
+    options: tuple[tuple[str, Any], ...] = (),
+) -> Robot:
+    key = (name, overrides, robot, options)
+    if key not in _ROBOTS:
+        _ROBOTS[key] = make_robot(robot, _task(name, overrides), seed=0, **dict(options))
+    return _ROBOTS[key]
+
+
+def close_robots() -> None:
+    """Close the robots this process built for its trials (a real arm's connection) and
+    forget them."""
+    while _ROBOTS:
+        _ROBOTS.popitem()[1].close()
 
 
 @cache
@@ -191,7 +212,7 @@ def _model(doc: str) -> SearchModel | None:
 def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
     """Run one trial in this process (task, robot and model cached per process)."""
     task = _task(job.task, job.overrides)
-    robot = _robot(job.task, job.overrides, job.robot)
+    robot = _robot(job.task, job.overrides, job.robot, job.robot_options)
     rng = episode_rng(job.seed, job.index)
     taught = taught_hole(task, job.hole_error, job.yaw_error, rng)
     ctx = peg_in_hole.hole_context(task, rng)
@@ -249,6 +270,7 @@ def assembly_jobs(
     learned: tuple[tuple[str, float], ...] = (),
     robot: str = "floating",
     keep_log: bool = False,
+    robot_options: tuple[tuple[str, Any], ...] = (),
 ) -> list[AssemblyJob]:
     """Jobs for every method x hole error x trial (trial ``i`` is the same for all methods);
     the keyword arguments are the :class:`AssemblyJob` fields of the same names."""
@@ -273,6 +295,7 @@ def assembly_jobs(
             learned=learned,
             robot=robot,
             keep_log=keep_log,
+            robot_options=robot_options,
         )  # fmt: skip
         for m in methods
         for e in hole_errors

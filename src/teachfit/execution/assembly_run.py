@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -45,6 +45,7 @@ def assembly_setup(
     yaw_error: float,
     robot: str,
     keep_log: bool,
+    robot_options: tuple[tuple[str, Any], ...] = (),
 ) -> tuple[SearchModel | None, str, list[AssemblyJob]]:
     """The search model, the method (``"joined"`` with a model, else ``"skill"``) and the jobs
     of ``assemble``'s trials (fields of :class:`~teachfit.execution.assembly.AssemblyJob`);
@@ -65,7 +66,7 @@ def assembly_setup(
     jobs = assembly_jobs(
         task[0], [method], [hole_error], trials, model, seed=seed, yaw_error=yaw_error,
         skill=skill, controller=controller, learned=tuple(sorted(learned.items())), robot=robot,
-        keep_log=keep_log,
+        keep_log=keep_log, robot_options=robot_options,
     )  # fmt: skip
     return model, method, jobs
 
