@@ -56,15 +56,17 @@ def test_bad_options_fail_in_one_line_before_any_run(
 
 def test_tasks_suite_writes_the_chosen_parts_and_refuses_an_unknown_one(tmp_path: Path) -> None:
     res = CliRunner().invoke(
-        app, ["tasks", "suite", str(tmp_path / "s"), "--parts", "round8-sharp-through"]
-    )
+        app,
+        ["tasks", "suite", str(tmp_path / "s"), "--parts", "round8-sharp-through",
+         "--clearance", "0.029"],
+    )  # fmt: skip
     assert res.exit_code == 0, res.output
     names = sorted(p.name for p in (tmp_path / "s").iterdir())
     assert names == [
         "round8-sharp-through-peg.stl", "round8-sharp-through-plate.stl",
         "round8-sharp-through.toml",
     ]  # fmt: skip
-    assert "H7/g6 5-29 um, simulated 0.2 mm" in res.output
+    assert "H7/g6 5-29 um, simulated 0.029 mm" in res.output
     bad = CliRunner().invoke(app, ["tasks", "suite", str(tmp_path / "t"), "--parts", "hexagon"])
     assert bad.exit_code == 2 and "unknown suite part" in bad.output
     assert not (tmp_path / "t").exists()

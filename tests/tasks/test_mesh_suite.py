@@ -47,10 +47,21 @@ def test_iso_286_h7_g6_clearances_of_the_nominal_ranges() -> None:
         suite.iso_clearance(25.0)
 
 
-def test_write_suite_refuses_an_unknown_part_before_writing(tmp_path: Path) -> None:
+def test_write_suite_refuses_an_unknown_part_or_a_bad_clearance_before_writing(
+    tmp_path: Path,
+) -> None:
     with pytest.raises(TaskError, match="unknown suite part"):
         suite.write_suite(tmp_path / "out", ["round8-sharp-through", "hexagon"])
+    for bad in (0.0, -0.1, 2.0):
+        with pytest.raises(TaskError, match="give a diametral clearance in"):
+            suite.write_suite(tmp_path / "out", clearance=bad)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_part_at_an_iso_fit_s_clearance() -> None:
+    part = suite.PARTS["round8-sharp-through"].at_clearance(0.029)
+    assert suite.peg(part).extents[:2] == pytest.approx([7.971, 7.971], abs=1e-3)
+    assert "simulated 0.029 mm" in part.describe()
 
 
 @pytest.mark.parametrize("name", ["round12-chamfer-blind", "rect12x8-sharp-through"])

@@ -47,6 +47,7 @@ def bench_parts(
     train_setups: Annotated[
         int, typer.Option(min=1, help="training set-ups per learning trial")
     ] = 4,
+    clearance: o.SuiteClearance = 0.2,
     seed: Annotated[int, o.seed("set-ups, starts, demonstrations and trials")] = 0,
     workers: o.Workers = 0,
     markdown: o.Markdown = None,
@@ -71,10 +72,11 @@ def bench_parts(
         _check_figure(plot)
     title = (
         f"parts suite ({setups} held-out set-ups, {trials} learning trials on {train_setups} "
-        f"set-ups, {starts} search starts / assemble trials, seed {seed})"
+        f"set-ups, {starts} search starts / assemble trials, {clearance:g} mm clearance, "
+        f"seed {seed})"
     )
     with tempfile.TemporaryDirectory(prefix="teachfit-parts-") as folder:
-        tasks = dict(zip(chosen, write_suite(folder, chosen), strict=True))
+        tasks = dict(zip(chosen, write_suite(folder, chosen, clearance), strict=True))
         rows = _run(tasks, robot_list, sizes, seed, method_list)
     _report(rows, title, markdown, plot)
 

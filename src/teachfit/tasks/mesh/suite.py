@@ -19,8 +19,9 @@ resolves -- the contact model gives about 0.1 mm of soft-contact penetration
 and the exact bore decomposition widens a bore by up to 0.02 mm per side
 (:mod:`teachfit.tasks.mesh.revolved`). Every part is therefore built with
 :data:`SIM_CLEARANCE` (0.2 mm diametral, 0.1 mm per side, as the ``round-peg`` example) in
-place of its ISO fit; :func:`iso_clearance` gives the fit the part stands for, and the part's
-name says the simulated clearance is what is run. The peg is made at its nominal size minus
+place of its ISO fit by default; :func:`iso_clearance` gives the fit the part stands for, and
+:func:`write_suite` builds the suite at any other clearance (``--clearance``), e.g. an ISO
+fit's largest, to measure what the simulation makes of it. The peg is made at its nominal size minus
 the clearance, the hole at the nominal size plus nothing (H: lower deviation 0).
 
 Chamfers: a chamfered round part has a 0.5 mm x 45 degree chamfer on the peg's tip and the
@@ -31,7 +32,7 @@ take it closes a 0.1 mm clearance). Lengths in millimetres.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import manifold3d
@@ -52,6 +53,7 @@ ISO286: dict[tuple[float, float], tuple[int, int, int, int]] = {
 }
 #: the diametral clearance (mm) every suite part is built with instead of its ISO fit
 SIM_CLEARANCE = 0.2
+MAX_CLEARANCE = 1.0  # mm: above it the pegs no longer stand for a fit
 CHAMFER = 0.5  # mm, 45 degrees
 PEG_LENGTH = 30.0
 PLATE_THICKNESS = 15.0
@@ -70,6 +72,11 @@ class Part:
     height: float = 0.0
     chamfered: bool = False
     through: bool = True
+    clearance: float = SIM_CLEARANCE  # diametral, mm
+
+    def at_clearance(self, clearance: float) -> Part:
+        """This part with another diametral clearance (mm), e.g. an ISO fit's."""
+        return replace(self, clearance=clearance)
 
     @property
     def round(self) -> bool:
@@ -82,9 +89,9 @@ class Part:
 
     @property
     def peg_size(self) -> tuple[float, float]:
-        """The peg's cross-section (mm): the nominal size less :data:`SIM_CLEARANCE`."""
+        """The peg's cross-section (mm): the nominal size less the clearance."""
         w, h = self.hole_size
-        return (w - SIM_CLEARANCE, h - SIM_CLEARANCE)
+        return (w - self.clearance, h - self.clearance)
 
     def describe(self) -> str:
         shape = f"{self.width:g} mm round" if self.round else f"{self.width:g}x{self.height:g} mm"
@@ -92,7 +99,7 @@ class Part:
         return (
             f"{shape} peg, {'chamfered' if self.chamfered else 'sharp'}, "
             f"{'through' if self.through else 'blind'} hole; H7/g6 {lo * 1e3:.0f}-{hi * 1e3:.0f}"
-            f" um, simulated {SIM_CLEARANCE:g} mm"
+            f" um, simulated {self.clearance:g} mm"
         )
 
 
@@ -180,20 +187,28 @@ def part_spec(name: str, folder: Path) -> MeshTaskSpec:
     )
 
 
-def write_suite(folder: str | Path, names: list[str] | None = None) -> list[Path]:
+def write_suite(
+    folder: str | Path, names: list[str] | None = None, clearance: float = SIM_CLEARANCE
+) -> list[Path]:
     """Write every suite part's (or those in ``names``) two STL meshes (mm) and task file into
-    ``folder``, each file atomically; return the task files' paths. Unknown names fail before
-    anything is written."""
+    ``folder``, each file atomically, the pegs ``clearance`` (diametral, mm) smaller than the
+    holes; return the task files' paths. Bad input fails before anything is written."""
     chosen = list(PARTS) if names is None else names
     bad = [n for n in chosen if n not in PARTS]
     if bad:
         raise TaskError(f"unknown suite part(s) {', '.join(bad)}; parts: {', '.join(PARTS)}")
-    out = []
-    for name in chosen:
-        spec = part_spec(name, Path(folder))
-        held, fixed = meshes(name)
-        write_atomic(spec.held_mesh, stl_bytes(held))
-        write_atomic(spec.fixed_mesh, stl_bytes(fixed))
-        write_atomic(spec.path, spec_to_toml(spec).encode())
-        out.append(spec.path)
-    return out
+    if not 0.0 < clearance <= MAX_CLEARANCE:
+        raise TaskError(
+            f"clearance {clearance:g} mm: give a diametral clearance in (0, {MAX_CLEARANCE:g}] mm"
+        )
+    return [write_part(PARTS[name].at_clearance(clearance), folder) for name in chosen]
+
+
+def write_part(part: Part, folder: str | Path) -> Path:
+    """Write ``part``'s two STL meshes (mm) and task file into ``folder`` (each atomically);
+    return the task file's path."""
+    spec = part_spec(part.name, Path(folder))
+    write_atomic(spec.held_mesh, stl_bytes(peg(part)))
+    write_atomic(spec.fixed_mesh, stl_bytes(plate(part)))
+    write_atomic(spec.path, spec_to_toml(spec).encode())
+    return spec.path
