@@ -20,7 +20,8 @@ def test_bench_parts_prints_a_row_per_method_with_its_interval(
 
     def fake(part, task, robot, sizes, seed=0, methods=bp.METHODS, progress=None):  # noqa: ANN001, ANN202
         seen.append((part, Path(task).is_file(), robot, sizes))
-        return [bp.PartRow(part, robot, m, summarize([True, False], [1.5, 0.0])) for m in methods]
+        s = summarize([True, False], [1.5, 0.0])
+        return [bp.PartRow(part, robot, m, s, ("error-condition: stuck",)) for m in methods]
 
     monkeypatch.setattr(bp, "bench_part", fake)
     md, png = tmp_path / "parts.md", tmp_path / "parts.png"
@@ -34,7 +35,7 @@ def test_bench_parts_prints_a_row_per_method_with_its_interval(
     assert seen == [("round8-sharp-through", True, "floating", bp.Sizes(2, 3, 4, 1))]
     rows = [line for line in md.read_text().splitlines() if line.startswith("| round8")]
     assert [r.split(" | ")[2] for r in rows] == list(bp.METHODS)
-    assert all("1/2 = 50 % [9, 91]" in r for r in rows)
+    assert all("1/2 = 50 % [9, 91] | 1.5 s | 1x error-condition: stuck |" in r for r in rows)
     assert "missed on round8-sharp-through/floating/skill" in res.output
     assert png.is_file()
 

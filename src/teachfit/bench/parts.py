@@ -23,6 +23,7 @@ Goal (a benchmark, not a test): every row at or above :data:`GOAL`.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -68,12 +69,32 @@ class Sizes:
 
 @dataclass(frozen=True)
 class PartRow:
-    """One method on one part and robot."""
+    """One method on one part and robot; ``failures`` each failed execution's outcome and
+    reason."""
 
     part: str
     robot: str
     method: str
     summary: SuccessSummary
+    failures: tuple[str, ...] = ()
+
+    def commonest_failure(self) -> str:
+        """The most frequent failure reason with its count (``""`` without failures)."""
+        if not self.failures:
+            return ""
+        (why, n), *_ = Counter(self.failures).most_common(1)
+        return f"{n}x {why}"
+
+
+#: a batch's summary and its failures' reasons
+Batch = tuple[SuccessSummary, tuple[str, ...]]
+
+
+def _batch(runs: Sequence[tuple[bool, str]], times: Sequence[float] | None = None) -> Batch:
+    """A batch of ``(success, reason)`` executions (times of insertion in s, NaN: none)."""
+    oks = [ok for ok, _ in runs]
+    summary = summarize(oks, list(times) if times is not None else [math.nan] * len(oks))
+    return summary, tuple(why for ok, why in runs if not ok)
 
 
 def check_choice(given: Sequence[str], known: Sequence[str], what: str) -> list[str]:
@@ -84,41 +105,32 @@ def check_choice(given: Sequence[str], known: Sequence[str], what: str) -> list[
     return list(given)
 
 
-def _outcomes(oks: Sequence[bool]) -> SuccessSummary:
-    return summarize(list(oks), [math.nan] * len(oks))
-
-
 def _skill_rows(
     task: str, robot: str, sizes: Sizes, seed: int, learned: bool, progress: Progress
-) -> dict[str, SuccessSummary]:
+) -> dict[str, Batch]:
     """``skill`` (default parameters) and, with ``learned``, ``skill-learned`` on the same
     held-out set-ups."""
     from teachfit.bench.learning import run_experiment
     from teachfit.learning.objective import SkillObjective
 
-    tick = progress or (lambda: None)
     out = {}
     plain = SkillObjective(task, seed=seed, n_starts=1, robot=robot)
-    out["skill"] = _outcomes(plain.held_out(None, sizes.setups))
-    for _ in range(sizes.setups):
-        tick()
+    out["skill"] = _batch(plain.held_out_runs(None, sizes.setups, progress))
     if learned:
         obj = SkillObjective(task, seed=seed, n_starts=1, robot=robot, setups=sizes.train_setups)
-        exp = run_experiment(
-            obj, sizes.learner, sizes.trials, workers=sizes.workers, on_trial=lambda _r: tick()
-        )
-        out["skill-learned"] = _outcomes(obj.held_out(exp.best_params, sizes.setups))
-        for _ in range(sizes.setups):
-            tick()
+        tick = (lambda _r: progress()) if progress is not None else None
+        exp = run_experiment(obj, sizes.learner, sizes.trials, workers=sizes.workers, on_trial=tick)
+        out["skill-learned"] = _batch(obj.held_out_runs(exp.best_params, sizes.setups, progress))
     return out
 
 
 def _search_rows(
     task: str, robot: str, sizes: Sizes, seed: int, methods: Sequence[str], progress: Progress
-) -> dict[str, SuccessSummary]:
+) -> dict[str, Batch]:
     """``search`` and ``assemble`` with one search model learned from the blind teacher."""
     from teachfit.bench import search as bs
-    from teachfit.bench.search_task import task_demos, task_table
+    from teachfit.bench.search_jobs import run_jobs
+    from teachfit.bench.search_task import task_demos, task_jobs
     from teachfit.execution.assembly import assembly_jobs, run_assembly
     from teachfit.models.search_model import SearchModel
 
@@ -126,16 +138,17 @@ def _search_rows(
     demos = task_demos(task, seed)
     out = {}
     if "search" in methods:
-        rows = task_table(
-            task, demos, seed, sizes.starts, sizes.points, sizes.workers, progress, False
-        )
-        out["search"] = rows[0].ours
+        searches = task_jobs(task, demos, seed, sizes.starts, sizes.points)
+        res = run_jobs(searches, sizes.workers, progress)
+        times = [r.time_to_insertion for r in res]
+        out["search"] = _batch([(r.success, r.reason) for r in res], times)
     if "assemble" in methods:
         model = SearchModel.fit(list(demos), demos[0].task)
         jobs = assembly_jobs(task, ["joined"], [HOLE_ERROR], sizes.starts, model, seed=seed,
                              robot=robot)  # fmt: skip
         trials = run_assembly(jobs, sizes.workers, progress)
-        out["assemble"] = summarize([t.success for t in trials], [t.time for t in trials])
+        runs = [(t.success, t.reason) for t in trials]
+        out["assemble"] = _batch(runs, [t.time for t in trials])
     return out
 
 
@@ -150,12 +163,12 @@ def bench_part(
 ) -> list[PartRow]:
     """The rows of ``methods`` on one part's task file ``task`` and ``robot``."""
     spec = str(task)
-    got: dict[str, SuccessSummary] = {}
+    got: dict[str, Batch] = {}
     if "skill" in methods or "skill-learned" in methods:
         got |= _skill_rows(spec, robot, sizes, seed, "skill-learned" in methods, progress)
     if "search" in methods or "assemble" in methods:
         got |= _search_rows(spec, robot, sizes, seed, methods, progress)
-    return [PartRow(part, robot, m, got[m]) for m in methods]
+    return [PartRow(part, robot, m, *got[m]) for m in methods]
 
 
 def run_parts(

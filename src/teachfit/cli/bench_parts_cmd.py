@@ -18,14 +18,17 @@ from teachfit.core.errors import TeachfitError
 if TYPE_CHECKING:
     from teachfit.bench.parts import PartRow
 
-_COLS = ("part", "robot", "method", "success [Wilson 95 %]", "median time")
+_COLS = ("part", "robot", "method", "success [Wilson 95 %]", "median time", "commonest failure")
 
 
 def _cells(r: PartRow) -> list[str]:
     from teachfit.bench.parts import rate_cell
 
     t = r.summary.median_time
-    return [r.part, r.robot, r.method, rate_cell(r.summary), "n/a" if t != t else f"{t:.1f} s"]
+    why = r.commonest_failure().replace("|", "/")
+    why = why if len(why) <= 80 else why[:79] + "…"
+    time = "n/a" if t != t else f"{t:.1f} s"
+    return [r.part, r.robot, r.method, rate_cell(r.summary), time, why]
 
 
 def _split(text: str) -> list[str]:
