@@ -29,7 +29,7 @@ def parts_figure(cells: Sequence[Cell], title: str = "", goal: float | None = 0.
     methods = list(dict.fromkeys(c[1] for c in cells))
     by = {(c[0], c[1], c[2]): c[3] for c in cells}
     width = 0.8 / max(len(series), 1)
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.6 * len(parts) + 2.0), 4.2), layout="constrained")
+    fig, ax = plt.subplots(figsize=(max(7.0, 1.6 * len(parts) + 3.5), 4.2), layout="constrained")
     colors = plt.get_cmap("tab10")
     for j, (method, robot) in enumerate(series):
         xs, rate, err = [], [], []
@@ -50,7 +50,7 @@ def parts_figure(cells: Sequence[Cell], title: str = "", goal: float | None = 0.
     ax.set_xticks(range(len(parts)), parts, rotation=15, fontsize=8)
     ax.set_ylim(0, 105)
     ax.set_ylabel("success (%), Wilson 95 % interval")
-    ax.legend(fontsize=7, ncols=2, loc="lower left")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.set_title(textwrap.fill(title, 100), fontsize=8)
     return fig
 
