@@ -32,7 +32,7 @@ def test_bench_parts_prints_a_row_per_method_with_its_interval(
     ]  # fmt: skip
     res = CliRunner().invoke(app, args, env={"COLUMNS": "200"})
     assert res.exit_code == 0, res.output
-    assert seen == [("round8-sharp-through", True, "floating", bp.Sizes(2, 3, 4, 1))]
+    assert seen == [("round8-sharp-through", True, "floating", bp.Sizes(2, 3, 4, 1, workers=None))]
     rows = [line for line in md.read_text().splitlines() if line.startswith("| round8")]
     assert [r.split(" | ")[2] for r in rows] == list(bp.METHODS)
     assert all("1/2 = 50 % [9, 91] | 1.5 s | 1x error-condition: stuck |" in r for r in rows)

@@ -52,7 +52,7 @@ def bench_parts(
     ] = 4,
     clearance: o.SuiteClearance = 0.2,
     seed: Annotated[int, o.seed("set-ups, starts, demonstrations and trials")] = 0,
-    workers: o.Workers = 0,
+    workers: o.Workers = None,
     markdown: o.Markdown = None,
     plot: Annotated[
         Path | None, o.plot("success per part x method x robot (Wilson 95 % intervals)")
