@@ -20,10 +20,10 @@ Simulated clearance: an H7/g6 clearance (2.5-17.5 um per side) is below what the
 resolves. The aligned peg does enter at 5 um (the cell checks pass), but soft contact lets a
 peg pushed sideways with 5-20 N sink 1-15 um into the wall, as much as the fit's clearance
 itself: measured by ``benchmarks/parts_clearance.py``, an 8 mm peg at H7/g6's smallest
-clearance (2.5 um per side) feels 3.9-6.7 um, 1.6-2.7x, a 12 x 8 mm one 2.4-6.8x; at the
-suite's 0.1 mm per side the error is 4-15 %. The exact bore decomposition also widens a bore
-by up to 0.02 mm per side (:mod:`teachfit.tasks.mesh.revolved`). Every part is therefore
-built with
+clearance (2.5 um per side) feels 3.9-6.7 um (1.5-2.7x), a 12 x 8 mm one at 3 um feels
+6.6-17.5 um (2.2-5.8x); at the suite's 0.1 mm per side the error is 4-15 %. The exact bore
+decomposition also widens a bore by up to 0.02 mm per side
+(:mod:`teachfit.tasks.mesh.revolved`). Every part is therefore built with
 :data:`SIM_CLEARANCE` (0.2 mm diametral, 0.1 mm per side, as the ``round-peg`` example) in
 place of its ISO fit by default; :func:`iso_clearance` gives the fit the part stands for, and
 :func:`write_suite` builds the suite at any other clearance (``--clearance``), e.g. an ISO
