@@ -26,6 +26,19 @@ def test_the_default_skill_runs_on_held_out_setups_of_a_suite_part(tmp_path: Pat
     assert len(ticks) == bp.Sizes(setups=1).units(["skill"]) == 1
 
 
+def test_search_and_assemble_run_on_the_robot_asked_for(tmp_path: Path) -> None:
+    from teachfit.bench import search as bs
+
+    (task,) = write_suite(tmp_path, ["round12-chamfer-blind"])
+    sizes = bp.Sizes(starts=1, points=50)
+    rows = bp.bench_part("round12", task, "fr3", sizes, methods=["search", "assemble"])
+    assert [(r.robot, r.method, r.summary.trials) for r in rows] == [
+        ("fr3", "search", 1), ("fr3", "assemble", 1)
+    ]  # fmt: skip
+    assert all(len(r.failures) == 1 - r.summary.successes for r in rows)
+    assert bs.ROBOT[0] == "floating"  # the search benches' robot is left as it was
+
+
 def test_sizes_below_one_are_refused() -> None:
     with pytest.raises(TeachfitError, match="--train-setups must be >= 1"):
         bp.Sizes(train_setups=0)

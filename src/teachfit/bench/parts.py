@@ -134,11 +134,15 @@ def _search_rows(
     from teachfit.execution.assembly import assembly_jobs, run_assembly
     from teachfit.models.search_model import SearchModel
 
-    bs.use_robot(robot)
-    demos = task_demos(task, seed)
+    before = bs.ROBOT[0]
+    bs.use_robot(robot)  # the teacher's and the search jobs' robot
+    try:
+        demos = task_demos(task, seed)
+        searches = task_jobs(task, demos, seed, sizes.starts, sizes.points)
+    finally:
+        bs.use_robot(before)
     out = {}
     if "search" in methods:
-        searches = task_jobs(task, demos, seed, sizes.starts, sizes.points)
         res = run_jobs(searches, sizes.workers, progress)
         times = [r.time_to_insertion for r in res]
         out["search"] = _batch([(r.success, r.reason) for r in res], times)
