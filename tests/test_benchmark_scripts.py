@@ -118,3 +118,14 @@ def test_search_speed_s_tshix_table_keeps_the_page_s_rows(monkeypatch) -> None:
         "| 2 | 100 |", "| 2 | 300 |", "| 2 | 500 |", "| 3 | 300 |"
     ]  # fmt: skip
     assert ergodic.splitlines()[-2:] == ["| 2 | 300 |", "| 3 | 300 |"]
+
+
+def test_parts_clearance_appends_one_row_per_fit(monkeypatch, capsys, tmp_path) -> None:
+    body = _check(
+        monkeypatch, capsys, tmp_path, "parts_clearance", ["--parts", "round8-sharp-through"]
+    )
+    rows = [line for line in body.splitlines() if line.startswith("| round8")]
+    assert [r.split(" | ")[1] for r in rows] == [
+        "H7/g6 smallest (5 um)", "H7/g6 largest (29 um)", "suite (200 um)"
+    ]  # fmt: skip
+    assert all(r.split(" | ")[2] in ("2.5 um", "14.5 um", "100.0 um") for r in rows)

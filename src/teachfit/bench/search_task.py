@@ -10,11 +10,12 @@ the paper ran only its own parts.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from teachfit.bench.search import ROBOT, Progress, Row, _jobs, _row
-from teachfit.bench.search_jobs import run_jobs
+from teachfit.bench.search_jobs import SearchJob, run_jobs
 from teachfit.core.errors import TeachfitError
 from teachfit.demonstrations.dataset import Demonstration
 from teachfit.execution.batch import episode_seed
@@ -39,6 +40,23 @@ def task_demos(
     return demos
 
 
+def task_jobs(
+    task_spec: str, demos: Sequence[Demonstration], seed: int, n_starts: int, n_points: int
+) -> list[SearchJob]:
+    """The TSHIX jobs of the protocol's ``n_starts`` starts (see the module docstring): the
+    ``tshix`` row of :func:`task_table` (:func:`~teachfit.bench.search_jobs.run_jobs`)."""
+    task = load_task(task_spec)
+    if any(d.task != task.name for d in demos):
+        raise TeachfitError(f"the demonstrations are not all of task {task.name!r}")
+    model = SearchModel.fit(list(demos), task.name)
+    rng = np.random.default_rng(seed + 1)
+    names = task.protocol.names
+    protocol = "table1" if "table1" in names else "teacher"
+    starts = task.protocol.protocol_starts(protocol, n_starts, rng, demos[0].start_pose)
+    seeds = [episode_seed(seed, i) for i in range(n_starts)]
+    return _jobs(task.name, {}, model, starts, "tshix", n_points, seeds)
+
+
 def task_table(
     task_spec: str,
     demos: Sequence[Demonstration],
@@ -49,18 +67,9 @@ def task_table(
     progress: Progress = None,
 ) -> list[Row]:
     """Rows ``tshix`` and ``ergodic`` on the same starts (see the module docstring)."""
-    task = load_task(task_spec)
-    if any(d.task != task.name for d in demos):
-        raise TeachfitError(f"the demonstrations are not all of task {task.name!r}")
-    model = SearchModel.fit(list(demos), task.name)
-    rng = np.random.default_rng(seed + 1)
-    names = task.protocol.names
-    protocol = "table1" if "table1" in names else "teacher"
-    starts = task.protocol.protocol_starts(protocol, n_starts, rng, demos[0].start_pose)
-    seeds = [episode_seed(seed, i) for i in range(n_starts)]
-    tshix = _jobs(task.name, {}, model, starts, "tshix", n_points, seeds)
+    tshix = task_jobs(task_spec, demos, seed, n_starts, n_points)
     res_t = run_jobs(tshix, workers, progress)
     length = float(np.mean([r.weighted_length for r in res_t]))
-    erg = _jobs(task.name, {}, model, starts, "ergodic", n_points, seeds, length=length)
+    erg = [replace(j, method="ergodic", length=length) for j in tshix]
     res_e = run_jobs(erg, workers, progress)
     return [_row("tshix", res_t, None), _row("ergodic", res_e, None)]

@@ -17,6 +17,7 @@ from teachfit.cli import (  # noqa: E402
     robot_cmd,
     skill_cmd,
 )
+from teachfit.cli.bench_parts_cmd import bench_parts  # noqa: E402
 from teachfit.cli.bench_search_cmd import bench_search  # noqa: E402
 from teachfit.cli.demo_cmd import app as demo_app  # noqa: E402
 from teachfit.cli.main_cmds import register  # noqa: E402
@@ -69,6 +70,7 @@ app.add_typer(skill_cmd.skill_app, name="skill")
 app.add_typer(capture_cmd.capture_app, name="capture")
 bench_app.command("capture")(capture_cmd.bench_capture_cmd)
 bench_app.command("search")(bench_search)
+bench_app.command("parts")(bench_parts)
 app.add_typer(robot_cmd.robot_app, name="robot")
 bench_app.command("robot")(robot_cmd.bench_robot)
 register(app, bench_app)

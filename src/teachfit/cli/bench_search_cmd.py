@@ -7,12 +7,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
 from teachfit.cli import options as o
-from teachfit.cli.common import RobotOpt, append_markdown, console, guarded
+from teachfit.cli.common import RobotOpt, console, guarded
 from teachfit.cli.progress import progress_bar
-from teachfit.cli.tables import print_table
+from teachfit.cli.tables import emit_table
 from teachfit.core.atomic import atomic_write_text
 from teachfit.core.errors import TeachfitError
 
@@ -50,16 +49,7 @@ def _cells(row: Row) -> list[str]:
 
 
 def _emit(title: str, rows: Sequence[Row], markdown: Path | None) -> None:
-    table = Table(title=title)
-    for col in _COLS:
-        table.add_column(col, justify="right")
-    for r in rows:
-        table.add_row(*_cells(r))
-    print_table(table)
-    if markdown is not None:
-        lines = [f"\n**{title}**\n", "| " + " | ".join(_COLS) + " |", "|" + " --- |" * len(_COLS)]
-        lines += ["| " + " | ".join(_cells(r)) + " |" for r in rows]
-        append_markdown(markdown, "\n".join(lines))
+    emit_table(title, _COLS, [_cells(r) for r in rows], markdown)
 
 
 @guarded
@@ -280,12 +270,7 @@ def _variants(
         )
     cols = (*(k for k, _ in results[0].variant.values), "demos kept/tried", "TSHIX", "ergodic")
     lines = [_variant_cells(r) for r in results]
-    table = Table(title=title)
-    for col in cols:
-        table.add_column(col, justify="right")
-    for cells in lines:
-        table.add_row(*cells)
-    print_table(table)
+    emit_table(title, cols, lines, markdown)
     misses = sv.goal_misses(results)
     goal = sv.GOALS[task]
     console.print(
@@ -293,7 +278,3 @@ def _variants(
         + ("met" if not misses else f"missed on {', '.join(r.variant.label for r in misses)}")
     )
     console.print(f"figure -> {out}, results -> {out.with_suffix('.json')}")
-    if markdown is not None:
-        md = [f"\n**{title}**\n", "| " + " | ".join(cols) + " |", "|" + " --- |" * len(cols)]
-        md += ["| " + " | ".join(c) + " |" for c in lines]
-        append_markdown(markdown, "\n".join(md))

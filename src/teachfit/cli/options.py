@@ -193,6 +193,13 @@ Markdown = Annotated[
 WriteOld = Annotated[bool, old("--write", "--markdown benchmarks/results/NAME.md")]
 Overwrite = Annotated[bool, typer.Option(help="replace an existing file")]
 Append = Annotated[bool, typer.Option(help="append to an existing file")]
+SuiteClearance = Annotated[
+    float,
+    typer.Option(
+        help="diametral clearance (mm) of the parts suite's pegs in their holes: 0.2 by "
+        "default (the simulated floor); e.g. 0.029, H7/g6's largest at 8 mm"
+    ),
+]
 Workers = Annotated[
     int | None,
     typer.Option(help="worker processes (default: all cores; 0: in this process)"),

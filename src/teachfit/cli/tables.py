@@ -8,6 +8,9 @@ column's header beside its value. Wide terminals get the whole table at full wid
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from pathlib import Path
+
 from rich.console import Console, RenderableType
 from rich.markdown import Markdown
 from rich.measure import Measurement
@@ -16,7 +19,7 @@ from rich.text import Text
 
 from teachfit.cli.common import console as default_console
 
-__all__ = ["markdown_table", "print_markdown", "print_table"]
+__all__ = ["emit_table", "markdown_table", "print_markdown", "print_table"]
 
 
 def _cells(table: Table) -> list[list[RenderableType]]:
@@ -44,6 +47,25 @@ def print_table(table: Table, console: Console | None = None) -> None:
         con.print(grid)
     if table.caption:
         con.print(Text.from_markup(str(table.caption), style="dim"))
+
+
+def emit_table(
+    title: str, cols: Sequence[str], rows: Sequence[Sequence[str]], markdown: Path | None
+) -> None:
+    """Print a right-justified table of ``rows`` under ``title`` and, with ``markdown``, append
+    it there as a markdown table (:func:`~teachfit.cli.common.append_markdown`)."""
+    from teachfit.cli.common import append_markdown
+
+    table = Table(title=title)
+    for col in cols:
+        table.add_column(col, justify="right")
+    for cells in rows:
+        table.add_row(*cells)
+    print_table(table)
+    if markdown is not None:
+        lines = [f"\n**{title}**\n", "| " + " | ".join(cols) + " |", "|" + " --- |" * len(cols)]
+        lines += ["| " + " | ".join(c) + " |" for c in rows]
+        append_markdown(markdown, "\n".join(lines))
 
 
 def markdown_table(lines: list[str], title: str | None = None) -> Table:

@@ -19,7 +19,7 @@ skipped, as every execution starts from a reset) and ``wall_s``; on a real arm a
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -148,6 +148,16 @@ class SkillObjective:
     def held_out(self, params: Mapping[str, float] | None, setups: int) -> tuple[bool, ...]:
         """Success of each execution of ``params`` on ``setups`` held-out set-ups (``n_starts``
         starts each, :mod:`teachfit.execution.setups`): set-ups no trial was evaluated on."""
+        return tuple(ok for ok, _ in self.held_out_runs(params, setups))
+
+    def held_out_runs(
+        self,
+        params: Mapping[str, float] | None,
+        setups: int,
+        progress: Callable[[], None] | None = None,
+    ) -> list[tuple[bool, str]]:
+        """:meth:`held_out`'s executions in order: success and the outcome with its reason
+        (``"outcome: reason"``); ``progress()`` after each."""
         from teachfit.execution.setups import draw_setups
         from teachfit.skills.library import get_skill
 
@@ -157,8 +167,13 @@ class SkillObjective:
             tr.setup.task, self.seed, self.n_starts, self.controller, skill, setups, True
         )
         s = drawn.setup
-        runs = (tr.run(params, st, s.frame(i)) for i, st in enumerate(s.starts))
-        return tuple(bool(tr.metric.evaluate(r)[0]) for r in runs)
+        out = []
+        for i, st in enumerate(s.starts):
+            r = tr.run(params, st, s.frame(i))
+            out.append((bool(tr.metric.evaluate(r)[0]), f"{r.outcome.value}: {r.reason}"))
+            if progress is not None:
+                progress()
+        return out
 
     def __call__(self, params: Mapping[str, float]) -> TrialResult:
         tr = self.trial()
