@@ -22,6 +22,10 @@ BASE src | tar -x -C /tmp/base``) and ``--compare`` the two files: executions/CP
 their ratio per task and overall, and the number of executions whose fingerprints differ (each
 difference is printed). ``--markdown FILE`` appends the comparison table with its provenance
 header (:mod:`teachfit.cli.script_markdown`).
+
+On a shared machine the CPU time of one version varies between runs: two runs of the same code
+(commit a172637, the 2-core machine with three other jobs) gave ratios of 1.05, 1.11 and 1.13
+per task; a ratio means something beyond that noise only, the fingerprints exactly.
 """
 
 from __future__ import annotations
