@@ -5,6 +5,7 @@ path that cannot be written is refused before any work, in one line, exit status
 from __future__ import annotations
 
 import importlib.util
+import json
 import sys
 from pathlib import Path
 from types import ModuleType, SimpleNamespace
@@ -129,3 +130,33 @@ def test_parts_clearance_appends_one_row_per_fit(monkeypatch, capsys, tmp_path) 
         "H7/g6 smallest (5 um)", "H7/g6 largest (29 um)", "suite (200 um)"
     ]  # fmt: skip
     assert all(r.split(" | ")[2] in ("2.5 um", "14.5 um", "100.0 um") for r in rows)
+
+
+def test_exec_per_cpu_runs_and_compares_fixed_executions(monkeypatch, capsys, tmp_path) -> None:
+    """One puzzle execution, run twice (the repeats must agree), written; compared with itself:
+    ratio 1.00 and no differing fingerprint; a changed fingerprint is named, other parameter
+    sets are refused in one line (exit 2)."""
+    run = tmp_path / "run.json"
+    _run(monkeypatch, "exec_per_cpu", ["--label", "here", "--out", str(run), "--tasks", "puzzle",
+                                       "--executions", "1", "--repeats", "2"])  # fmt: skip
+    data = json.loads(run.read_text(encoding="utf-8"))
+    (fp,) = data["tasks"]["puzzle"]["fingerprints"]
+    assert set(fp) == {"outcome", "success_tick", "ticks", "pos_um"} and fp["ticks"] > 0
+    body = _check(monkeypatch, capsys, tmp_path, "exec_per_cpu", ["--compare", str(run), str(run)])
+    assert "**Executions per CPU-second, here vs here**" in body
+    last = body.splitlines()[-1]
+    assert last.startswith("| all | 1 | ") and last.endswith(" | 1.00 | 0 |")
+    moved = json.loads(run.read_text(encoding="utf-8"))
+    moved["tasks"]["puzzle"]["fingerprints"][0]["pos_um"][2] += 3
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps(moved), encoding="utf-8")
+    capsys.readouterr()
+    _run(monkeypatch, "exec_per_cpu", ["--compare", str(run), str(other)])
+    out = capsys.readouterr().out
+    assert "| puzzle | 1 | " in out and out.rstrip().endswith("(final position 3 µm apart)")
+    moved["tasks"]["puzzle"]["params"][0]["force"] = -1.0
+    other.write_text(json.dumps(moved), encoding="utf-8")
+    with pytest.raises(SystemExit) as stop:
+        _run(monkeypatch, "exec_per_cpu", ["--compare", str(run), str(other)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and err.count("\n") == 1 and "other parameter sets" in err
