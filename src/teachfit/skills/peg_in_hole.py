@@ -53,6 +53,7 @@ from teachfit.skills.conditions import (
     TimeAbove,
 )
 from teachfit.skills.controllers import controller_params
+from teachfit.skills.fit_context import fit_context, fit_of
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
 from teachfit.skills.primitive import Insert, Move, MoveTo
@@ -64,7 +65,10 @@ NAME = "peg-in-hole"
 CONTEXT: dict[str, ContextParam] = {
     "depth": ContextParam(0.0105, "m", "insertion depth below the estimated entry"),
     "approach_height": ContextParam(0.005, "m", "TCP height of the approach pose"),
-    "lateral_offset": ContextParam(0.003, "m", "approach pose before the hole, along -x"),
+    "lateral_offset": ContextParam(
+        0.003, "m", "approach pose at x = -lateral_offset (before the hole for lateral_dir 1)"
+    ),
+    "lateral_dir": ContextParam(1.0, "", "lateral move along +x (1) or -x (-1: low rim first)"),
     "roi": ContextParam(0.012, "m", "region of interest: radius around the hole axis"),
     "rz_period": ContextParam(0.0, "rad", "symmetry of the part about z (0: none)"),
     "v_max": ContextParam(0.1, "m/s", "translational speed limit"),
@@ -77,6 +81,10 @@ CONTEXT: dict[str, ContextParam] = {
     "f_contact": ContextParam(3.0, "N", "force that marks contact with the surface"),
     "f_push": ContextParam(4.0, "N", "pressing force while moving laterally and aligning"),
     "f_lateral": ContextParam(4.0, "N", "resistance that marks a constrained lateral move"),
+    "f_lateral_rev": ContextParam(
+        1000.0, "N", "resistance along +x that marks a constrained move along -x"
+    ),
+    "k_across": ContextParam(300.0, "N/m", "lateral move: stiffness across the move (y)"),
     "t_settle": ContextParam(
         0.05, "s", "lateral move: time after landing before a resistance counts as a constraint"
     ),
@@ -180,11 +188,11 @@ def _reach_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
         Node(
             "lateral",
             Move(
-                direction=(1.0, 0.0, 0.0),
+                direction=("lateral_dir", 0.0, 0.0),
                 speed="v_lateral",
                 speed_factor="speed_factor",
                 push="f_push",
-                stiffness=(1500.0, 300.0, 300.0, 80.0, 80.0, 80.0),
+                stiffness=(1500.0, "k_across", 300.0, 80.0, 80.0, 80.0),
             ),
             TimeAbove("t_lateral") | roi,
             "sideways until constrained",
@@ -231,6 +239,7 @@ def _transitions() -> tuple[Transition, ...]:
     constrained = Any_(
         (
             TimeAbove("t_settle") & ForceAbove("f_lateral", axis="-x"),
+            TimeAbove("t_settle") & ForceAbove("f_lateral_rev", axis="+x"),
             DepthAbove("drop_depth"),
             TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
         )
@@ -299,7 +308,9 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
 
 def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     """Context for ``task``: estimated hole pose, goal depth, approach height above the
-    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping, the
+    surface, part symmetry; for a task that knows its fit a low-rim-first lateral move
+    (:mod:`teachfit.skills.fit_context`); overrides from a task's optional ``skill_context``
+    mapping, the
     learned parameters its optional ``skill_fixed`` mapping fixes and the ``(low, high)``
     domains its optional ``skill_domains`` mapping gives."""
     hole = task.hole2world
@@ -315,11 +326,18 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
         "drop_depth": 0.001 - above,  # 1 mm below the surface around the hole
         "rz_period": float(getattr(task, "rz_period", 0.0) or 0.0),
     }
+    fit = fit_of(task)
+    fit_domains: dict[str, ParamDomain] = {}
+    if fit is not None:
+        defaults = {n: p.value for n, p in CONTEXT.items()}
+        speed_low = LEARNED["speed_factor"].domain.low
+        fit_values, fit_domains = fit_context(fit, defaults, speed_low, LEARNED["tilt"].domain)
+        values.update(fit_values)
     values.update(dict(getattr(task, "skill_context", {}) or {}))
     goal = hole.compose(Pose(np.array([0.0, 0.0, -float(task.success_depth)])))
     fixed = {k: float(v) for k, v in (getattr(task, "skill_fixed", {}) or {}).items()}
     bounds = getattr(task, "skill_domains", {}) or {}
-    domains = {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
+    domains = fit_domains | {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
     bound = f"task {task.name} bounds it: a task parameter widens it (teachfit tasks)"
     return HoleContext(est, goal, values, fixed, domains, bound)
 

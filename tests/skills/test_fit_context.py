@@ -1,0 +1,70 @@
+"""The peg-in-hole context a fit gives (skills/fit_context.py), and what built-in tasks keep."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teachfit.core.errors import SkillError
+from teachfit.core.params import ParamDomain
+from teachfit.skills import peg_in_hole
+from teachfit.skills.fit_context import NEVER, FitGeometry, fit_context
+from teachfit.tasks.registry import get_task
+
+DEFAULTS = {n: p.value for n, p in peg_in_hole.CONTEXT.items()}
+TILT = ParamDomain(0.0, 0.3)
+
+
+def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_light_press() -> None:
+    # the round-peg example: r = 4 mm, c = 0.1 mm, no chamfer, sigma = 0.5 mm
+    values, domains = fit_context(FitGeometry(0.004, 1e-4, 0.0, 5e-4), DEFAULTS, 0.25, TILT)
+    start = 0.004 + 0.0041 + 3 * 5e-4
+    assert values["lateral_dir"] == -1.0
+    assert values["lateral_offset"] == pytest.approx(-start)
+    assert values["roi"] == pytest.approx(start + 0.001)
+    assert values["k_across"] == 0.0
+    assert values["f_lateral"] == NEVER and values["f_lateral_rev"] == DEFAULTS["f_lateral"]
+    assert values["f_push"] == pytest.approx(0.5 * DEFAULTS["f_push"])
+    t_lateral = (start + 0.0041) / (DEFAULTS["v_lateral"] * 0.25)
+    assert values["t_lateral"] == pytest.approx(t_lateral)
+    assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + t_lateral - DEFAULTS["t_lateral"])
+    assert domains["tilt"].high == pytest.approx(math.acos(0.004 / 0.0041))  # 0.22 rad
+
+
+def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() -> None:
+    values, domains = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4), DEFAULTS, 0.25, TILT)
+    assert values["f_push"] == DEFAULTS["f_push"]
+    assert values["lateral_offset"] == pytest.approx(-(0.005 + 0.0055 + 6e-4))
+    assert math.acos(0.0045 / 0.0055) > 0.3  # the fit allows more than the skill's own
+    assert domains["tilt"].high == 0.3
+    # a short move: t_lateral stays at its default
+    short, _ = fit_context(FitGeometry(0.001, 5e-4, 0.0, 0.0), DEFAULTS, 0.25, TILT)
+    assert short["t_lateral"] == DEFAULTS["t_lateral"] and short["t_max"] == DEFAULTS["t_max"]
+
+
+@pytest.mark.parametrize(
+    "args", [(0.0, 1e-4, 0.0, 0.0), (0.004, -1e-4, 0.0, 0.0), (0.004, 0.0, 0.004, 0.0)]
+)
+def test_an_impossible_fit_is_an_error(args: tuple[float, float, float, float]) -> None:
+    with pytest.raises(SkillError, match="fit:"):
+        FitGeometry(*args)
+
+
+@pytest.mark.parametrize("name", ["peg2d", "socket3d", "peg", "key", "puzzle"])
+def test_built_in_tasks_keep_johannsmeier_s_context(name: str) -> None:
+    ctx = peg_in_hole.hole_context(get_task(name), np.random.default_rng(0))
+    for key in ("lateral_dir", "lateral_offset", "roi", "k_across", "f_lateral_rev", "f_push"):
+        assert key not in ctx.values
+    assert "tilt" not in ctx.domains
+
+
+def test_the_round_peg_example_gives_its_fit(mesh_examples: dict[str, str]) -> None:
+    task = get_task(mesh_examples["round-peg"])
+    assert task.part_half_width == pytest.approx(0.004)
+    assert task.clearance == pytest.approx(1e-4, rel=0.01)
+    assert task.tip_chamfer == 0.0
+    ctx = peg_in_hole.hole_context(task, np.random.default_rng(0))
+    assert ctx.values["lateral_dir"] == -1.0
+    assert ctx.values["lateral_offset"] == pytest.approx(-(0.004 + 0.0041 + 0.0015), abs=1e-6)
