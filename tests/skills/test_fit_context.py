@@ -26,6 +26,7 @@ def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_li
     assert values["roi"] == pytest.approx(start + 0.001)
     assert values["k_across"] == 0.0
     assert values["f_lateral"] == NEVER and values["f_lateral_rev"] == DEFAULTS["f_lateral"]
+    assert values["wall_depth"] == 0.0
     assert values["f_push"] == pytest.approx(0.5 * DEFAULTS["f_push"])
     t_lateral = (start + 0.0041) / (DEFAULTS["v_lateral"] * 0.25)
     assert values["t_lateral"] == pytest.approx(t_lateral)
@@ -39,6 +40,9 @@ def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() ->
     assert values["lateral_offset"] == pytest.approx(-(0.005 + 0.0055 + 6e-4))
     assert math.acos(0.0045 / 0.0055) > 0.3  # the fit allows more than the skill's own
     assert domains["tilt"].high == 0.3
+    # a top that ends nearer: the start stays over it
+    near, _ = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4, 0.008), DEFAULTS, 0.25, TILT)
+    assert near["lateral_offset"] == -0.008
     # a short move: t_lateral stays at its default
     short, _ = fit_context(FitGeometry(0.001, 5e-4, 0.0, 0.0), DEFAULTS, 0.25, TILT)
     assert short["t_lateral"] == DEFAULTS["t_lateral"] and short["t_max"] == DEFAULTS["t_max"]
@@ -55,7 +59,7 @@ def test_an_impossible_fit_is_an_error(args: tuple[float, float, float, float]) 
 @pytest.mark.parametrize("name", ["peg2d", "socket3d", "peg", "key", "puzzle"])
 def test_built_in_tasks_keep_johannsmeier_s_context(name: str) -> None:
     ctx = peg_in_hole.hole_context(get_task(name), np.random.default_rng(0))
-    for key in ("lateral_dir", "lateral_offset", "roi", "k_across", "f_lateral_rev", "f_push"):
+    for key in ("lateral_dir", "lateral_offset", "roi", "k_across", "f_lateral_rev", "wall_depth"):
         assert key not in ctx.values
     assert "tilt" not in ctx.domains
 

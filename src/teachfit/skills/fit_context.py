@@ -16,20 +16,28 @@ without sinking until it stalled (4/10).
 A task that knows its fit (``part_half_width`` ``r``, ``clearance`` ``c`` per side,
 ``tip_chamfer`` ``e`` of the part, ``params.hole_pos_sigma`` ``sigma``; m) gets the tilted
 search's way instead (:mod:`teachfit.skills.tilt`): the part slides along -x
-(``lateral_dir = -1``) with its *leading* rim lowest, which drops over the hole anywhere
-along a chord, slides to the far wall (``f_lateral_rev`` resisting along +x marks the catch;
-``f_lateral``, along -x, never fires) free across the move (``k_across = 0``: the round wall
-centres it), and turns upright about that rim into the hole. With ``R = r + c`` the hole's
+(``lateral_dir = -1``) with its *leading* rim lowest, which dips over the hole and slides to
+the far wall (``f_lateral_rev`` resisting along +x with the TCP below the entry,
+``wall_depth = 0``, marks the catch; ``f_lateral``, along -x, never fires) free across the
+move (``k_across = 0``: the round wall centres it), and turns upright about that rim into
+the hole. Across the move the rim dips only where the part is within a few tenths of a
+millimetre of the hole's line (a part as wide as its hole rests on the top beside it):
+the round-peg example missed the hole with the taught hole 0.9-1.3 mm off across the move.
+With ``R = r + c`` the hole's
 half width:
 
 * start the rim beyond the hole's near edge when the taught hole is ``3 sigma`` off toward it:
-  ``lateral_offset = -(r + R + 3 sigma)`` (the approach pose on the +x side);
+  ``lateral_offset = -(r + R + 3 sigma)`` (the approach pose on the +x side), at most the
+  task's ``detection_radius`` (beyond it the part would land off the top or in another hole);
 * ``roi = |lateral_offset| + 1 mm``: beyond the start, and a missed hole ends the move there;
 * the tilt domain ``(0, min(0.3, acos((r - e) / R)))``: turning upright about the far wall,
   the high rim clears the near edge for any depth (*Jams* in :mod:`teachfit.skills.tilt`);
 * ``t_lateral = (|lateral_offset| + R) / (v_lateral s_low)`` with ``s_low`` the lowest learned
   ``speed_factor``: the slowest move still reaches the far wall; ``t_max`` grows by as much as
   ``t_lateral`` does over its default;
+* the TCP below the entry: on the FR3 the near edge under the tilted face resisted the
+  slide with 4.1 N (the arm presses 10 N as it lands) with the TCP 0.2 mm above the entry,
+  and the part, turned upright there, stood on the top (2/3 set-ups inserted);
 * a sharp leading rim (``e < c``) is pressed with half the default ``f_push``: pressed with
   4 N it caught on the seam between the plate's convex pieces 5.1 mm from the axis (a
   resistance of 4.2 N along +x with the TCP still on the top, 4 of 10 executions); with
@@ -58,12 +66,14 @@ SHARP_PUSH = 0.5
 class FitGeometry:
     """A part's fit in its hole (m): ``half_width`` ``r`` of the part along the lateral move,
     ``clearance`` ``c`` per side, the part's ``tip_chamfer`` ``e`` (0: a sharp edge) and the
-    taught hole's position error ``sigma`` per axis."""
+    taught hole's position error ``sigma`` per axis; ``reach``: how far from the hole the
+    part stays over the top surface (inf: unknown)."""
 
     half_width: float
     clearance: float
     tip_chamfer: float
     sigma: float
+    reach: float = math.inf
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.half_width) and self.half_width > 0):
@@ -96,8 +106,9 @@ def fit_of(task: object) -> FitGeometry | None:
     if not all(isinstance(v, int | float) for v in vals):
         return None
     sigma = float(getattr(getattr(task, "params", None), "hole_pos_sigma", 0.0) or 0.0)
+    reach = getattr(task, "detection_radius", None)
     r, c, e = (float(v) for v in vals if isinstance(v, int | float))
-    return FitGeometry(r, c, e, sigma)
+    return FitGeometry(r, c, e, sigma, float(reach) if isinstance(reach, int | float) else math.inf)
 
 
 def fit_context(
@@ -108,7 +119,7 @@ def fit_context(
     ``t_lateral``, ``t_max``, ``f_lateral``, ``f_push``), ``speed_low`` the lowest
     ``speed_factor``, ``tilt`` the skill's own tilt domain (the fit only narrows it)."""
     big_r = fit.hole_half_width
-    start = fit.half_width + big_r + 3.0 * fit.sigma
+    start = min(fit.half_width + big_r + 3.0 * fit.sigma, fit.reach)
     t_lateral = max(defaults["t_lateral"], (start + big_r) / (defaults["v_lateral"] * speed_low))
     press = SHARP_PUSH if fit.tip_chamfer < fit.clearance else 1.0
     values = {
@@ -119,6 +130,7 @@ def fit_context(
         "k_across": 0.0,
         "f_lateral": NEVER,
         "f_lateral_rev": defaults["f_lateral"],
+        "wall_depth": 0.0,
         "t_lateral": t_lateral,
         "t_max": defaults["t_max"] + t_lateral - defaults["t_lateral"],
     }

@@ -85,6 +85,9 @@ CONTEXT: dict[str, ContextParam] = {
         1000.0, "N", "resistance along +x that marks a constrained move along -x"
     ),
     "k_across": ContextParam(300.0, "N/m", "lateral move: stiffness across the move (y)"),
+    "wall_depth": ContextParam(
+        -1.0, "m", "depth the TCP must have sunk to for f_lateral_rev to count (a wall)"
+    ),
     "t_settle": ContextParam(
         0.05, "s", "lateral move: time after landing before a resistance counts as a constraint"
     ),
@@ -239,7 +242,9 @@ def _transitions() -> tuple[Transition, ...]:
     constrained = Any_(
         (
             TimeAbove("t_settle") & ForceAbove("f_lateral", axis="-x"),
-            TimeAbove("t_settle") & ForceAbove("f_lateral_rev", axis="+x"),
+            TimeAbove("t_settle")
+            & ForceAbove("f_lateral_rev", axis="+x")
+            & DepthAbove("wall_depth"),
             DepthAbove("drop_depth"),
             TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
         )
