@@ -35,9 +35,12 @@ half width:
 * ``t_lateral = (|lateral_offset| + R) / (v_lateral s_low)`` with ``s_low`` the lowest learned
   ``speed_factor``: the slowest move still reaches the far wall; ``t_max`` grows by as much as
   ``t_lateral`` does over its default;
-* the TCP below the entry: on the FR3 the near edge under the tilted face resisted the
-  slide with 4.1 N (the arm presses 10 N as it lands) with the TCP 0.2 mm above the entry,
-  and the part, turned upright there, stood on the top (2/3 set-ups inserted);
+* the TCP below the entry (``wall_depth``) for a resistance or a stop to count: on the FR3
+  (which presses 4-10 N as it lands) the near edge under the tilted face resisted the
+  slide with 4.1 N, and the seam between the plate's convex pieces 5.1 mm from the axis
+  stopped the part, both with the TCP 0.2-0.3 mm above the entry; turned upright there,
+  the part stood on the top (held-out set-ups: 5/20 inserted; 14/20 with the resistance
+  gated, 19/20 with the stop gated too);
 * a sharp leading rim (``e < c``) is pressed with half the default ``f_push``: pressed with
   4 N it caught on the seam between the plate's convex pieces 5.1 mm from the axis (a
   resistance of 4.2 N along +x with the TCP still on the top, 4 of 10 executions); with

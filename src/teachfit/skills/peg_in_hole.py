@@ -86,7 +86,7 @@ CONTEXT: dict[str, ContextParam] = {
     ),
     "k_across": ContextParam(300.0, "N/m", "lateral move: stiffness across the move (y)"),
     "wall_depth": ContextParam(
-        -1.0, "m", "depth the TCP must have sunk to for f_lateral_rev to count (a wall)"
+        -1.0, "m", "depth the TCP must have sunk to for f_lateral_rev or a stop to count"
     ),
     "t_settle": ContextParam(
         0.05, "s", "lateral move: time after landing before a resistance counts as a constraint"
@@ -246,7 +246,7 @@ def _transitions() -> tuple[Transition, ...]:
             & ForceAbove("f_lateral_rev", axis="+x")
             & DepthAbove("wall_depth"),
             DepthAbove("drop_depth"),
-            TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
+            TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1) & DepthAbove("wall_depth"),
         )
     )
     return (
