@@ -23,14 +23,17 @@ def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_li
     start = 0.004 + 0.0041 + 3 * 5e-4
     assert values["lateral_dir"] == -1.0
     assert values["lateral_offset"] == pytest.approx(-start)
-    assert values["roi"] == pytest.approx(start + 0.001)
+    assert values["pass_y"] == pytest.approx(0.001) and values["pass_end"] == pytest.approx(0.0041)
+    assert values["roi"] == pytest.approx(math.hypot(start, 0.001) + 0.001)
     assert values["k_across"] == 0.0
-    assert values["f_lateral"] == NEVER and values["f_lateral_rev"] == DEFAULTS["f_lateral"]
-    assert values["wall_depth"] == 0.0
+    assert values["f_lateral"] == NEVER
+    assert values["f_lateral_rev"] == pytest.approx(2 * DEFAULTS["f_lateral"])
+    assert values["wall_depth"] == 0.0 and values["wall_x"] == pytest.approx(1e-4 + 1.5e-3)
     assert values["f_push"] == pytest.approx(0.5 * DEFAULTS["f_push"])
     t_lateral = (start + 0.0041) / (DEFAULTS["v_lateral"] * 0.25)
     assert values["t_lateral"] == pytest.approx(t_lateral)
-    assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + t_lateral - DEFAULTS["t_lateral"])
+    extra = t_lateral - DEFAULTS["t_lateral"] + 2 * (t_lateral + 1.0)
+    assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + extra)
     assert domains["tilt"].high == pytest.approx(math.acos(0.004 / 0.0041))  # 0.22 rad
 
 
@@ -45,7 +48,8 @@ def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() ->
     assert near["lateral_offset"] == -0.008
     # a short move: t_lateral stays at its default
     short, _ = fit_context(FitGeometry(0.001, 5e-4, 0.0, 0.0), DEFAULTS, 0.25, TILT)
-    assert short["t_lateral"] == DEFAULTS["t_lateral"] and short["t_max"] == DEFAULTS["t_max"]
+    assert short["t_lateral"] == DEFAULTS["t_lateral"]
+    assert short["t_max"] == pytest.approx(DEFAULTS["t_max"] + 2 * (DEFAULTS["t_lateral"] + 1.0))
 
 
 @pytest.mark.parametrize(
@@ -59,7 +63,16 @@ def test_an_impossible_fit_is_an_error(args: tuple[float, float, float, float]) 
 @pytest.mark.parametrize("name", ["peg2d", "socket3d", "peg", "key", "puzzle"])
 def test_built_in_tasks_keep_johannsmeier_s_context(name: str) -> None:
     ctx = peg_in_hole.hole_context(get_task(name), np.random.default_rng(0))
-    for key in ("lateral_dir", "lateral_offset", "roi", "k_across", "f_lateral_rev", "wall_depth"):
+    assert "pass_end" not in ctx.values  # 1 m: no extra pass is ever taken
+    for key in (
+        "lateral_dir",
+        "lateral_offset",
+        "roi",
+        "k_across",
+        "wall_depth",
+        "wall_x",
+        "pass_y",
+    ):
         assert key not in ctx.values
     assert "tilt" not in ctx.domains
 

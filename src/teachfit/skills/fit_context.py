@@ -17,34 +17,36 @@ A task that knows its fit (``part_half_width`` ``r``, ``clearance`` ``c`` per si
 ``tip_chamfer`` ``e`` of the part, ``params.hole_pos_sigma`` ``sigma``; m) gets the tilted
 search's way instead (:mod:`teachfit.skills.tilt`): the part slides along -x
 (``lateral_dir = -1``) with its *leading* rim lowest, which dips over the hole and slides to
-the far wall (``f_lateral_rev`` resisting along +x with the TCP below the entry,
-``wall_depth = 0``, marks the catch; ``f_lateral``, along -x, never fires) free across the
-move (``k_across = 0``: the round wall centres it), and turns upright about that rim into
-the hole. Across the move the rim dips only where the part is within a few tenths of a
-millimetre of the hole's line (a part as wide as its hole rests on the top beside it):
-the round-peg example missed the hole with the taught hole 0.9-1.3 mm off across the move.
-With ``R = r + c`` the hole's
-half width:
+the far wall, free across the move (``k_across = 0``: the round wall centres it), and turns
+upright about that rim into the hole. With ``R = r + c`` the hole's half width:
 
 * start the rim beyond the hole's near edge when the taught hole is ``3 sigma`` off toward it:
   ``lateral_offset = -(r + R + 3 sigma)`` (the approach pose on the +x side), at most the
   task's ``detection_radius`` (beyond it the part would land off the top or in another hole);
-* ``roi = |lateral_offset| + 1 mm``: beyond the start, and a missed hole ends the move there;
+* passes: a part as wide as its hole rests on the top beside it unless it is within a few
+  tenths of a millimetre of the hole's line (round-peg: caught 0.5 mm across, missed 0.7-1.5
+  mm), so a move that went ``pass_end = R`` past the taught axis (x <= -R) missed and the
+  next pass starts ``pass_y = 2 sigma`` to one side, then to the other: three lines cover
+  ``3 sigma`` across when a pass catches within ``sigma`` of its line (round-peg, taught hole
+  0.5-1.5 mm off across: 1/6 inserted with one pass, 6/6 with three, both robots);
+* ``roi = hypot(|lateral_offset|, pass_y) + 1 mm``: beyond every start;
+* the far wall: a resistance along +x of ``f_lateral_rev = 2 f_lateral`` (``f_lateral``,
+  along -x, never fires), or the part stopped, counts only with the TCP below the entry
+  (``wall_depth = 0``) or within ``wall_x = c + 3 sigma`` of the taught axis along x (where
+  the far wall is): on the FR3 (which presses 4-10 N as it lands) the near edge under the
+  tilted face resisted the slide with 4.1 N and the seam between the plate's convex pieces
+  5.1 mm from the axis stopped the part at 5-8 N, both with the TCP 0.2-0.3 mm above the
+  entry, and the part turned upright there stood on the top; a part centred on the hole's
+  line may stop at the far edge without dipping (TCP 0.4 mm above the entry, 0.1 mm past
+  the axis);
 * the tilt domain ``(0, min(0.3, acos((r - e) / R)))``: turning upright about the far wall,
   the high rim clears the near edge for any depth (*Jams* in :mod:`teachfit.skills.tilt`);
 * ``t_lateral = (|lateral_offset| + R) / (v_lateral s_low)`` with ``s_low`` the lowest learned
   ``speed_factor``: the slowest move still reaches the far wall; ``t_max`` grows by as much as
-  ``t_lateral`` does over its default;
-* the TCP below the entry (``wall_depth``) for a resistance or a stop to count: on the FR3
-  (which presses 4-10 N as it lands) the near edge under the tilted face resisted the
-  slide with 4.1 N, and the seam between the plate's convex pieces 5.1 mm from the axis
-  stopped the part, both with the TCP 0.2-0.3 mm above the entry; turned upright there,
-  the part stood on the top (held-out set-ups: 5/20 inserted; 14/20 with the resistance
-  gated, 19/20 with the stop gated too);
+  ``t_lateral`` does over its default, plus two passes of ``t_lateral + 1 s``;
 * a sharp leading rim (``e < c``) is pressed with half the default ``f_push``: pressed with
-  4 N it caught on the seam between the plate's convex pieces 5.1 mm from the axis (a
-  resistance of 4.2 N along +x with the TCP still on the top, 4 of 10 executions); with
-  2 N it slides over it (10/10).
+  4 N it caught on the seam between the plate's convex pieces (a resistance of 4.2 N along
+  +x with the TCP still on the top, 4 of 10 executions); with 2 N it slid over it (10/10).
 
 Tasks without the three attributes (the built-in ones) keep Johannsmeier et al.'s context.
 """
@@ -61,6 +63,10 @@ from teachfit.core.params import ParamDomain
 ROI_MARGIN = 0.001
 #: a force threshold that never fires (N): above any force limit
 NEVER = 1000.0
+#: the far wall's resistance, times the default f_lateral
+WALL_SHARE = 2.0
+#: time (s) the approach and contact of an extra pass take at most
+PASS_TIME = 1.0
 #: share of the default press a sharp leading rim gets (see the module docstring)
 SHARP_PUSH = 0.5
 
@@ -125,16 +131,23 @@ def fit_context(
     start = min(fit.half_width + big_r + 3.0 * fit.sigma, fit.reach)
     t_lateral = max(defaults["t_lateral"], (start + big_r) / (defaults["v_lateral"] * speed_low))
     press = SHARP_PUSH if fit.tip_chamfer < fit.clearance else 1.0
+    pass_y = 2.0 * fit.sigma
     values = {
         "f_push": press * defaults["f_push"],
         "lateral_dir": -1.0,
         "lateral_offset": -start,
-        "roi": start + ROI_MARGIN,
+        "roi": math.hypot(start, pass_y) + ROI_MARGIN,
         "k_across": 0.0,
         "f_lateral": NEVER,
-        "f_lateral_rev": defaults["f_lateral"],
+        "f_lateral_rev": WALL_SHARE * defaults["f_lateral"],
         "wall_depth": 0.0,
+        "wall_x": fit.clearance + 3.0 * fit.sigma,
+        "pass_end": big_r,
+        "pass_y": pass_y,
         "t_lateral": t_lateral,
-        "t_max": defaults["t_max"] + t_lateral - defaults["t_lateral"],
+        "t_max": defaults["t_max"]
+        + t_lateral
+        - defaults["t_lateral"]
+        + 2.0 * (t_lateral + PASS_TIME),
     }
     return values, {"tilt": ParamDomain(tilt.low, min(tilt.high, fit.max_tilt))}
