@@ -37,3 +37,14 @@ def test_depth_stalled_fires_only_after_the_duration_without_progress() -> None:
 
 def _inline(d: dict) -> str:
     return "{ " + ", ".join(f'{k} = "{v}"' for k, v in d.items()) + " }"
+
+
+def test_x_below_reads_a_negated_parameter_from_toml() -> None:
+    cond = condition_from_toml({"kind": "x_below", "value": "-pass_end"})
+    check = cond.compile({"pass_end": 0.004})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    pc.p[0] = -0.0039
+    assert not check(pc)
+    pc.p[0] = -0.0041
+    assert check(pc)
+    assert cond.to_toml() == {"kind": "x_below", "value": "-pass_end"}

@@ -173,6 +173,21 @@ class LateralAbove(_Threshold):
 
 
 @dataclass(frozen=True)
+class XBelow(_Threshold):
+    """The TCP's task-frame x is at most ``value`` (m) (e.g. a move along -x went past the
+    hole)."""
+
+    kind: ClassVar[str] = "x_below"
+
+    def compile(self, values: Mapping[str, float]) -> Check:
+        thr = resolve(self.value, values)
+        return lambda pc: pc.p[0] <= thr
+
+    def describe(self) -> str:
+        return f"p_x ≤ {_fmt(self.value, 'm')}"
+
+
+@dataclass(frozen=True)
 class RemainingBelow(_Threshold):
     """The TCP is within ``value`` (m) of the active primitive's goal."""
 
@@ -388,6 +403,7 @@ _LEAVES: dict[str, type[Condition]] = {
         TimeAbove,
         DepthAbove,
         LateralAbove,
+        XBelow,
         RemainingBelow,
         TiltBelow,
         SpeedBelow,

@@ -8,13 +8,19 @@ surface); the lateral move runs along its +x. Five primitives:
    ``tilt`` about the task y-axis so that the tool axis leans back (towards -x) and the
    trailing rim of the part is its lowest point.
 2. ``contact``   down at ``v_contact`` until the surface pushes back ``f_contact``.
-3. ``lateral``   along +x at ``v_lateral`` pressing ``f_push``, compliant across the motion,
+3. ``lateral``   along +x (``lateral_dir``) at ``v_lateral`` pressing ``f_push``, compliant
+   across the motion (``k_across``),
    until constrained: the lowest rim has dropped over the hole edge (``drop_depth`` below
    the entry) or the part is wedged (the environment resists the motion with ``f_lateral``
    once ``t_settle`` has passed, or the part stopped moving). The settle time keeps the
    landing's impact out of that check: on an arm (several kg of apparent mass, the FR3) the
    part lands with 15 N, whose friction alone resists with more than ``f_lateral`` in the
    first tick, and the skill skipped the lateral move; the floating tool lands with 4 N.
+   A move along -x that went past ``x = -pass_end`` missed: the part is taken to the
+   approach pose ``pass_y`` to one side (``approach_2``, ``contact_2``, ``lateral_2``), then
+   to the other (``_3``); with the defaults (``pass_end`` 1 m) never (a task's fit sets
+   them: :mod:`teachfit.skills.fit_context`, as ``wall_depth`` and ``wall_x``, where along
+   -x a resistance ``f_lateral_rev`` or a stop counts).
 4. ``align``     rotate upright into the estimated hole orientation (the nearest yaw modulo
    the part's symmetry ``rz_period``) keeping contact with ``f_push``.
 5. ``insert``    push with the learned ``force`` while the set-point sinks to ``depth``,
@@ -51,10 +57,12 @@ from teachfit.skills.conditions import (
     RemainingBelow,
     SpeedBelow,
     TimeAbove,
+    XBelow,
 )
 from teachfit.skills.controllers import controller_params
+from teachfit.skills.fit_context import fit_context, fit_of
 from teachfit.skills.graph import Node, Skill, Transition
-from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
+from teachfit.skills.params import ContextParam, LearnedParam, SkillParams, Value
 from teachfit.skills.primitive import Insert, Move, MoveTo
 from teachfit.tasks.base import Task
 
@@ -64,7 +72,10 @@ NAME = "peg-in-hole"
 CONTEXT: dict[str, ContextParam] = {
     "depth": ContextParam(0.0105, "m", "insertion depth below the estimated entry"),
     "approach_height": ContextParam(0.005, "m", "TCP height of the approach pose"),
-    "lateral_offset": ContextParam(0.003, "m", "approach pose before the hole, along -x"),
+    "lateral_offset": ContextParam(
+        0.003, "m", "approach pose at x = -lateral_offset (before the hole for lateral_dir 1)"
+    ),
+    "lateral_dir": ContextParam(1.0, "", "lateral move along +x (1) or -x (-1: low rim first)"),
     "roi": ContextParam(0.012, "m", "region of interest: radius around the hole axis"),
     "rz_period": ContextParam(0.0, "rad", "symmetry of the part about z (0: none)"),
     "v_max": ContextParam(0.1, "m/s", "translational speed limit"),
@@ -77,6 +88,14 @@ CONTEXT: dict[str, ContextParam] = {
     "f_contact": ContextParam(3.0, "N", "force that marks contact with the surface"),
     "f_push": ContextParam(4.0, "N", "pressing force while moving laterally and aligning"),
     "f_lateral": ContextParam(4.0, "N", "resistance that marks a constrained lateral move"),
+    "f_lateral_rev": ContextParam(
+        1000.0, "N", "resistance along +x that marks a constrained move along -x"
+    ),
+    "k_across": ContextParam(300.0, "N/m", "lateral move: stiffness across the move (y)"),
+    "wall_depth": ContextParam(
+        -1.0, "m", "f_lateral_rev or a stop counts with the TCP this deep (or x <= wall_x)"
+    ),
+    "wall_x": ContextParam(1.0, "m", "f_lateral_rev or a stop counts at x <= wall_x (or deep)"),
     "t_settle": ContextParam(
         0.05, "s", "lateral move: time after landing before a resistance counts as a constraint"
     ),
@@ -91,6 +110,10 @@ CONTEXT: dict[str, ContextParam] = {
     "stall_depth": ContextParam(5e-4, "m", "insert: least depth gain that counts as progress"),
     "stall_time": ContextParam(1.5, "s", "insert: error after this long without progress"),
     "retract_height": ContextParam(0.01, "m", "recovery: retract this far up"),
+    "pass_end": ContextParam(
+        1.0, "m", "a move along -x past x = -pass_end missed: the next pass (1 m: none)"
+    ),
+    "pass_y": ContextParam(0.0, "m", "the extra passes' approach poses at y = +-pass_y"),
 }
 
 #: learned parameters: default and domain from system / safety limits
@@ -150,13 +173,24 @@ def _fast() -> _Speeds:
 
 
 def _reach_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
-    """``approach``, ``contact`` and ``lateral``: from the approach pose down onto the surface
-    and sideways until the part is caught by the hole (``roi``: left the region of interest)."""
+    """``approach``, ``contact`` and ``lateral`` (see :func:`_pass_nodes`), and the same for
+    the extra passes ``pass_y`` to either side (``_2``: +y, ``_3``: -y)."""
+    return (
+        _pass_nodes("", 0.0, fast, roi)
+        + _pass_nodes("_2", "pass_y", fast, roi)
+        + _pass_nodes("_3", "-pass_y", fast, roi)
+    )
+
+
+def _pass_nodes(suffix: str, y: Value, fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
+    """``approach``, ``contact`` and ``lateral`` (names with ``suffix``), the approach pose
+    at ``y`` across the move: from the approach pose down onto the surface and sideways
+    until the part is caught by the hole (``roi``: left the region of interest)."""
     return (
         Node(
-            "approach",
+            "approach" + suffix,
             MoveTo(
-                goal=("-lateral_offset", 0.0, "approach_height"),
+                goal=("-lateral_offset", y, "approach_height"),
                 yaw=0.0,
                 tilt="-tilt",
                 rz_period="rz_period",
@@ -167,7 +201,7 @@ def _reach_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
             "trapezoidal profile to the approach pose",
         ),
         Node(
-            "contact",
+            "contact" + suffix,
             Move(
                 direction=(0.0, 0.0, -1.0),
                 speed="v_contact",
@@ -178,13 +212,13 @@ def _reach_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
             "down until contact",
         ),
         Node(
-            "lateral",
+            "lateral" + suffix,
             Move(
-                direction=(1.0, 0.0, 0.0),
+                direction=("lateral_dir", 0.0, 0.0),
                 speed="v_lateral",
                 speed_factor="speed_factor",
                 push="f_push",
-                stiffness=(1500.0, 300.0, 300.0, 80.0, 80.0, 80.0),
+                stiffness=(1500.0, "k_across", 300.0, 80.0, 80.0, 80.0),
             ),
             TimeAbove("t_lateral") | roi,
             "sideways until constrained",
@@ -228,19 +262,25 @@ def _insert_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
 
 def _transitions() -> tuple[Transition, ...]:
     """approach -> contact -> lateral -> (constrained) align -> insert."""
+    at_wall = DepthAbove("wall_depth") | XBelow("wall_x")
     constrained = Any_(
         (
             TimeAbove("t_settle") & ForceAbove("f_lateral", axis="-x"),
+            TimeAbove("t_settle") & ForceAbove("f_lateral_rev", axis="+x") & at_wall,
             DepthAbove("drop_depth"),
-            TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1),
+            TimeAbove(0.2) & SpeedBelow("v_still", duration=0.1) & at_wall,
         )
     )
-    return (
-        Transition("approach", "contact", Done() & RemainingBelow(0.001)),
-        Transition("contact", "lateral", ForceAbove("f_contact", axis="+z")),
-        Transition("lateral", "align", constrained),
-        Transition("align", "insert", Done()),
-    )
+    return tuple(
+        t
+        for sfx, nxt in (("", "_2"), ("_2", "_3"), ("_3", None))
+        for t in (
+            Transition("approach" + sfx, "contact" + sfx, Done() & RemainingBelow(0.001)),
+            Transition("contact" + sfx, "lateral" + sfx, ForceAbove("f_contact", axis="+z")),
+            Transition("lateral" + sfx, "align", constrained),
+            *((Transition("lateral" + sfx, "approach" + nxt, XBelow("-pass_end")),) if nxt else ()),
+        )
+    ) + (Transition("align", "insert", Done()),)
 
 
 def _recovery(fast: _Speeds) -> Node:
@@ -299,7 +339,9 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
 
 def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     """Context for ``task``: estimated hole pose, goal depth, approach height above the
-    surface, part symmetry; overrides from a task's optional ``skill_context`` mapping, the
+    surface, part symmetry; for a task that knows its fit a low-rim-first lateral move
+    (:mod:`teachfit.skills.fit_context`); overrides from a task's optional ``skill_context``
+    mapping, the
     learned parameters its optional ``skill_fixed`` mapping fixes and the ``(low, high)``
     domains its optional ``skill_domains`` mapping gives."""
     hole = task.hole2world
@@ -315,11 +357,18 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
         "drop_depth": 0.001 - above,  # 1 mm below the surface around the hole
         "rz_period": float(getattr(task, "rz_period", 0.0) or 0.0),
     }
+    fit = fit_of(task)
+    fit_domains: dict[str, ParamDomain] = {}
+    if fit is not None:
+        defaults = {n: p.value for n, p in CONTEXT.items()}
+        speed_low = LEARNED["speed_factor"].domain.low
+        fit_values, fit_domains = fit_context(fit, defaults, speed_low, LEARNED["tilt"].domain)
+        values.update(fit_values)
     values.update(dict(getattr(task, "skill_context", {}) or {}))
     goal = hole.compose(Pose(np.array([0.0, 0.0, -float(task.success_depth)])))
     fixed = {k: float(v) for k, v in (getattr(task, "skill_fixed", {}) or {}).items()}
     bounds = getattr(task, "skill_domains", {}) or {}
-    domains = {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
+    domains = fit_domains | {k: ParamDomain(float(lo), float(hi)) for k, (lo, hi) in bounds.items()}
     bound = f"task {task.name} bounds it: a task parameter widens it (teachfit tasks)"
     return HoleContext(est, goal, values, fixed, domains, bound)
 

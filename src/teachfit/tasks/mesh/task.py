@@ -173,6 +173,27 @@ class MeshTask(SkillTask):
         return self.cell.fit.detection_radius
 
     @property
+    def clearance(self) -> float:
+        """The fit's clearance per side (m)."""
+        return self.cell.fit.clearance
+
+    @property
+    def part_half_width(self) -> float:
+        """The held part's half width along the task x (m): its largest ``|x|`` (TCP frame)
+        over the length that enters the hole."""
+        verts = self.cell.held.vertices
+        body = verts[verts[:, 2] <= verts[:, 2].min() + self.hole_depth]
+        return float(np.abs(body[:, 0]).max())
+
+    @property
+    def tip_chamfer(self) -> float:
+        """How much narrower along x (m) the held part's tip face is than its body (0: a sharp
+        edge)."""
+        verts = self.cell.held.vertices
+        tip = verts[verts[:, 2] <= verts[:, 2].min() + 1e-6]
+        return max(0.0, self.part_half_width - float(np.abs(tip[:, 0]).max()))
+
+    @property
     def rz_tolerance(self) -> float:
         return self.cell.fit.rz_tolerance
 

@@ -1,0 +1,87 @@
+"""The peg-in-hole context a fit gives (skills/fit_context.py), and what built-in tasks keep."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from teachfit.core.errors import SkillError
+from teachfit.core.params import ParamDomain
+from teachfit.skills import peg_in_hole
+from teachfit.skills.fit_context import NEVER, FitGeometry, fit_context
+from teachfit.tasks.registry import get_task
+
+DEFAULTS = {n: p.value for n, p in peg_in_hole.CONTEXT.items()}
+TILT = ParamDomain(0.0, 0.3)
+
+
+def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_light_press() -> None:
+    # the round-peg example: r = 4 mm, c = 0.1 mm, no chamfer, sigma = 0.5 mm
+    values, domains = fit_context(FitGeometry(0.004, 1e-4, 0.0, 5e-4), DEFAULTS, 0.25, TILT)
+    start = 0.004 + 0.0041 + 3 * 5e-4
+    assert values["lateral_dir"] == -1.0
+    assert values["lateral_offset"] == pytest.approx(-start)
+    assert values["pass_y"] == pytest.approx(0.001) and values["pass_end"] == pytest.approx(0.0041)
+    assert values["roi"] == pytest.approx(math.hypot(start, 0.001) + 0.001)
+    assert values["k_across"] == 0.0
+    assert values["f_lateral"] == NEVER
+    assert values["f_lateral_rev"] == pytest.approx(2 * DEFAULTS["f_lateral"])
+    assert values["wall_depth"] == 0.0 and values["wall_x"] == pytest.approx(1e-4 + 1.5e-3)
+    assert values["f_push"] == pytest.approx(0.5 * DEFAULTS["f_push"])
+    t_lateral = (start + 0.0041) / (DEFAULTS["v_lateral"] * 0.25)
+    assert values["t_lateral"] == pytest.approx(t_lateral)
+    extra = t_lateral - DEFAULTS["t_lateral"] + 2 * (t_lateral + 1.0)
+    assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + extra)
+    assert domains["tilt"].high == pytest.approx(math.acos(0.004 / 0.0041))  # 0.22 rad
+
+
+def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() -> None:
+    values, domains = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4), DEFAULTS, 0.25, TILT)
+    assert values["f_push"] == DEFAULTS["f_push"]
+    assert values["lateral_offset"] == pytest.approx(-(0.005 + 0.0055 + 6e-4))
+    assert math.acos(0.0045 / 0.0055) > 0.3  # the fit allows more than the skill's own
+    assert domains["tilt"].high == 0.3
+    # a top that ends nearer: the start stays over it
+    near, _ = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4, 0.008), DEFAULTS, 0.25, TILT)
+    assert near["lateral_offset"] == -0.008
+    # a short move: t_lateral stays at its default
+    short, _ = fit_context(FitGeometry(0.001, 5e-4, 0.0, 0.0), DEFAULTS, 0.25, TILT)
+    assert short["t_lateral"] == DEFAULTS["t_lateral"]
+    assert short["t_max"] == pytest.approx(DEFAULTS["t_max"] + 2 * (DEFAULTS["t_lateral"] + 1.0))
+
+
+@pytest.mark.parametrize(
+    "args", [(0.0, 1e-4, 0.0, 0.0), (0.004, -1e-4, 0.0, 0.0), (0.004, 0.0, 0.004, 0.0)]
+)
+def test_an_impossible_fit_is_an_error(args: tuple[float, float, float, float]) -> None:
+    with pytest.raises(SkillError, match="fit:"):
+        FitGeometry(*args)
+
+
+@pytest.mark.parametrize("name", ["peg2d", "socket3d", "peg", "key", "puzzle"])
+def test_built_in_tasks_keep_johannsmeier_s_context(name: str) -> None:
+    ctx = peg_in_hole.hole_context(get_task(name), np.random.default_rng(0))
+    assert "pass_end" not in ctx.values  # 1 m: no extra pass is ever taken
+    for key in (
+        "lateral_dir",
+        "lateral_offset",
+        "roi",
+        "k_across",
+        "wall_depth",
+        "wall_x",
+        "pass_y",
+    ):
+        assert key not in ctx.values
+    assert "tilt" not in ctx.domains
+
+
+def test_the_round_peg_example_gives_its_fit(mesh_examples: dict[str, str]) -> None:
+    task = get_task(mesh_examples["round-peg"])
+    assert task.part_half_width == pytest.approx(0.004)
+    assert task.clearance == pytest.approx(1e-4, rel=0.01)
+    assert task.tip_chamfer == 0.0
+    ctx = peg_in_hole.hole_context(task, np.random.default_rng(0))
+    assert ctx.values["lateral_dir"] == -1.0
+    assert ctx.values["lateral_offset"] == pytest.approx(-(0.004 + 0.0041 + 0.0015), abs=1e-6)
