@@ -54,3 +54,19 @@ def test_a_reflex_is_recovered_and_its_execution_run_once_more() -> None:
     ticks[0] = 0
     first = trial.run(None, trial.setup.starts[0])
     assert first.reflex and first.outcome is Outcome.FAULT and "cartesian_reflex" in first.reason
+
+
+def test_a_skill_without_a_context_parameter_the_task_gives_still_sets_up(tmp_path) -> None:
+    """A mesh task's fit gives context parameters (``pass_end``, ``k_across``, ...) that a skill
+    written without them (a user's older skill file; here the built-in tilted search) does not
+    declare: the skill sets up on the task and takes the context it has."""
+    from teachfit.skills.library import get_skill
+    from teachfit.tasks.mesh.examples import write_example
+    from teachfit.tasks.registry import load_task
+
+    write_example("round-peg", tmp_path)
+    task = load_task(str(tmp_path / "round-peg.toml"))
+    old = get_skill("tilted-search", "adaptive")
+    assert "pass_end" not in old.params.context
+    setup = peg_in_hole_setup(task, seed=0, n_starts=1, skill=old)
+    assert setup.skill.params.context == old.params.context  # none it does not declare

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -28,6 +28,8 @@ from teachfit.skills import peg_in_hole
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.graph import Skill
 from teachfit.tasks.base import Task
+
+V = TypeVar("V")
 
 
 @dataclass(frozen=True)
@@ -69,13 +71,22 @@ def peg_in_hole_setup(
     deviate = getattr(task.protocol, "start_frames", None)
     frames = tuple(deviate(ctx.hole2world_est, starts)) if callable(deviate) else ()
     return SkillSetup(
-        base.with_context(ctx.values).with_fixed(ctx.fixed).with_domains(ctx.domains, ctx.bound),
+        base.with_context(_known(ctx.values, base.params.context))
+        .with_fixed(ctx.fixed)
+        .with_domains(_known(ctx.domains, base.params.learned), ctx.bound),
         task,
         ctx.hole2world_est,
         ctx.goal2world,
         tuple(starts),
         frames,
     )
+
+
+def _known(values: Mapping[str, V], names: Mapping[str, object]) -> dict[str, V]:
+    """The task's values for the skill's parameters ``names``: a skill written without a
+    parameter the task's fit gives (a user's older skill file) runs without it; the task
+    gives context and domains, the skill takes those it has."""
+    return {k: v for k, v in values.items() if k in names}
 
 
 @dataclass(frozen=True)
