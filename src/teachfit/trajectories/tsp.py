@@ -145,8 +145,9 @@ def _compiled(
 
 def _default_kicks(n: int) -> int:
     """Kicks of the iterated local search: max(5 N, 1500) up to 300 points (≈ 20-30 ms, no LK
-    chains, Or-opt of any segment), then 3 N (N / 300)^0.75 (measured in benchmarks/search_speed.py: larger sets need more kicks
-    per point to stay within 1 % of LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
+    chains, Or-opt of any segment), then 3 N (N / 300)^0.75 (measured in
+    benchmarks/search_speed.py: larger sets need more kicks per point to stay within 1 % of
+    LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
     if n <= _LK_FROM:
         return max(5 * n, _MIN_KICKS)
     return int(round(3 * n * (n / _LK_FROM) ** 0.75))
