@@ -106,3 +106,19 @@ def test_lin_kernighan_chains_keep_a_valid_near_optimal_tour(monkeypatch):
     assert sorted(a.order.tolist()) == list(range(150))
     assert a.length == pytest.approx(path_length(np.zeros(3), pts, a.order))
     assert a.length <= 1.02 * open_tour(pts, solver="lkh").length
+
+
+#: LKH-3 (elkai, RUNS=1) open-tour lengths of the instances of ``benchmarks/search_speed.py
+#: --part tsp`` (``_points(family, n, default_rng((0, i, n)))``) on which the solver was
+#: furthest from LKH before Or-opt of any segment (1.0255 and 1.0187)
+_LKH = {("gaussian", 300, 7): 0.5780632135642297, ("gaussian", 100, 2): 0.305350695024383}
+
+
+@pytest.mark.parametrize("key", list(_LKH))
+def test_formerly_worst_instances_are_within_1_percent_of_lkh(key):
+    family, n, i = key
+    assert family == "gaussian"
+    pts = np.random.default_rng((0, i, n)).normal(0.0, 0.01, (n, 2))  # _points("gaussian", ...)
+    r = open_tour(pts)
+    assert sorted(r.order.tolist()) == list(range(n))
+    assert r.length <= 1.01 * _LKH[key]

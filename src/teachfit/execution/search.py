@@ -25,9 +25,9 @@ from teachfit.robot.interface import Robot
 from teachfit.skills.follow import FollowConfig
 from teachfit.skills.tilt import TiltConfig, rim_lead, tilted_drop, wedge_lag
 from teachfit.tasks.base import Task
-from teachfit.trajectories import SearchTrajectory, TshixPlanner, ergodic_trajectory
+from teachfit.trajectories import SearchTrajectory, TshixPlanner
 from teachfit.trajectories.baselines import archimedean_spiral, random_walk
-from teachfit.trajectories.ergodic_opt import optimise_ergodic
+from teachfit.trajectories.ergodic_opt import ergodic_search
 
 METHODS = ("tshix", "ergodic", "ergodic-opt", "spiral", "random-walk")
 _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rz": 5}
@@ -135,8 +135,9 @@ def plan_search(
 
     ``n_points``: TSHIX samples, or random-walk steps; an ergodic trajectory is as long as
     ``length`` (m, rz weighted by the planner's length scale) or as a TSHIX pass through
-    ``n_points`` samples; ``"ergodic-opt"`` then lowers its ergodic metric by trajectory
-    optimisation (:func:`~teachfit.trajectories.ergodic_opt.optimise_ergodic`). ``sampling``
+    ``n_points`` samples: spectral coverage, then trajectory optimisation at that length
+    (:func:`~teachfit.trajectories.ergodic_opt.ergodic_search`; ``"ergodic-opt"`` with five
+    times the optimiser's iterations). ``sampling``
     is TSHIX's sampler (``"qmc"`` or Ehlers et al.'s i.i.d. ``"random"``). The baselines span the
     exploration distribution's 2-sigma radius (and, for rz, its 2-sigma rz range).
 
@@ -176,21 +177,19 @@ def _plan_ergodic(
     sampling: str,
 ) -> SearchTrajectory:
     """An ergodic trajectory of ``length`` (by default a TSHIX pass's through ``n_points``
-    samples), optimised for ``"ergodic-opt"``."""
+    samples), by :func:`~teachfit.trajectories.ergodic_opt.ergodic_search`."""
     if length is None:
         planner = TshixPlanner.from_model(model, sampling=sampling)
         length = planner.plan(n_points, rng).path_length(cast(float, planner.length_scale))
-    traj = ergodic_trajectory(
+    # ergodic-opt: the same optimisation, five times the iterations
+    return ergodic_search(
         model.exploration,
         speed=model.speed,
         length=length,
         angular_speed=model.angular_speed,
         start=np.zeros(len(model.dims)),
-    )
-    if method == "ergodic":
-        return traj
-    return optimise_ergodic(
-        traj, model.exploration, speed=model.speed, angular_speed=model.angular_speed
+        iterations=200 if method == "ergodic" else 1000,
+        method=method,
     )
 
 

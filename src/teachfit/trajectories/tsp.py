@@ -5,7 +5,8 @@ zero distance from every node and the edge ``(dummy, start)`` may never be remov
 tour ``start → p_1 → … → p_N → dummy → start`` then costs exactly the open path.
 
 ``solver="fast"`` (default): nearest-neighbour construction, then the compiled local search
-of :mod:`teachfit.trajectories.tsp_kernel` (2-opt, Or-opt and Lin-Kernighan chains over the
+of :mod:`teachfit.trajectories.tsp_kernel` (2-opt, Or-opt (of any segment up to 300 points)
+and Lin-Kernighan chains over the
 nearest and Delaunay neighbours from ``scipy.spatial``, then a fixed number of seeded
 double-bridge kicks; why it is written here is said there). ``solver="lkh"`` calls LKH-3
 through ``elkai`` (slow, the reference quality of the benchmark).
@@ -110,6 +111,8 @@ _DEPTH, _BREADTH = 3, 1  # Lin-Kernighan chain: flips at most, alternatives at i
 # up to this many points the chain is off and the kicks are 5 N: as close to LKH as 3 N kicks
 # with chains, in half the time (300 points, benchmarks/search_speed.py)
 _LK_FROM = 300
+#: at least this many kicks (small sets: 1500 kicks of 100 points take about 15 ms)
+_MIN_KICKS = 1500
 
 
 def _compiled(
@@ -135,16 +138,18 @@ def _compiled(
         _THRESHOLD * d0,
         _DEPTH if x.shape[0] - 1 > _LK_FROM else 0,
         _BREADTH,
+        x.shape[0] - 1 <= _LK_FROM,
     )
     return [int(v) for v in out]
 
 
 def _default_kicks(n: int) -> int:
-    """Kicks of the iterated local search: 5 N up to 300 points (≈ 20-30 ms, no LK chains),
-    then 3 N (N / 300)^0.75 (measured in benchmarks/search_speed.py: larger sets need more kicks
-    per point to stay within 1 % of LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
+    """Kicks of the iterated local search: max(5 N, 1500) up to 300 points (≈ 20-30 ms, no LK
+    chains, Or-opt of any segment), then 3 N (N / 300)^0.75 (measured in
+    benchmarks/search_speed.py: larger sets need more kicks per point to stay within 1 % of
+    LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
     if n <= _LK_FROM:
-        return 5 * n
+        return max(5 * n, _MIN_KICKS)
     return int(round(3 * n * (n / _LK_FROM) ** 0.75))
 
 
@@ -192,8 +197,8 @@ def open_tour(
     n_neighbours : int
         Candidate-list size K of the local search.
     n_kicks : int, optional
-        Iterated-local-search kicks; default ``5 N`` up to 300 points (≈ 20-30 ms CPU for
-        N = 300), ``3 N (N / 300)^0.75`` beyond. A fixed count,
+        Iterated-local-search kicks; default ``max(5 N, 1500)`` up to 300 points (≈ 20-30 ms
+        CPU), ``3 N (N / 300)^0.75`` beyond. A fixed count,
         not a time budget: the same input gives the same tour on every machine.
     lkh_runs : int
         LKH ``RUNS`` parameter.

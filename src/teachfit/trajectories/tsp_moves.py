@@ -256,3 +256,56 @@ def _lk_node(
             for r in range(best_k - 1, -1, -1):
                 _reverse(tour, pos, flips[r, 0], flips[r, 1])
     return 0.0, 0
+
+
+@njit(cache=True)
+def _insertion_gain(
+    x: np.ndarray, tour: np.ndarray, b: int, p: int, q: int, dummy: int
+) -> tuple[float, bool]:
+    """Gain of putting the segment ``b..p`` between ``tour[q]`` and ``tour[q+1]``, the better
+    way round, and whether that is reversed (``p..b``)."""
+    left, right = tour[q], tour[q + 1]
+    old = _d(x, left, right, dummy)
+    fwd = old - _d(x, left, b, dummy) - _d(x, p, right, dummy)
+    rev = old - _d(x, left, p, dummy) - _d(x, b, right, dummy)
+    return (rev, True) if rev > fwd else (fwd, False)
+
+
+# Long on purpose (> 60 lines): compiled candidate scan of one move kind; its gains share the
+# locals of the two loops.
+@njit(cache=True)
+def _or_segment(
+    x: np.ndarray, neigh: np.ndarray, tour: np.ndarray, pos: np.ndarray, a: int, eps: float
+) -> tuple[float, int, int]:
+    """Or-opt of a segment of any length: the segment ``S = tour[i+1..j-1]`` between ``a =
+    tour[i]`` and a candidate ``c = tour[j]`` of ``a`` is cut out (``a`` joined to ``c``) and
+    put, either way round, next to a candidate of its first or last node. Applies the first
+    improving one; returns (gain, lo, hi) like :func:`_move_segment` (gain 0: none)."""
+    m = tour.shape[0]
+    dummy = m - 1
+    i = pos[a]
+    if i > m - 3:
+        return 0.0, 0, 0
+    b = tour[i + 1]
+    dab = _d(x, a, b, dummy)
+    for c in neigh[a]:
+        j = pos[c]
+        if j <= i + 1 or j > m - 1:
+            continue
+        dac = _d(x, a, c, dummy)
+        if dab - dac <= eps:
+            break
+        p = tour[j - 1]
+        g1 = dab + _d(x, p, c, dummy) - dac
+        for end in range(2):
+            v = b if end == 0 else p
+            for e in neigh[v]:
+                q0 = pos[e]
+                for q in (q0 - 1, q0):
+                    if q < 0 or q > m - 2 or (i <= q <= j - 1):
+                        continue
+                    g2, flip = _insertion_gain(x, tour, b, p, q, dummy)
+                    if g1 + g2 > eps:
+                        lo, hi = _move_segment(tour, pos, i + 1, j - 1, q, flip)
+                        return g1 + g2, lo, hi
+    return 0.0, 0, 0
