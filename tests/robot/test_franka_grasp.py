@@ -16,7 +16,7 @@ def test_a_part_released_from_the_fingers_is_lost_at_the_next_check(franka_sim: 
 
     watch, why = connect_gripper(pf, "127.0.0.1")
     assert watch is not None and why == ""
-    hand = pf.Gripper("127.0.0.1")
+    hand = watch.gripper  # a hand serves one client: commands go through the same connection
     width = hand.read_once().width
     # "grasp" at the width the fingers are at (the simulated hand holds no object): grasped
     assert hand.grasp(width, 0.05, 20.0, 0.005, 0.005)
@@ -33,10 +33,10 @@ def test_a_hand_holding_nothing_at_the_start_is_not_watched(franka_sim: object) 
 
     from teachfit.robot.franka.grasp import connect_gripper
 
-    hand = pf.Gripper("127.0.0.1")
-    hand.move(hand.read_once().max_width, 0.1)  # open: nothing grasped
     watch, _ = connect_gripper(pf, "127.0.0.1")
     assert watch is not None
+    hand = watch.gripper
+    hand.move(hand.read_once().max_width, 0.1)  # open: nothing grasped
     watch.check()
     assert not watch.active and "the grasp is not watched" in watch.note
     watch.check()  # off: never raises

@@ -82,3 +82,33 @@ def test_a_second_server_is_refused_while_the_port_is_taken(franka_sim: object) 
     with pytest.raises(ConnectionLost, match="taken"):
         second.start()
     assert second.pid is None  # nothing was started
+
+
+def _running(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, ended and waiting to be reaped, does not)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+    except (FileNotFoundError, IndexError):
+        return False
+
+
+def test_a_simulator_ends_with_the_process_that_started_it_even_when_killed(
+    robot_port: int,
+) -> None:
+    """The starter SIGKILLed (no clean-up runs): the kernel stops its simulator, no orphan."""
+    import time
+
+    code = (
+        "import time\nfrom teachfit.robot.franka.sim import SimServer\n"
+        "s = SimServer().start()\nprint(s.pid, flush=True)\ntime.sleep(600)\n"
+    )
+    starter = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert starter.stdout is not None
+    sim_pid = int(starter.stdout.readline())
+    assert _running(sim_pid)
+    starter.kill()
+    starter.wait()
+    deadline = time.monotonic() + 30
+    while _running(sim_pid) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert not _running(sim_pid), "the simulator outlived the process that started it"

@@ -31,8 +31,6 @@ finish (or their process dies and it claims them).
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import logging
 import math
 import multiprocessing
@@ -48,6 +46,7 @@ from typing import Any
 
 from teachfit.core.errors import NeedsAPerson
 from teachfit.core.params import LearningError
+from teachfit.core.process import die_with_parent
 from teachfit.learning.base import Candidate, TrialResult
 from teachfit.learning.study import Study, TrialRecord
 
@@ -117,22 +116,6 @@ def cap_workers(requested: int | None, left: int, cpus: int | None = None) -> tu
         f"{requested} workers asked: using {n} ({left} trial(s) left, "
         f"{cpus} core(s), at most one worker per trial and {WORKERS_PER_CPU} per core)"
     )
-
-
-_PR_SET_PDEATHSIG = 1
-
-
-def die_with_parent(parent: int | None = None) -> bool:
-    """Have the kernel SIGKILL this process when its parent dies (Linux ``prctl``); exit at
-    once if ``parent`` (the expected parent PID) is already gone. False where unsupported."""
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        ok = libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
-    except (OSError, AttributeError):
-        ok = False
-    if parent is not None and os.getppid() != parent:
-        os._exit(1)  # the parent died before the request took effect
-    return ok
 
 
 def _worker_init(parent: int | None) -> None:

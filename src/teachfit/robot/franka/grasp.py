@@ -37,7 +37,8 @@ class GraspWatch:
     """
 
     def __init__(self, gripper: Any, tolerance: float = 0.002) -> None:
-        self._gripper = gripper
+        #: the connected hand (one connection per hand: commands go through it too)
+        self.gripper = gripper
         self.tolerance = tolerance
         self.reference: float | None = None
         self.active = True
@@ -48,7 +49,7 @@ class GraspWatch:
         when the part is gone."""
         if not self.active:
             return
-        state = self._gripper.read_once()
+        state = self.gripper.read_once()
         width, held = float(state.width), bool(state.is_grasped)
         if self.reference is None:
             if not held:
@@ -74,15 +75,34 @@ GRIPPER_PORT = 1338
 
 
 def connect_gripper(pf: Any, host: str, timeout: float = 1.0) -> tuple[GraspWatch | None, str]:
-    """A :class:`GraspWatch` on the hand at ``host``, or ``None`` and why not (no hand
-    answers on the gripper port within ``timeout`` s, or its connect failed)."""
+    """A :class:`GraspWatch` on the hand at ``host``, or ``None`` and why not: no hand answers
+    on the gripper port, or its connect does not finish within ``timeout`` s (a hand serves
+    one client: another program holding it makes libfranka's connect wait for ever; the
+    waiting thread is then left behind, a daemon)."""
     import socket
+    import threading
 
     try:
         socket.create_connection((host, GRIPPER_PORT), timeout=timeout).close()
-        return GraspWatch(pf.Gripper(host)), ""
-    except (OSError, RuntimeError, pf.NetworkException) as exc:
+    except OSError as exc:
         return (
             None,
             f"no gripper answers at {host}:{GRIPPER_PORT} ({exc}): the grasp is not watched",
         )
+    got: list[Any] = []
+
+    def connect() -> None:
+        try:
+            got.append(pf.Gripper(host))
+        except (RuntimeError, pf.NetworkException) as exc:
+            got.append(exc)
+
+    worker = threading.Thread(target=connect, name="gripper-connect", daemon=True)
+    worker.start()
+    worker.join(timeout)
+    if not got or isinstance(got[0], Exception):
+        why = (
+            f"({got[0]})" if got else f"(no answer within {timeout:g} s: another client holds it?)"
+        )
+        return None, f"the gripper at {host} did not connect {why}: the grasp is not watched"
+    return GraspWatch(got[0]), ""

@@ -127,7 +127,14 @@ def main(argv: list[str] | None = None) -> None:
     """Run franky-sim (MuJoCo, one FR3) on 127.0.0.1 until SIGTERM/SIGINT."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--push-file", type=Path, default=None)
+    parser.add_argument(
+        "--parent", type=int, default=None, help="end with this process (the one that started it)"
+    )
     args = parser.parse_args(argv)
+    if args.parent is not None:  # SIGTERM (a clean stop) if the starter dies without stopping us
+        from teachfit.core.process import die_with_parent
+
+        die_with_parent(args.parent, signal.SIGTERM)
     if not _port_free(HOST, ROBOT_PORT):
         _refuse(PORT_TAKEN)
     confine_to_loopback()
@@ -185,7 +192,7 @@ class SimServer:
         """Start the server process and wait until it listens (it prints READY)."""
         if not _port_free(HOST, ROBOT_PORT):
             raise ConnectionLost(f"{HOST}:{ROBOT_PORT} is taken: another Franka server runs")
-        cmd = [sys.executable, "-m", "teachfit.robot.franka.sim"]
+        cmd = [sys.executable, "-m", "teachfit.robot.franka.sim", "--parent", str(os.getpid())]
         if self.push_file is not None:
             cmd += ["--push-file", str(self.push_file)]
         self.proc = subprocess.Popen(
