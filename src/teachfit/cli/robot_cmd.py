@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Annotated
 
@@ -85,6 +85,50 @@ def check(
         )
     for line in result.lines():
         console.print(line, markup=False, highlight=False)
+
+
+@robot_app.command("twin")
+@guarded
+def twin(
+    task: Annotated[str, o.task()] = "peg",
+    host: Annotated[str, typer.Option(help="loopback address to listen on")] = "127.0.0.1",
+    seed: Annotated[int, o.seed("the sensors' noise and offsets")] = 0,
+    realtime: Annotated[
+        bool,
+        typer.Option(
+            help="step at 1 kHz whatever the client does (a late client violates the "
+            "communication constraint); --no-realtime: in lock-step with a client without a "
+            "real-time kernel"
+        ),
+    ] = True,
+) -> None:
+    """A digital twin of a Franka: the task's FR3 cell (the part in the hand) behind
+    libfranka's protocol on 127.0.0.1, with the firmware's wrench estimate, reflexes and
+    limits. Runs until Ctrl-C or SIGTERM; connect with --robot franka --host 127.0.0.1."""
+    from teachfit.robot.franka.twin import TwinParams, check_host, serve
+    from teachfit.tasks import get_task
+
+    check_host(host)
+    cell = get_task(task)
+    try:
+        serve(cell, host, TwinParams(seed=seed), realtime=realtime, ready=_twin_ready(task))
+    except KeyboardInterrupt:
+        err_console.print("twin stopped (Ctrl-C)")
+    except SystemExit:  # SIGTERM (teachfit's CLI): its status, 143
+        err_console.print("twin stopped (SIGTERM)")
+        raise
+
+
+def _twin_ready(task: str) -> Callable[[str], None]:
+    def ready(host: str) -> None:
+        console.print(
+            f"Franka twin of task {task!r} listening on {host} (libfranka's protocol); "
+            "stop with Ctrl-C",
+            markup=False,
+            highlight=False,
+        )
+
+    return ready
 
 
 @guarded

@@ -128,7 +128,7 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--push-file", type=Path, default=None)
     args = parser.parse_args(argv)
-    if not _port_free(HOST, ROBOT_PORT):
+    if not port_free(HOST, ROBOT_PORT):
         _refuse(PORT_TAKEN)
     confine_to_loopback()
     import franky_sim
@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> None:
                 franky_sim.SimulationServer(sim, hostname_candidates=[HOST])
             )
         except OSError as exc:  # taken since the check above, or another bind failure
-            _refuse(PORT_TAKEN if not _port_free(HOST, ROBOT_PORT) else f"cannot listen: {exc}")
+            _refuse(PORT_TAKEN if not port_free(HOST, ROBOT_PORT) else f"cannot listen: {exc}")
         if args.push_file is not None:
             _install_push(sim, robot, args.push_file)
         print(f"{READY} {robot.hostname}", flush=True)  # listening since the init
@@ -163,6 +163,10 @@ class SimServer:
         Seconds to wait for the server to print that it is ready and accept on port 1337.
     """
 
+    #: the line the server prints once it listens; what it is, for messages
+    ready = READY
+    what = "franky-sim"
+
     def __init__(self, push_file: Path | None = None, startup_timeout: float = 60.0) -> None:
         self.push_file = push_file
         self.startup_timeout = startup_timeout
@@ -176,20 +180,17 @@ class SimServer:
         try:
             for line in out:
                 self.log.append(line)
-                if line.startswith(READY):
+                if line.startswith(self.ready):
                     self._ready.set()
         except (OSError, ValueError):  # closed by stop()
             pass
 
     def start(self) -> SimServer:
         """Start the server process and wait until it listens (it prints READY)."""
-        if not _port_free(HOST, ROBOT_PORT):
+        if not port_free(HOST, ROBOT_PORT):
             raise ConnectionLost(f"{HOST}:{ROBOT_PORT} is taken: another Franka server runs")
-        cmd = [sys.executable, "-m", "teachfit.robot.franka.sim"]
-        if self.push_file is not None:
-            cmd += ["--push-file", str(self.push_file)]
         self.proc = subprocess.Popen(
-            cmd,
+            self.command(),
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
@@ -206,8 +207,15 @@ class SimServer:
         # accept the probe as its one client and make the real client's connect time out.
         if not self._ready.is_set():
             self.stop()
-            raise ConnectionLost("franky-sim did not start:\n" + "".join(list(self.log)[-20:]))
+            raise ConnectionLost(f"{self.what} did not start:\n" + "".join(list(self.log)[-20:]))
         return self
+
+    def command(self) -> list[str]:
+        """The server's command line."""
+        cmd = [sys.executable, "-m", "teachfit.robot.franka.sim"]
+        if self.push_file is not None:
+            cmd += ["--push-file", str(self.push_file)]
+        return cmd
 
     @property
     def pid(self) -> int | None:
@@ -243,7 +251,7 @@ class SimServer:
         self.stop()
 
 
-def _port_free(host: str, port: int) -> bool:
+def port_free(host: str, port: int) -> bool:
     """Whether nothing listens on ``host:port`` (a bind test: a probe connection would be
     taken by a franky-sim as its client)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
