@@ -190,7 +190,18 @@ def test_robot_twin_bad_input_is_one_line_and_status_2(args: list[str], message:
     assert message in " ".join(res.output.split()), res.output
 
 
-def test_robot_twin_stops_on_sigterm_with_nothing_left(robot_port: int) -> None:
+def _default_sigint() -> None:
+    # as at a terminal: a runner that started the tests in the background left SIGINT ignored
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.mark.parametrize(
+    ("sig", "status", "said"),
+    [(signal.SIGTERM, 143, "twin stopped (SIGTERM)"), (signal.SIGINT, 130, "(Ctrl-C)")],
+)
+def test_robot_twin_stops_on_sigterm_and_ctrl_c_with_nothing_left(
+    robot_port: int, sig: int, status: int, said: str
+) -> None:
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2] / "src")}
     proc = subprocess.Popen(
         [sys.executable, "-c", _MAIN, "robot", "twin", "--task", "peg", "--no-realtime"],
@@ -199,17 +210,19 @@ def test_robot_twin_stops_on_sigterm_with_nothing_left(robot_port: int) -> None:
         text=True,
         env=env,
         start_new_session=True,
+        preexec_fn=_default_sigint,
     )
     try:
         assert proc.stdout is not None
-        assert "listening on 127.0.0.1" in proc.stdout.readline()
-        os.killpg(proc.pid, signal.SIGTERM)
+        line = proc.stdout.readline()
+        assert "listening on 127.0.0.1" in line and f"PID {proc.pid}" in line, line
+        os.killpg(proc.pid, sig)
         _, err = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
-    assert proc.returncode == 143
-    assert "twin stopped (SIGTERM)" in err
+    assert proc.returncode == status, err
+    assert said in err
     with pytest.raises(ProcessLookupError):
         os.killpg(proc.pid, 0)  # no process of its group is left

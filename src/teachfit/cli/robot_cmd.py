@@ -114,18 +114,23 @@ def twin(
         serve(cell, host, TwinParams(seed=seed), realtime=realtime, ready=_twin_ready(task))
     except KeyboardInterrupt:
         err_console.print("twin stopped (Ctrl-C)")
+        raise typer.Exit(130) from None
     except SystemExit:  # SIGTERM (teachfit's CLI): its status, 143
         err_console.print("twin stopped (SIGTERM)")
         raise
 
 
 def _twin_ready(task: str) -> Callable[[str], None]:
+    import os
+
     def ready(host: str) -> None:
+        pid = os.getpid()
         console.print(
-            f"Franka twin of task {task!r} listening on {host} (libfranka's protocol); "
-            "stop with Ctrl-C",
+            f"Franka twin of task {task!r} listening on {host} (libfranka's protocol), "
+            f"PID {pid}; stop with Ctrl-C or kill {pid}",
             markup=False,
             highlight=False,
+            soft_wrap=True,
         )
 
     return ready

@@ -30,6 +30,7 @@ reflex! [...]"). A new motion is refused (``kCommandNotPossibleRejected``) until
 from __future__ import annotations
 
 import logging
+import select
 import time
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -183,6 +184,12 @@ class FirmwareServer(FrankaRobotServer):
         """A torque motion has commanded and no new command came this tick."""
         return self.torque_mode and self.commanded and not self.fresh
 
+    def wait_for_command(self, timeout: float) -> None:
+        """Block until the client's UDP socket has data (a command) or ``timeout`` s pass."""
+        sock = self._FrankaServer__udp_socket  # franky-sim's per-client UDP socket
+        if sock is not None:
+            select.select([sock], [], [], timeout)
+
     def _pre_process_commands(self) -> None:
         super()._pre_process_commands()
         self.fresh = False
@@ -318,7 +325,7 @@ class TwinSimulationServer(SimulationServer):
         assert twin is not None, "init() first"
         twin.process_commands()
         if not self.realtime and twin.awaiting_command():
-            time.sleep(2e-4)  # the client is late: wait for it, the physics does not move
+            twin.wait_for_command(0.01)  # the client is late: wait, the physics does not move
             return
         self.sim.step()
         twin.tick_done()
