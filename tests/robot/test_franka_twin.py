@@ -168,6 +168,8 @@ def test_a_client_that_stops_commanding_violates_the_communication_constraint(
         for _ in range(50):
             state, _ = control.readOnce()
             control.writeOnce(pf.Torques([0.0] * 7))
+    # 21 of the motion's last 100 ticks went without a command
+    assert robot.read_once().control_command_success_rate == pytest.approx(0.79, abs=0.011)
 
 
 _MAIN = "from teachfit.cli import main; main()"

@@ -187,8 +187,8 @@ class SimServer:
 
     def start(self) -> SimServer:
         """Start the server process and wait until it listens (it prints READY)."""
-        if not port_free(HOST, ROBOT_PORT):
-            raise ConnectionLost(f"{HOST}:{ROBOT_PORT} is taken: another Franka server runs")
+        if not port_free(self.host, ROBOT_PORT):
+            raise ConnectionLost(f"{self.host}:{ROBOT_PORT} is taken: another Franka server runs")
         self.proc = subprocess.Popen(
             self.command(),
             stdout=subprocess.PIPE,

@@ -75,13 +75,15 @@ def serve(
 
 
 def main(argv: list[str] | None = None) -> None:
-    """The twin as a process: ``--task NAME [--seed N] [--no-realtime] [--start DX DY DZ]``
+    """The twin as a process: ``--task NAME [--host ADDRESS] [--seed N] [--no-realtime]
+    [--start DX DY DZ]``
     (the TCP's start from the hole's contact pose, m); READY once it listens; SIGTERM/SIGINT
     end it. Bad input: one line on stderr, exit status 2."""
     from teachfit.tasks import get_task
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--task", required=True)
+    parser.add_argument("--host", default=HOST)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-realtime", action="store_true")
     parser.add_argument("--start", type=float, nargs=3, default=TwinParams.start)
@@ -90,6 +92,7 @@ def main(argv: list[str] | None = None) -> None:
     try:
         serve(
             get_task(args.task),
+            args.host,
             params=TwinParams(start=tuple(args.start), seed=args.seed),
             realtime=not args.no_realtime,
             ready=lambda host: print(f"{READY} {host}", flush=True),
@@ -113,13 +116,16 @@ class TwinProcess(SimServer):
         task: str = "peg",
         realtime: bool = False,
         start: tuple[float, float, float] = TwinParams.start,
+        host: str = HOST,
         startup_timeout: float = 120.0,
     ) -> None:
         super().__init__(startup_timeout=startup_timeout)
         self.task, self.realtime, self.start_offset = task, realtime, start
+        self.host = check_host(host)
 
     def command(self) -> list[str]:
         cmd = [sys.executable, "-m", "teachfit.robot.franka.twin", "--task", self.task]
+        cmd += ["--host", self.host]
         cmd += ["--start", *(repr(float(v)) for v in self.start_offset)]
         return cmd + ([] if self.realtime else ["--no-realtime"])
 

@@ -15,9 +15,13 @@
 * **limits** checked every tick of a motion: joint position and speed (the FR3 datasheet's,
   :mod:`teachfit.robot.fr3.params`), the commanded torque's rate (1000 N·m/s:
   ``controller_torque_discontinuity``), and the communication constraint: more than
-  ``max_missed`` consecutive ticks of a torque motion without a command from the client
+  ``max_missed`` (20) consecutive ticks of a torque motion without a command from the client
   (``communication_constraints_violation``; in real-time mode only, see
-  :class:`TwinSimulationServer`).
+  :class:`TwinSimulationServer`). The FCI documentation ("Minimum system and network
+  requirements") states that limit: 20 consecutive dropped packets stop the robot, and a
+  dropped controller packet reuses the last torques (as franky-sim does); the state's
+  ``control_command_success_rate`` is the share of the last 100 ticks of the motion that got
+  a command.
 
 Any of them aborts the running motion as the firmware does: the Move command is answered
 ``kReflexAborted``, the error is set in the state's ``errors`` and ``reflex_reason`` (libfranka's
@@ -160,6 +164,8 @@ class FirmwareServer(FrankaRobotServer):
         self._tau_prev = np.zeros(7)
         self._rate_exceeded = False
         self._stepped = False
+        self._received = np.ones(100, dtype=bool)  # the last 100 ticks: a command came
+        self._tick = 0
         self._o_f = np.zeros(6)
         self._k_f = np.zeros(6)
         self._tau_ext = np.zeros(7)
@@ -175,6 +181,7 @@ class FirmwareServer(FrankaRobotServer):
         self.torque_mode = self._FrankaRobotServer__control_mode == ControlMode.TORQUE
         self.missed, self.commanded, self._rate_exceeded = 0, False, False
         self._tau_prev = np.zeros(7)
+        self._received[:] = True
 
     def stop_motion(self, send_preemption_signal: bool = True) -> None:
         super().stop_motion(send_preemption_signal)
@@ -208,8 +215,10 @@ class FirmwareServer(FrankaRobotServer):
     def tick_done(self) -> None:
         """The physics stepped: count a tick the client missed; estimate and check anew."""
         self._stepped = True
-        if self.torque_mode and self.commanded and not self.fresh:
-            self.missed += 1
+        if self.torque_mode and self.commanded:
+            self._received[self._tick % len(self._received)] = self.fresh
+            self._tick += 1
+            self.missed = 0 if self.fresh else self.missed + 1
 
     def _post_process_commands(self) -> None:
         stepped, self._stepped = self._stepped, False
@@ -284,6 +293,7 @@ class FirmwareServer(FrankaRobotServer):
             errors=tuple(self.errors.tolist()),
             reflex_reason=tuple(self.reflex_reason.tolist()),
             robot_mode=RobotMode.kReflex if self.errors.any() else state.robot_mode,
+            control_command_success_rate=float(self._received.mean()),
         )
 
 
