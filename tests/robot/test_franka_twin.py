@@ -98,18 +98,26 @@ def test_pressing_down_reads_o_f_ext_hat_k_in_libfrankas_sign(franka_twin: Twin)
     assert tuple(state.cartesian_collision) == (0.0,) * 6  # under the 20 N default
 
 
-def test_a_low_cartesian_threshold_makes_a_push_a_reflex_that_recovery_clears(
-    franka_twin: Twin,
+@pytest.mark.parametrize(
+    ("torque", "force", "reflex", "other"),
+    [
+        ([20.0] * 7, [5.0] * 6, "cartesian_reflex", "joint_reflex"),
+        ([1.0] * 7, [20.0] * 6, "joint_reflex", "cartesian_reflex"),
+    ],
+)
+def test_a_low_threshold_makes_a_push_a_reflex_that_recovery_clears(
+    franka_twin: Twin, torque: list[float], force: list[float], reflex: str, other: str
 ) -> None:
     franka_twin(start=BESIDE_BOSS)
     robot, model = _client()
-    robot.set_collision_behavior([20.0] * 7, [20.0] * 7, [3.0] * 6, [5.0] * 6)
-    with pytest.raises(pf.ControlException, match="reflex.*cartesian_reflex"):
+    lower = [min(v, 3.0) for v in force]
+    robot.set_collision_behavior([min(v, 1.0) for v in torque], torque, lower, force)
+    with pytest.raises(pf.ControlException, match=f"reflex.*{reflex}"):
         _press(robot, model, force=10.0, ticks=1500)
     state = robot.read_once()
     assert state.robot_mode == pf.RobotMode.Reflex
-    assert state.current_errors.cartesian_reflex and state.last_motion_errors.cartesian_reflex
-    assert not state.current_errors.joint_reflex
+    assert getattr(state.current_errors, reflex) and getattr(state.last_motion_errors, reflex)
+    assert not getattr(state.current_errors, other)
     robot.set_collision_behavior([20.0] * 7, [20.0] * 7, [20.0] * 6, [20.0] * 6)
     robot.automatic_error_recovery()
     for _ in range(10):  # states sent before the recovery may still be in flight
@@ -117,7 +125,7 @@ def test_a_low_cartesian_threshold_makes_a_push_a_reflex_that_recovery_clears(
         if state.robot_mode != pf.RobotMode.Reflex:
             break
     assert state.robot_mode == pf.RobotMode.Idle
-    assert not state.current_errors.cartesian_reflex
+    assert not getattr(state.current_errors, reflex)
     # a new motion is accepted again and runs
     state = _press(robot, model, force=2.0, ticks=300)
     assert not state.current_errors
@@ -190,6 +198,33 @@ def test_robot_twin_bad_input_is_one_line_and_status_2(args: list[str], message:
     res = CliRunner().invoke(app, ["robot", "twin", *args])
     assert res.exit_code == 2, res.output
     assert message in " ".join(res.output.split()), res.output
+
+
+def _spin_wrist(robot: Any, step: float, peak: float, ticks: int) -> None:
+    """Torque-control joint 7 alone: ramp its torque by ``step`` N·m per tick up to ``peak``
+    (the other joints get no torque; franky-sim compensates gravity)."""
+    control = robot.start_torque_control()
+    control.readOnce()
+    tau = np.zeros(7)
+    for _ in range(ticks):
+        tau[6] = min(peak, tau[6] + step)
+        control.writeOnce(pf.Torques(tau.tolist()))
+        control.readOnce()
+
+
+def test_a_joint_over_its_speed_limit_aborts_the_motion(franka_twin: Twin) -> None:
+    franka_twin()
+    robot, _ = _client()
+    with pytest.raises(pf.ControlException, match="joint_velocity_violation"):
+        _spin_wrist(robot, step=0.9, peak=8.0, ticks=400)  # 5.26 rad/s is joint 7's limit
+    assert robot.read_once().current_errors.joint_velocity_violation
+
+
+def test_a_torque_step_over_the_rate_limit_is_a_discontinuity(franka_twin: Twin) -> None:
+    franka_twin()
+    robot, _ = _client()
+    with pytest.raises(pf.ControlException, match="controller_torque_discontinuity"):
+        _spin_wrist(robot, step=3.0, peak=6.0, ticks=10)  # 3 N·m in 1 ms: 3000 N·m/s
 
 
 def _default_sigint() -> None:
