@@ -191,6 +191,11 @@ class TwinSimulator(BaseSimulator):
         mujoco.mj_step(self.model, self.data)
         kernel.observe(fns, m_ptr, d_ptr, dat, bufs, sc)
 
+    def joints(self) -> tuple[np.ndarray, np.ndarray]:
+        """The arm's joint angles (7,) (rad) and speeds (7,) (rad/s)."""
+        r, d = self.robot, self.data
+        return d.qpos[r._qpos_addrs], d.qvel[r._dof_addrs]
+
     # ------------------------------------------------------------------ the estimate
     def external_torques(self) -> np.ndarray:
         """The estimated external joint torques (7,) (N·m), *the environment's on the arm*

@@ -245,7 +245,7 @@ class FirmwareServer(FrankaRobotServer):
             out.append("cartesian_reflex")
         if np.any(np.abs(self._tau_ext) > np.asarray(th.upper_torque)):
             out.append("joint_reflex")
-        q, dq = self.sim.data.qpos[:7], self.sim.data.qvel[:7]
+        q, dq = self.sim.joints()
         if np.any(q < np.asarray(Q_MIN)) or np.any(q > np.asarray(Q_MAX)):
             out.append("joint_position_limits_violation")
         if np.any(np.abs(dq) > np.asarray(DQ_MAX)):
