@@ -91,14 +91,16 @@ def check(
 @guarded
 def twin(
     task: Annotated[str, o.task()] = "peg",
-    host: Annotated[str, typer.Option(help="loopback address to listen on")] = "127.0.0.1",
+    host: Annotated[
+        str, typer.Option(help="address of a real robot (here: the loopback address to serve on)")
+    ] = "127.0.0.1",
     seed: Annotated[int, o.seed("the sensors' noise and offsets")] = 0,
     realtime: Annotated[
         bool,
         typer.Option(
-            help="step at 1 kHz whatever the client does (a late client violates the "
-            "communication constraint); --no-realtime: in lock-step with a client without a "
-            "real-time kernel"
+            help="real robot: require a real-time kernel (here: step at 1 kHz whatever the "
+            "client does, a late client violates the communication constraint; --no-realtime: "
+            "in lock-step with a client without a real-time kernel)"
         ),
     ] = True,
 ) -> None:
