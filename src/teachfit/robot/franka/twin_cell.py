@@ -22,8 +22,9 @@ joint-torque momentum observer (:class:`~teachfit.robot.fr3.sensing.JointTorqueO
 compiled :func:`teachfit.robot.fr3.kernel.observe`): the external joint torques estimated from
 the link-side torque sensors (with white noise) through the arm's model, as the firmware
 estimates ``tau_ext_hat_filtered``. A fixed per-joint offset (``TwinParams.torque_bias``, drawn
-once from the seed) stands for the sensors' calibration offsets: a real arm reads a few newtons
-at rest (franka_ros issue #404). :meth:`TwinSimulator.external_wrench` turns the estimate into
+once from the seed; 0.2 N·m std reads 0.5-2 N at the hand at rest) stands for the sensors'
+calibration and the model's errors: a real arm reads a few newtons at rest without contact
+(franka_ros issue #404). :meth:`TwinSimulator.external_wrench` turns the estimate into
 libfranka's ``O_F_ext_hat_K`` (see there for the sign).
 """
 
@@ -64,7 +65,7 @@ class TwinParams:
 
     start: tuple[float, float, float] = (0.0, 0.0, 0.05)
     torque_noise: float = 0.02
-    torque_bias: float = 0.03
+    torque_bias: float = 0.2
     wrench_cutoff: float = 30.0
     output_cutoff: float = 18.0
     seed: int = 0
