@@ -200,6 +200,19 @@ def test_robot_twin_bad_input_is_one_line_and_status_2(args: list[str], message:
     assert message in " ".join(res.output.split()), res.output
 
 
+def test_robot_twin_on_a_taken_port_is_one_line_and_status_2(franka_twin: Twin) -> None:
+    from typer.testing import CliRunner
+
+    from teachfit.cli import app
+
+    franka_twin()
+    args = ["robot", "twin", "--task", "peg", "--host", "127.0.0.1", "--no-realtime"]
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 2, res.output
+    text = " ".join(res.output.split())
+    assert "127.0.0.1:1337 is taken" in text and "start the twin again" in text, text
+
+
 def _spin_wrist(robot: Any, step: float, peak: float, ticks: int) -> None:
     """Torque-control joint 7 alone: ramp its torque by ``step`` N·m per tick up to ``peak``
     (the other joints get no torque; franky-sim compensates gravity)."""

@@ -66,7 +66,8 @@ def serve(
 
     check_host(host)
     if not port_free(host, ROBOT_PORT):
-        raise TeachfitError(PORT_TAKEN.replace(HOST, host))
+        why = PORT_TAKEN.replace(HOST, host).replace("the simulator again", "the twin again")
+        raise TeachfitError(why)
     confine_to_loopback()
     sim = TwinSimulator(task, params)
     with sim, TwinSimulationServer(sim, host, realtime=realtime) as server:
