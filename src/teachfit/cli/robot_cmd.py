@@ -107,9 +107,14 @@ def twin(
     """A digital twin of a Franka: the task's FR3 cell (the part in the hand) behind
     libfranka's protocol on 127.0.0.1, with the firmware's wrench estimate, reflexes and
     limits. Runs until Ctrl-C or SIGTERM; connect with --robot franka --host 127.0.0.1."""
-    from teachfit.robot.franka.twin import TwinParams, check_host, serve
     from teachfit.tasks import get_task
 
+    try:
+        from teachfit.robot.franka.twin import TwinParams, check_host, serve
+    except ImportError as exc:  # pragma: no cover - depends on the installed extras
+        raise TeachfitError(
+            f"robot twin needs franky-sim and pylibfranka: pip install teachfit[franka] ({exc})"
+        ) from exc
     check_host(host)
     cell = get_task(task)
     try:
