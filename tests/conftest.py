@@ -82,6 +82,7 @@ from franka_fixtures import (  # noqa: E402, F401
     expected_tcp,
     franka_port,
     franka_sim,
+    franka_twin,
     listener,
     push_file,
     robot_port,

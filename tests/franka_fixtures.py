@@ -81,6 +81,31 @@ def robot_port(franka_port: SimServer) -> Iterator[int]:
             franka_port.start()
 
 
+@pytest.fixture
+def franka_twin(robot_port: int) -> Iterator[Callable[..., SimServer]]:
+    """``start(start=(dx, dy, dz), realtime=False) -> TwinProcess``: the Franka twin of task
+    ``peg`` (``teachfit.robot.franka.twin``; lock-step ``--no-realtime`` unless ``realtime``)
+    with its TCP ``start`` (m) from the hole's contact pose, on 127.0.0.1:1337 in its own
+    process group, stopped by its PID after the test (franky-sim is stopped for the test and
+    started again after it, :func:`robot_port`)."""
+    from teachfit.robot.franka.twin import TwinProcess
+
+    started: list[SimServer] = []
+
+    def start(
+        start: tuple[float, float, float] = (0.0, 0.0, 0.05), realtime: bool = False
+    ) -> SimServer:
+        twin = TwinProcess("peg", realtime=realtime, start=start)
+        started.append(twin)
+        return twin.start()
+
+    try:
+        yield start
+    finally:
+        for twin in started:
+            twin.stop()
+
+
 #: a listener on 127.0.0.1: ``silent`` accepts and never answers, ``junk`` accepts and sends
 #: bytes that are not libfranka's protocol; prints ``ready`` once listening
 _LISTENER = """

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Annotated
 
@@ -85,6 +85,62 @@ def check(
         )
     for line in result.lines():
         console.print(line, markup=False, highlight=False)
+
+
+@robot_app.command("twin")
+@guarded
+def twin(
+    task: Annotated[str, o.task()] = "peg",
+    host: Annotated[
+        str, typer.Option(help="address of a real robot (here: the loopback address to serve on)")
+    ] = "127.0.0.1",
+    seed: Annotated[int, o.seed("the sensors' noise and offsets")] = 0,
+    realtime: Annotated[
+        bool,
+        typer.Option(
+            help="real robot: require a real-time kernel (here: step at 1 kHz whatever the "
+            "client does, a late client violates the communication constraint; --no-realtime: "
+            "in lock-step with a client without a real-time kernel)"
+        ),
+    ] = True,
+) -> None:
+    """A digital twin of a Franka: the task's FR3 cell (the part in the hand) behind
+    libfranka's protocol on 127.0.0.1, with the firmware's wrench estimate, reflexes and
+    limits. Runs until Ctrl-C or SIGTERM; connect with --robot franka --host 127.0.0.1."""
+    from teachfit.tasks import get_task
+
+    try:
+        from teachfit.robot.franka.twin import TwinParams, check_host, serve
+    except ImportError as exc:  # pragma: no cover - depends on the installed extras
+        raise TeachfitError(
+            f"robot twin needs franky-sim and pylibfranka: pip install teachfit[franka] ({exc})"
+        ) from exc
+    check_host(host)
+    cell = get_task(task)
+    try:
+        serve(cell, host, TwinParams(seed=seed), realtime=realtime, ready=_twin_ready(task))
+    except KeyboardInterrupt:
+        err_console.print("twin stopped (Ctrl-C)")
+        raise typer.Exit(130) from None
+    except SystemExit:  # SIGTERM (teachfit's CLI): its status, 143
+        err_console.print("twin stopped (SIGTERM)")
+        raise
+
+
+def _twin_ready(task: str) -> Callable[[str], None]:
+    import os
+
+    def ready(host: str) -> None:
+        pid = os.getpid()
+        console.print(
+            f"Franka twin of task {task!r} listening on {host} (libfranka's protocol), "
+            f"PID {pid}; stop with Ctrl-C or kill {pid}",
+            markup=False,
+            highlight=False,
+            soft_wrap=True,
+        )
+
+    return ready
 
 
 @guarded

@@ -3,7 +3,9 @@
 Modules: :mod:`.driver` (:class:`FrankaRobot`), :mod:`.tick` (the per-tick law-to-torque
 computation), :mod:`.safety` (:class:`FrankaLimits`), :mod:`.frames` (base/world, EE/TCP),
 :mod:`.record` (kinesthetic teaching), :mod:`.check` (``robot check`` and the loop benchmark),
-:mod:`.sim` (the libfranka-protocol simulator franky-sim, confined to loopback).
+:mod:`.sim` (the libfranka-protocol simulator franky-sim, confined to loopback), :mod:`.twin`
+(``teachfit robot twin``: the task's cell behind libfranka's protocol, with the firmware's
+wrench estimate, reflexes and limits; :mod:`.twin_cell`, :mod:`.twin_firmware`).
 Needs the ``franka`` extra (``pylibfranka``; ``franky-sim`` for the simulator).
 """
 

@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> None:
         from teachfit.core.process import die_with_parent
 
         die_with_parent(args.parent, signal.SIGTERM)
-    if not _port_free(HOST, ROBOT_PORT):
+    if not port_free(HOST, ROBOT_PORT):
         _refuse(PORT_TAKEN)
     confine_to_loopback()
     import franky_sim
@@ -149,7 +149,7 @@ def main(argv: list[str] | None = None) -> None:
                 franky_sim.SimulationServer(sim, hostname_candidates=[HOST])
             )
         except OSError as exc:  # taken since the check above, or another bind failure
-            _refuse(PORT_TAKEN if not _port_free(HOST, ROBOT_PORT) else f"cannot listen: {exc}")
+            _refuse(PORT_TAKEN if not port_free(HOST, ROBOT_PORT) else f"cannot listen: {exc}")
         if args.push_file is not None:
             _install_push(sim, robot, args.push_file)
         print(f"{READY} {robot.hostname}", flush=True)  # listening since the init
@@ -170,6 +170,10 @@ class SimServer:
         Seconds to wait for the server to print that it is ready and accept on port 1337.
     """
 
+    #: the line the server prints once it listens; what it is, for messages
+    ready = READY
+    what = "franky-sim"
+
     def __init__(self, push_file: Path | None = None, startup_timeout: float = 60.0) -> None:
         self.push_file = push_file
         self.startup_timeout = startup_timeout
@@ -183,20 +187,17 @@ class SimServer:
         try:
             for line in out:
                 self.log.append(line)
-                if line.startswith(READY):
+                if line.startswith(self.ready):
                     self._ready.set()
         except (OSError, ValueError):  # closed by stop()
             pass
 
     def start(self) -> SimServer:
         """Start the server process and wait until it listens (it prints READY)."""
-        if not _port_free(HOST, ROBOT_PORT):
-            raise ConnectionLost(f"{HOST}:{ROBOT_PORT} is taken: another Franka server runs")
-        cmd = [sys.executable, "-m", "teachfit.robot.franka.sim", "--parent", str(os.getpid())]
-        if self.push_file is not None:
-            cmd += ["--push-file", str(self.push_file)]
+        if not port_free(self.host, ROBOT_PORT):
+            raise ConnectionLost(f"{self.host}:{ROBOT_PORT} is taken: another Franka server runs")
         self.proc = subprocess.Popen(
-            cmd,
+            self.command(),
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
@@ -213,8 +214,15 @@ class SimServer:
         # accept the probe as its one client and make the real client's connect time out.
         if not self._ready.is_set():
             self.stop()
-            raise ConnectionLost("franky-sim did not start:\n" + "".join(list(self.log)[-20:]))
+            raise ConnectionLost(f"{self.what} did not start:\n" + "".join(list(self.log)[-20:]))
         return self
+
+    def command(self) -> list[str]:
+        """The server's command line (it ends with this process: ``--parent``)."""
+        cmd = [sys.executable, "-m", "teachfit.robot.franka.sim", "--parent", str(os.getpid())]
+        if self.push_file is not None:
+            cmd += ["--push-file", str(self.push_file)]
+        return cmd
 
     @property
     def pid(self) -> int | None:
@@ -250,7 +258,7 @@ class SimServer:
         self.stop()
 
 
-def _port_free(host: str, port: int) -> bool:
+def port_free(host: str, port: int) -> bool:
     """Whether nothing listens on ``host:port`` (a bind test: a probe connection would be
     taken by a franky-sim as its client)."""
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:

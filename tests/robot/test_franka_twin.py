@@ -1,0 +1,278 @@
+"""The Franka twin (``teachfit robot twin``): the peg cell behind libfranka's protocol.
+
+A plain pylibfranka client (no teachfit in between) presses the held peg on the base plate
+beside the boss and reads what the twin's firmware reports; the teachfit driver checks the
+robot and descends onto the boss as a skill does. The twin runs in lock-step
+(``--no-realtime``), so nothing here depends on the machine's speed.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+pf = pytest.importorskip("pylibfranka", reason="needs the franka extra (pylibfranka)")
+pytest.importorskip("franky_sim", reason="needs the franka extra (franky-sim)")
+
+from teachfit.core.geometry import Pose  # noqa: E402
+from teachfit.core.state import ImpedanceCommand  # noqa: E402
+from teachfit.robot.franka import DEFAULT_BASE2WORLD, franka_for_task  # noqa: E402
+from teachfit.robot.franka.check import check_robot  # noqa: E402
+from teachfit.robot.franka.frames import approach_waypoints  # noqa: E402
+from teachfit.robot.franka.sim import SimServer  # noqa: E402
+from teachfit.tasks import get_task  # noqa: E402
+
+TASK = get_task("peg")
+PLATE_TOP = TASK.params.base_height  # the base plate's top beside the boss (m, world z)
+#: the TCP 30 mm beside the hole (the peg clear of the boss), 2 mm above the plate
+BESIDE_BOSS = (0.03, 0.0, PLATE_TOP + 0.002 - TASK.surface_z)
+Twin = Callable[..., SimServer]
+
+
+def _press(robot: Any, model: Any, force: float, ticks: int) -> Any:
+    """Torque-control the arm from where it is: hold x, y and the orientation (Cartesian
+    impedance), push ``force`` N down (world/base -z); return the last state. Raises
+    pylibfranka's exceptions (a reflex)."""
+    from scipy.spatial.transform import Rotation
+
+    control = robot.start_torque_control()
+    state, _ = control.readOnce()
+    t0 = np.asarray(state.O_T_EE).reshape(4, 4, order="F")
+    for i in range(ticks):
+        t = np.asarray(state.O_T_EE).reshape(4, 4, order="F")
+        jac = np.asarray(model.zero_jacobian(state)).reshape(6, 7, order="F")
+        twist = jac @ np.asarray(state.dq)
+        rot_err = Rotation.from_matrix(t0[:3, :3] @ t[:3, :3].T).as_rotvec()
+        wrench = np.zeros(6)
+        wrench[:2] = 1500.0 * (t0[:2, 3] - t[:2, 3]) - 60.0 * twist[:2]
+        wrench[2] = -force * min(1.0, i / 500) - 300.0 * twist[2]
+        wrench[3:] = 60.0 * rot_err - 3.0 * twist[3:]
+        tau = jac.T @ wrench + np.asarray(model.coriolis(state)) - 0.5 * np.asarray(state.dq)
+        torques = pf.Torques(tau.tolist())
+        torques.motion_finished = i == ticks - 1
+        control.writeOnce(torques)
+        if i < ticks - 1:
+            state, _ = control.readOnce()
+    return state
+
+
+def _client() -> tuple[Any, Any]:
+    robot = pf.Robot("127.0.0.1", pf.RealtimeConfig.kIgnore)
+    return robot, robot.load_model()
+
+
+def test_robot_check_passes_and_the_tcp_is_where_the_cell_holds_the_part(
+    franka_twin: Twin,
+) -> None:
+    franka_twin()
+    result = check_robot("127.0.0.1", seconds=0.3, realtime=False)
+    assert result.robot_mode == "Idle"
+    assert result.timing.ticks == 300
+    # check_robot's TCP is libfranka's EE frame, where the twin holds the part's top: the
+    # part's tip starts 50 mm above the hole's entry
+    top = TASK.contact_pose(np.zeros(2)).pos + [0.0, 0.0, 0.05 + TASK.scene.held_part_length]
+    np.testing.assert_allclose(result.tcp_pos, top, atol=2e-3)
+
+
+def test_pressing_down_reads_o_f_ext_hat_k_in_libfrankas_sign(franka_twin: Twin) -> None:
+    franka_twin(start=BESIDE_BOSS)
+    robot, model = _client()
+    state = _press(robot, model, force=10.0, ticks=900)
+    o_f = np.asarray(state.O_F_ext_hat_K)
+    # the robot pushes the plate down with 10 N: libfranka reports that push, -z in the base
+    assert -13.0 < o_f[2] < -7.0, o_f
+    assert np.all(np.abs(o_f[:2]) < 3.0), o_f
+    # K (= EE) has its z axis pointing down the part: the same push is +z in K
+    assert 7.0 < state.K_F_ext_hat_K[2] < 13.0, state.K_F_ext_hat_K
+    ee_z = np.asarray(state.O_T_EE)[14] + DEFAULT_BASE2WORLD.pos[2]  # world
+    tip_z = ee_z - TASK.scene.held_part_length
+    assert tip_z > PLATE_TOP - 1e-3
+    assert tuple(state.cartesian_collision) == (0.0,) * 6  # under the 20 N default
+
+
+@pytest.mark.parametrize(
+    ("torque", "force", "reflex", "other"),
+    [
+        ([20.0] * 7, [5.0] * 6, "cartesian_reflex", "joint_reflex"),
+        ([1.0] * 7, [20.0] * 6, "joint_reflex", "cartesian_reflex"),
+    ],
+)
+def test_a_low_threshold_makes_a_push_a_reflex_that_recovery_clears(
+    franka_twin: Twin, torque: list[float], force: list[float], reflex: str, other: str
+) -> None:
+    franka_twin(start=BESIDE_BOSS)
+    robot, model = _client()
+    lower = [min(v, 3.0) for v in force]
+    robot.set_collision_behavior([min(v, 1.0) for v in torque], torque, lower, force)
+    with pytest.raises(pf.ControlException, match=f"reflex.*{reflex}"):
+        _press(robot, model, force=10.0, ticks=1500)
+    state = robot.read_once()
+    assert state.robot_mode == pf.RobotMode.Reflex
+    assert getattr(state.current_errors, reflex) and getattr(state.last_motion_errors, reflex)
+    assert not getattr(state.current_errors, other)
+    robot.set_collision_behavior([20.0] * 7, [20.0] * 7, [20.0] * 6, [20.0] * 6)
+    robot.automatic_error_recovery()
+    for _ in range(10):  # states sent before the recovery may still be in flight
+        state = robot.read_once()
+        if state.robot_mode != pf.RobotMode.Reflex:
+            break
+    assert state.robot_mode == pf.RobotMode.Idle
+    assert not getattr(state.current_errors, reflex)
+    # a new motion is accepted again and runs
+    state = _press(robot, model, force=2.0, ticks=300)
+    assert not state.current_errors
+
+
+def test_a_motion_is_refused_until_the_reflex_is_recovered(franka_twin: Twin) -> None:
+    franka_twin(start=BESIDE_BOSS)
+    robot, model = _client()
+    robot.set_collision_behavior([20.0] * 7, [20.0] * 7, [3.0] * 6, [5.0] * 6)
+    with pytest.raises(pf.ControlException, match="cartesian_reflex"):
+        _press(robot, model, force=10.0, ticks=1500)
+    with pytest.raises((pf.ControlException, pf.CommandException), match="not possible"):
+        _press(robot, model, force=0.0, ticks=10)
+
+
+def test_descending_below_the_entry_off_the_hole_is_stopped_by_the_boss(
+    franka_twin: Twin,
+) -> None:
+    franka_twin(start=(0.003, 0.0, 0.005))  # 3 mm off the hole: the peg meets its rim
+    above = TASK.contact_pose(np.array([0.003, 0.0]))
+    below = Pose(above.pos - [0.0, 0.0, 0.01], above.quat)  # 10 mm below the entry
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        start = above.translated([0.0, 0.0, 0.005])
+        robot.reset(start)
+        # the set-point descends at 2 cm/s as a skill's does, to 10 mm below the entry
+        for pose in approach_waypoints(start, below, 0.02, 0.3, 0.01):
+            robot.command(ImpedanceCommand.hold(pose, stiffness=800.0))
+            state = robot.step(10)
+        for _ in range(30):
+            robot.command(ImpedanceCommand.hold(below, stiffness=800.0))
+            state = robot.step(10)
+    assert state.pos[2] > TASK.surface_z - 5e-4, state.pos  # on the boss, not in it
+    assert state.wrench[2] > 4.0, state.wrench  # the boss pushes the part up (~8 N)
+
+
+def test_a_client_that_stops_commanding_violates_the_communication_constraint(
+    franka_twin: Twin,
+) -> None:
+    import time
+
+    franka_twin(start=BESIDE_BOSS, realtime=True)
+    robot, _ = _client()
+    control = robot.start_torque_control()
+    state, _ = control.readOnce()
+    control.writeOnce(pf.Torques([0.0] * 7))
+    time.sleep(0.3)  # 300 ticks without a command (the limit is 20)
+    with pytest.raises(pf.ControlException, match="communication_constraints_violation"):
+        for _ in range(50):
+            state, _ = control.readOnce()
+            control.writeOnce(pf.Torques([0.0] * 7))
+    # 21 of the motion's last 100 ticks went without a command
+    assert robot.read_once().control_command_success_rate == pytest.approx(0.79, abs=0.011)
+
+
+_MAIN = "from teachfit.cli import main; main()"
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--task", "nope"], "unknown task 'nope'"),
+        (["--task", "peg", "--host", "10.1.2.3"], "--host 10.1.2.3: the twin listens on loopback"),
+    ],
+)
+def test_robot_twin_bad_input_is_one_line_and_status_2(args: list[str], message: str) -> None:
+    from typer.testing import CliRunner
+
+    from teachfit.cli import app
+
+    res = CliRunner().invoke(app, ["robot", "twin", *args])
+    assert res.exit_code == 2, res.output
+    assert message in " ".join(res.output.split()), res.output
+
+
+def test_robot_twin_on_a_taken_port_is_one_line_and_status_2(franka_twin: Twin) -> None:
+    from typer.testing import CliRunner
+
+    from teachfit.cli import app
+
+    franka_twin()
+    args = ["robot", "twin", "--task", "peg", "--host", "127.0.0.1", "--no-realtime"]
+    res = CliRunner().invoke(app, args)
+    assert res.exit_code == 2, res.output
+    text = " ".join(res.output.split())
+    assert "127.0.0.1:1337 is taken" in text and "start the twin again" in text, text
+
+
+def _spin_wrist(robot: Any, step: float, peak: float, ticks: int) -> None:
+    """Torque-control joint 7 alone: ramp its torque by ``step`` N·m per tick up to ``peak``
+    (the other joints get no torque; franky-sim compensates gravity)."""
+    control = robot.start_torque_control()
+    control.readOnce()
+    tau = np.zeros(7)
+    for _ in range(ticks):
+        tau[6] = min(peak, tau[6] + step)
+        control.writeOnce(pf.Torques(tau.tolist()))
+        control.readOnce()
+
+
+def test_a_joint_over_its_speed_limit_aborts_the_motion(franka_twin: Twin) -> None:
+    franka_twin()
+    robot, _ = _client()
+    with pytest.raises(pf.ControlException, match="joint_velocity_violation"):
+        _spin_wrist(robot, step=0.9, peak=8.0, ticks=400)  # 5.26 rad/s is joint 7's limit
+    assert robot.read_once().current_errors.joint_velocity_violation
+
+
+def test_a_torque_step_over_the_rate_limit_is_a_discontinuity(franka_twin: Twin) -> None:
+    franka_twin()
+    robot, _ = _client()
+    with pytest.raises(pf.ControlException, match="controller_torque_discontinuity"):
+        _spin_wrist(robot, step=3.0, peak=6.0, ticks=10)  # 3 N·m in 1 ms: 3000 N·m/s
+
+
+def _default_sigint() -> None:
+    # as at a terminal: a runner that started the tests in the background left SIGINT ignored
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.mark.parametrize(
+    ("sig", "status", "said"),
+    [(signal.SIGTERM, 143, "twin stopped (SIGTERM)"), (signal.SIGINT, 130, "(Ctrl-C)")],
+)
+def test_robot_twin_stops_on_sigterm_and_ctrl_c_with_nothing_left(
+    robot_port: int, sig: int, status: int, said: str
+) -> None:
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2] / "src")}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _MAIN, "robot", "twin", "--task", "peg", "--no-realtime"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        start_new_session=True,
+        preexec_fn=_default_sigint,
+    )
+    try:
+        assert proc.stdout is not None
+        line = proc.stdout.readline()
+        assert "listening on 127.0.0.1" in line and f"PID {proc.pid}" in line, line
+        os.killpg(proc.pid, sig)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == status, err
+    assert said in err
+    with pytest.raises(ProcessLookupError):
+        os.killpg(proc.pid, 0)  # no process of its group is left
