@@ -108,7 +108,10 @@ def test_a_simulator_ends_with_the_process_that_started_it_even_when_killed(
     assert _running(sim_pid)
     starter.kill()
     starter.wait()
+    from teachfit.robot.franka.sim import HOST, ROBOT_PORT, port_free
+
     deadline = time.monotonic() + 30
-    while _running(sim_pid) and time.monotonic() < deadline:
+    while (_running(sim_pid) or not port_free(HOST, ROBOT_PORT)) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not _running(sim_pid), "the simulator outlived the process that started it"
+    assert port_free(HOST, ROBOT_PORT)
