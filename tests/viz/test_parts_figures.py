@@ -43,3 +43,17 @@ def test_one_bar_group_per_part_with_an_interval_per_bar() -> None:
 def test_the_figure_is_written(tmp_path: Path) -> None:
     path = save_parts_figure(_cells()[:2], tmp_path / "parts.png", "t")
     read_png(path)
+
+
+def test_rates_of_none_and_all_draw_with_their_intervals() -> None:
+    """0/10 and 10/10: the Wilson bound sits on the rate up to rounding, never a negative bar."""
+    cells: list[Cell] = [
+        ("round8", "skill", "floating", summarize([False] * 10, [1.0] * 10)),
+        ("round8", "search", "floating", summarize([True] * 10, [1.0] * 10)),
+        ("round16", "skill", "floating", summarize([True] * 9 + [False], [1.0] * 10)),
+    ]
+    ax = parts_figure(cells, "edges").axes[0]
+    heights = sorted(
+        round(p.get_height()) for c in ax.containers for p in getattr(c, "patches", [])
+    )
+    assert heights == [0, 90, 100]

@@ -39,7 +39,8 @@ def parts_figure(cells: Sequence[Cell], title: str = "", goal: float | None = 0.
                 continue
             xs.append(i + (j - (len(series) - 1) / 2) * width)
             rate.append(100 * s.rate)
-            err.append((100 * (s.rate - s.low), 100 * (s.high - s.rate)))
+            # at 0 % or 100 % the Wilson bound equals the rate up to rounding: never below 0
+            err.append((max(0.0, 100 * (s.rate - s.low)), max(0.0, 100 * (s.high - s.rate))))
         ax.bar(
             xs, rate, width, yerr=np.array(err).T.reshape(2, -1), capsize=2,
             color=colors(methods.index(method)), hatch="//" if robots.index(robot) else None,
