@@ -276,3 +276,31 @@ def test_robot_twin_stops_on_sigterm_and_ctrl_c_with_nothing_left(
     assert said in err
     with pytest.raises(ProcessLookupError):
         os.killpg(proc.pid, 0)  # no process of its group is left
+
+
+def test_a_reset_out_of_an_inserted_hole_leaves_along_its_axis_under_5_n(
+    franka_twin: Twin,
+) -> None:
+    """The part inserted 8 mm deep, the next start 20 mm to the side: the reset pulls it out
+    along the hole's axis first; the largest lateral force on the way out stays under 5 N."""
+    franka_twin(start=(0.0, 0.0, 0.005))
+    entry = TASK.contact_pose(np.array([0.0, 0.0]))
+    deep = Pose(entry.pos - [0.0, 0.0, 0.008], entry.quat)
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        start = entry.translated([0.0, 0.0, 0.005])
+        robot.reset(start)
+        # compliant across (the chamfer centres the peg), stiff along the axis
+        soft = np.array([150.0, 150.0, 800.0, 30.0, 30.0, 100.0])
+        for pose in approach_waypoints(start, deep, 0.02, 0.3, 0.01):
+            robot.command(ImpedanceCommand.hold(pose, stiffness=soft))
+            state = robot.step(10)
+        for _ in range(50):
+            robot.command(ImpedanceCommand.hold(deep, stiffness=soft))
+            state = robot.step(10)
+        assert state.pos[2] < TASK.surface_z - 0.004, state.pos  # in the hole
+        aside = entry.translated([0.02, 0.0, 0.025])
+        done = robot.reset(aside)
+        assert robot.reset_guard is not None
+        peak = robot.reset_guard.peaks[-1]
+    assert np.linalg.norm(done.pos - aside.pos) < 0.006
+    assert peak <= 5.0, peak
