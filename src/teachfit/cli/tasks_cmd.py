@@ -229,7 +229,9 @@ def tasks_example(
 @tasks_app.command("suite")
 @guarded
 def tasks_suite(
-    folder: Annotated[Path, typer.Argument(help="folder to write the meshes and task files")],
+    out: Annotated[
+        Path, typer.Argument(metavar="FOLDER", help="folder to write the meshes and task files")
+    ],
     parts: Annotated[
         str, typer.Option(help="parts of the suite, comma-separated (default: all)")
     ] = "",
@@ -240,5 +242,5 @@ def tasks_suite(
     from teachfit.tasks.mesh.suite import PARTS, write_suite
 
     names = [p.strip() for p in parts.split(",") if p.strip()] or None
-    for path in write_suite(folder, names, clearance):
+    for path in write_suite(out, names, clearance):
         console.print(f"wrote {path}: {PARTS[path.stem].at_clearance(clearance).describe()}")
