@@ -18,7 +18,8 @@ import teachfit
 SRC = str(Path(teachfit.__file__).resolve().parents[1])
 
 #: a driver: a child before the watchdog, two after it (one a grandchild, as the raylet's
-#: agents are), all noted; prints their PIDs, then stops the watchdog or waits to be killed
+#: agents are), all noted; prints their PIDs, then (told so on stdin) stops the watchdog, or
+#: waits to be killed
 DRIVER = """
 import subprocess, sys, time
 from teachfit.learning.ray_reaper import Reaper
@@ -32,6 +33,7 @@ grandchild = int(shell.stdout.readline())
 reaper.note()
 print(before.pid, child.pid, shell.pid, grandchild, flush=True)
 if sys.argv[1] == "stop":
+    sys.stdin.readline()  # the test has seen them all alive: stop now
     reaper.stop()
     print("stopped", flush=True)
 time.sleep(300)
@@ -59,6 +61,7 @@ def test_what_the_driver_started_after_the_watchdog_ends_with_it(end: str) -> No
     proc = subprocess.Popen(
         [sys.executable, "-c", DRIVER, end],
         env=dict(os.environ, PYTHONPATH=SRC),
+        stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         text=True,
     )
@@ -71,6 +74,9 @@ def test_what_the_driver_started_after_the_watchdog_ends_with_it(end: str) -> No
         if end == "kill":
             proc.send_signal(signal.SIGKILL)
         else:
+            assert proc.stdin is not None
+            proc.stdin.write("go\n")  # not before the check above: the stop would race it
+            proc.stdin.flush()
             assert proc.stdout.readline().strip() == "stopped"
         assert _gone(after)
         assert _alive(before)  # started before the watchdog: not the instance's
