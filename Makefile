@@ -19,7 +19,7 @@ demo: $(STAMP)
 
 # `make test` lints first (ruff check, ruff format --check and mypy), then runs the tests
 test: lint
-	$(BIN)/python -m pytest -n 2 --dist loadgroup --durations=10
+	$(BIN)/python -m pytest -n 2 --durations=10
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks

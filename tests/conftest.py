@@ -88,11 +88,3 @@ from franka_fixtures import (  # noqa: E402, F401
     robot_port,
 )
 
-
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """Every test that needs 127.0.0.1:1337 (libfranka's fixed port: the simulator, the twin or
-    a test's own listener) runs on one pytest-xdist worker (``--dist loadgroup``), so the other
-    worker never waits on the port's lock."""
-    for item in items:
-        if "franka_port" in getattr(item, "fixturenames", ()):
-            item.add_marker(pytest.mark.xdist_group("franka-port"))
