@@ -87,4 +87,3 @@ from franka_fixtures import (  # noqa: E402, F401
     push_file,
     robot_port,
 )
-
