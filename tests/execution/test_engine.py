@@ -77,6 +77,15 @@ def test_failure_costs_limit_plus_factor_times_remaining(task):
     )
     assert out.costs[0] == pytest.approx(1.6 + 100.0 * tr.remaining)
     assert tr.visits[-1].node == "retract"  # the recovery node ran after the error
+    # ... on its own clock: the last node ran for over a second, the retract still gets its
+    # 0.5 s budget (or ends at its goal, 10 mm up) instead of one command period
+    rec = tr.visits[-1]
+    assert tr.visits[-2].t_exit - tr.visits[-2].t_enter > 0.5
+    assert rec.t_exit - rec.t_enter > 0.1
+    lifted = (
+        tr.log.pos[tr.log.t >= rec.t_exit - 1e-9][0, 2] - tr.log.pos[tr.log.t <= rec.t_enter][-1, 2]
+    )
+    assert lifted > 0.003
     assert LearningMetric(1.6, 100.0).evaluate(tr) == (False, out.costs[0])
 
 

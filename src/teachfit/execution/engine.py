@@ -321,7 +321,7 @@ class _Run:
         t = st.t - self.t0
         pc = self.pc
         pc.update(st, t)
-        pc.t_node = t - self.t_enter  # from the last graph node's entry (in recovery too)
+        pc.t_node = t - self.t_enter  # from the entry of the node running (recovery's too)
         if not math.isfinite(sum(pc.p.tolist()) + sum(pc.f.tolist())):  # NaN/inf propagate
             raise SimulationDiverged(f"non-finite state at t={t:.3f} s")
         pc.detected = bool(self.detect(st.pose)) if self.detect is not None else False
@@ -377,7 +377,7 @@ class _Run:
     def _recover(self, node: CompiledNode) -> NodeVisit:
         """Run the recovery node for at most ``cfg.recovery_time`` (a fault ends it)."""
         pc, cmd = self.pc, self.cmd
-        t_enter = pc.t
+        t_enter = self.t_enter = pc.t  # the recovery's clock (``advance`` sets ``t_node``)
         _enter(node, pc)
         why = "recovered"
         try:
