@@ -11,7 +11,8 @@ from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
-from teachfit.skills.search import recentred, states_to_setpoints
+from teachfit.skills.percept import Percept
+from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
 from teachfit.tasks import get_task
 
 
@@ -81,3 +82,44 @@ def test_search_recovers_a_hole_beyond_the_lateral_reach(peg):
     joined = out["joined"]
     assert joined.success and joined.ground_truth_inserted
     assert [v.node for v in joined.visits][-3:] == ["search", "align", "insert"]
+
+
+def test_recentred_widens_a_spread_narrower_than_the_radius_only(peg):
+    _, model = peg
+    ex = model.exploration
+    r0 = surface_radius(ex)
+    assert r0 > 0
+    wide = recentred(ex, 1.0, 3.0 * r0)  # a taught-hole error beyond the human's search
+    assert surface_radius(wide) == pytest.approx(3.0 * r0)
+    assert np.allclose(wide.cov, 9.0 * ex.cov, rtol=1e-6)  # the shape kept
+    kept = recentred(ex, 1.0, 0.5 * r0)  # already wider: the learned scale alone
+    assert np.allclose(kept.cov, ex.cov, rtol=1e-6)
+    with pytest.raises(SkillError, match="radius"):
+        recentred(ex, 1.0, -0.001)
+
+
+def _lateral_switch(sk, source: str):
+    return [t.condition for t in sk.transitions if (t.source, t.target) == (source, "search")]
+
+
+def test_joined_lateral_moves_search_only_after_reaching_the_hole(peg):
+    """A fit's long lateral move (``t_reach`` to the taught hole) is not cut at ``t_switch``;
+    every pass gives up to the search, and the last pass's miss searches."""
+    _, model = peg
+    sk = peg_in_hole_search.build(model, "impedance")
+    values = sk.resolve({"t_switch": 0.8}) | {"t_reach": 2.0, "roi": 0.1, "pass_end": 0.006}
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    for lateral in peg_in_hole_search.LATERALS:
+        switch, *miss = (c.compile(values) for c in _lateral_switch(sk, lateral))
+        fired = []
+        for t in (1.0, 1.9, 2.1):
+            pc.t_node = t
+            fired.append(switch(pc))
+        assert fired == [False, False, True]
+        pc.t_node = 0.1
+        pc.p[0] = -0.007  # past the hole
+        assert [m(pc) for m in miss] == ([True] if lateral == "lateral_3" else [])
+        pc.p[0] = 0.0
+    built_in = sk.resolve({"t_switch": 0.8}) | {"roi": 0.1}  # t_reach 0: t_switch alone
+    pc.t_node = 0.9
+    assert _lateral_switch(sk, "lateral")[0].compile(built_in)(pc)
