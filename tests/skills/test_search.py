@@ -11,7 +11,7 @@ from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
-from teachfit.skills.percept import Percept
+from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
 from teachfit.tasks import get_task
 
@@ -123,3 +123,32 @@ def test_joined_lateral_moves_search_only_after_reaching_the_hole(peg):
     built_in = sk.resolve({"t_switch": 0.8}) | {"roi": 0.1}  # t_reach 0: t_switch alone
     pc.t_node = 0.9
     assert _lateral_switch(sk, "lateral")[0].compile(built_in)(pc)
+    # a resistance along +x (the far wall where the fit did not expect it) searches at once
+    stop = _lateral_switch(sk, "lateral")[0].compile(values | {"f_lateral_rev": 8.0})
+    pc.t_node, pc.f[0] = 0.1, 9.0
+    assert stop(pc)
+    pc.f[0] = 0.0
+    assert not stop(pc)
+
+
+def _tour(model, repeat: float):
+    """A learned search entered at the origin, stepped past its first tour's end."""
+    sk = peg_in_hole_search.build(model, "impedance")
+    values = sk.resolve({"search_points": 10.0}) | {"search_repeat": repeat}
+    run = sk.node("search").primitive.compile(values)
+    pc, out = Percept(Pose(np.zeros(3)), 0.01), MPCommand()
+    run.enter(pc)
+    first = run.trajectory
+    pc.t_node = first.duration + 0.01
+    run.command(pc, out)
+    return run, first, pc
+
+
+def test_a_search_without_a_catch_tours_again_from_where_it_ended(peg):
+    _, model = peg
+    run, first, pc = _tour(model, 1.0)
+    assert not pc.done and run.trajectory is not first  # a fresh tour, from here
+    assert run.t0 == pytest.approx(first.duration + 0.01)
+    assert np.allclose(run.trajectory.pos[0, :2], pc.p[:2], atol=1e-9)
+    _, _, pc_once = _tour(model, 0.0)  # Ehlers et al.'s: one tour, done
+    assert pc_once.done

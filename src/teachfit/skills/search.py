@@ -123,7 +123,9 @@ class LearnedSearch(Primitive):
     ``n_points`` TSHIX samples (rounded), ``scale`` of the exploration spread (``radius``:
     its least RMS radius in the surface plane, m; see :func:`recentred`), ``speed``
     factor on the teacher's speeds, ``push`` (N) onto the surface, ``seed`` of the sampler
-    (each entry of the node draws fresh samples from it). ``follow`` sets the compliance
+    (each entry of the node draws fresh samples from it), ``repeat`` (> 0: a finished tour
+    without a catch plans the next from where it ended, so the search ends only by the node's
+    time limit; 0: one tour, done when it ends, as Ehlers et al.'s). ``follow`` sets the compliance
     (its ``push_force`` is replaced by ``push``). Built in code only (it holds a model).
     """
 
@@ -134,6 +136,7 @@ class LearnedSearch(Primitive):
     push: Value = "search_push"
     seed: Value = "search_seed"
     radius: Value = "search_radius"
+    repeat: Value = "search_repeat"
     follow: FollowConfig = FollowConfig(settle_time=0.0)
     kind: ClassVar[str] = "learned_search"
 
@@ -156,7 +159,7 @@ class LearnedSearch(Primitive):
             )
         cfg = FollowConfig(**{**self.follow.__dict__, "push_force": push, "anchor": "frame"})
         rng = np.random.default_rng(int(resolve(self.seed, values)))
-        return _SearchRun(self.model, planner, n, cfg, rng)
+        return _SearchRun(self.model, planner, n, cfg, rng, resolve(self.repeat, values) > 0)
 
     def describe(self) -> str:
         return (
@@ -176,13 +179,21 @@ class _SearchRun(PrimitiveRun):
         n: int,
         cfg: FollowConfig,
         rng: np.random.Generator,
+        repeat: bool = False,
     ) -> None:
         self.model, self.planner, self.n, self.cfg, self.rng = model, planner, n, cfg, rng
+        self.repeat = repeat
+        self.t0 = 0.0
         self.dims = model.dims
         self.follow: _FollowRun | None = None
         self.trajectory: SetpointTrajectory | None = None
 
     def enter(self, pc: Percept) -> None:
+        self.t0 = 0.0
+        self._plan(pc)
+
+    def _plan(self, pc: Percept) -> None:
+        """A tour from the measured pose, followed from node time ``t0`` on."""
         here = {"x": pc.p[0], "y": pc.p[1], "z": pc.p[2], "rz": yaw_of(pc.q)}
         start = np.array([here[d] for d in self.dims])
         try:
@@ -197,6 +208,14 @@ class _SearchRun(PrimitiveRun):
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         assert self.follow is not None, "enter() first"
-        self.follow.command(pc, out)
+        t_node = pc.t_node
+        pc.t_node = t_node - self.t0  # the tour's own clock
+        try:
+            self.follow.command(pc, out)
+        finally:
+            pc.t_node = t_node
         pc.p_d[2] = pc.p[2]  # force control along z: only the push presses (see the docstring)
         out.twist[2] = 0.0
+        if pc.done and self.repeat:  # a tour without a catch: another one from here
+            self.t0 = t_node
+            self._plan(pc)
