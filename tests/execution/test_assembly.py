@@ -6,11 +6,13 @@ from search_models import raster_model
 
 from teachfit.core.errors import TeachfitError
 from teachfit.execution.assembly import (
+    _search_context,
     assembly_jobs,
     method_skill,
     run_assembly,
     taught_hole,
 )
+from teachfit.execution.batch import episode_seed
 from teachfit.tasks import get_task
 
 
@@ -65,3 +67,18 @@ def test_same_trials_for_every_method_and_open_loop_misses_a_far_hole(peg):
     assert joined.nodes[:3] == ("approach", "contact", "lateral")
     assert joined.result is not None and joined.result.log.t.size > 10
     assert joined.success == (joined.result.outcome.value == "success")
+
+
+def test_a_searching_method_is_told_the_error_s_size(peg):
+    """The search's least spread is the taught hole's error (its size, not its direction);
+    the skill alone has no search to tell."""
+    _, model = peg
+    jobs = assembly_jobs("peg2d", ["joined", "search", "skill"], [0.003], 1, model, seed=4)
+    for job in jobs:
+        sk = method_skill(job.method, model, job.skill, "impedance")
+        ctx = _search_context(job, sk)
+        if job.method == "skill":
+            assert ctx == {}
+        else:
+            assert ctx["search_radius"] == pytest.approx(0.003)
+            assert ctx["search_seed"] == float(episode_seed(4, 0))

@@ -34,6 +34,7 @@ def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_li
     assert values["t_lateral"] == pytest.approx(t_lateral)
     extra = t_lateral - DEFAULTS["t_lateral"] + 2 * (t_lateral + 1.0)
     assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + extra)
+    assert values["t_reach"] == pytest.approx(start / (DEFAULTS["v_lateral"] * 0.25))
     assert domains["tilt"].high == pytest.approx(math.acos(0.004 / 0.0041))  # 0.22 rad
 
 
@@ -85,3 +86,20 @@ def test_the_round_peg_example_gives_its_fit(mesh_examples: dict[str, str]) -> N
     ctx = peg_in_hole.hole_context(task, np.random.default_rng(0))
     assert ctx.values["lateral_dir"] == -1.0
     assert ctx.values["lateral_offset"] == pytest.approx(-(0.004 + 0.0041 + 0.0015), abs=1e-6)
+
+
+def test_a_fit_extends_the_skill_s_own_time_limit(mesh_examples: dict[str, str]) -> None:
+    """The joined skill's t_max (time for a search) grows by the fit's extension as the plain
+    skill's does: a fit must not cut a skill's budget to the plain skill's."""
+    from teachfit.skills import peg_in_hole_search
+
+    task = get_task(mesh_examples["round-peg"])
+    plain = peg_in_hole.hole_context(task, np.random.default_rng(0))
+    joined = dict(peg_in_hole.CONTEXT) | peg_in_hole_search.CONTEXT
+    ctx = peg_in_hole.hole_context(task, np.random.default_rng(0), joined)
+    t_lateral = plain.values["t_lateral"]  # the fit's, longer than either skill's default
+    own = {n: p.value for n, p in peg_in_hole_search.CONTEXT.items()}
+    assert ctx.values["t_lateral"] == pytest.approx(t_lateral) and t_lateral > own["t_lateral"]
+    extra = t_lateral - own["t_lateral"] + 2 * (t_lateral + 1.0)
+    assert ctx.values["t_max"] == pytest.approx(own["t_max"] + extra)
+    assert ctx.values["t_max"] > plain.values["t_max"] + 10.0  # the search's time kept

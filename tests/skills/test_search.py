@@ -11,7 +11,8 @@ from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
-from teachfit.skills.search import recentred, states_to_setpoints
+from teachfit.skills.percept import MPCommand, Percept
+from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
 from teachfit.tasks import get_task
 
 
@@ -81,3 +82,73 @@ def test_search_recovers_a_hole_beyond_the_lateral_reach(peg):
     joined = out["joined"]
     assert joined.success and joined.ground_truth_inserted
     assert [v.node for v in joined.visits][-3:] == ["search", "align", "insert"]
+
+
+def test_recentred_widens_a_spread_narrower_than_the_radius_only(peg):
+    _, model = peg
+    ex = model.exploration
+    r0 = surface_radius(ex)
+    assert r0 > 0
+    wide = recentred(ex, 1.0, 3.0 * r0)  # a taught-hole error beyond the human's search
+    assert surface_radius(wide) == pytest.approx(3.0 * r0)
+    assert np.allclose(wide.cov, 9.0 * ex.cov, rtol=1e-6)  # the shape kept
+    kept = recentred(ex, 1.0, 0.5 * r0)  # already wider: the learned scale alone
+    assert np.allclose(kept.cov, ex.cov, rtol=1e-6)
+    with pytest.raises(SkillError, match="radius"):
+        recentred(ex, 1.0, -0.001)
+
+
+def _lateral_switch(sk, source: str):
+    return [t.condition for t in sk.transitions if (t.source, t.target) == (source, "search")]
+
+
+def test_joined_lateral_moves_search_only_after_reaching_the_hole(peg):
+    """A fit's long lateral move (``t_reach`` to the taught hole) is not cut at ``t_switch``;
+    every pass gives up to the search, and the last pass's miss searches."""
+    _, model = peg
+    sk = peg_in_hole_search.build(model, "impedance")
+    values = sk.resolve({"t_switch": 0.8}) | {"t_reach": 2.0, "roi": 0.1, "pass_end": 0.006}
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    for lateral in peg_in_hole_search.LATERALS:
+        switch, *miss = (c.compile(values) for c in _lateral_switch(sk, lateral))
+        fired = []
+        for t in (1.0, 1.9, 2.1):
+            pc.t_node = t
+            fired.append(switch(pc))
+        assert fired == [False, False, True]
+        pc.t_node = 0.1
+        pc.p[0] = -0.007  # past the hole
+        assert [m(pc) for m in miss] == ([True] if lateral == "lateral_3" else [])
+        pc.p[0] = 0.0
+    built_in = sk.resolve({"t_switch": 0.8}) | {"roi": 0.1}  # t_reach 0: t_switch alone
+    pc.t_node = 0.9
+    assert _lateral_switch(sk, "lateral")[0].compile(built_in)(pc)
+    # a resistance along +x (the far wall where the fit did not expect it) searches at once
+    stop = _lateral_switch(sk, "lateral")[0].compile(values | {"f_lateral_rev": 8.0})
+    pc.t_node, pc.f[0] = 0.1, 9.0
+    assert stop(pc)
+    pc.f[0] = 0.0
+    assert not stop(pc)
+
+
+def _tour(model, repeat: float):
+    """A learned search entered at the origin, stepped past its first tour's end."""
+    sk = peg_in_hole_search.build(model, "impedance")
+    values = sk.resolve({"search_points": 10.0}) | {"search_repeat": repeat}
+    run = sk.node("search").primitive.compile(values)
+    pc, out = Percept(Pose(np.zeros(3)), 0.01), MPCommand()
+    run.enter(pc)
+    first = run.trajectory
+    pc.t_node = first.duration + 0.01
+    run.command(pc, out)
+    return run, first, pc
+
+
+def test_a_search_without_a_catch_tours_again_from_where_it_ended(peg):
+    _, model = peg
+    run, first, pc = _tour(model, 1.0)
+    assert not pc.done and run.trajectory is not first  # a fresh tour, from here
+    assert run.t0 == pytest.approx(first.duration + 0.01)
+    assert np.allclose(run.trajectory.pos[0, :2], pc.p[:2], atol=1e-9)
+    _, _, pc_once = _tour(model, 0.0)  # Ehlers et al.'s: one tour, done
+    assert pc_once.done

@@ -5,7 +5,9 @@ every method sees the same trials), a *taught* hole pose: the true hole moved by
 ``hole_error`` (m) in a uniformly random direction of the surface plane, its yaw by a uniform
 ``+-yaw_error`` (rad, tasks whose yaw matters), and a start 25 mm above it (1 mm jitter). The
 skill's task frame is the taught hole; the true hole is known only to the simulator (ground
-truth, recorded beside the measured outcome). Methods (:data:`METHODS`):
+truth, recorded beside the measured outcome). A searching method is told the error's size,
+not its direction: the search's spread is at least ``hole_error`` wide (``search_radius``).
+Methods (:data:`METHODS`):
 
 - ``"skill"``: Johannsmeier et al.'s skill alone (its recovery only retracts);
 - ``"search"``: Ehlers et al.'s learned search alone, started on the surface at the taught pose (the
@@ -209,13 +211,26 @@ def _model(doc: str) -> SearchModel | None:
     return SearchModel.from_dict(json.loads(doc)) if doc else None
 
 
+def _search_context(job: AssemblyJob, skill: Skill) -> dict[str, float]:
+    """The search's context of a trial where ``skill`` searches: its seed (the trial's) and
+    its least spread, the taught hole's error (``search_radius``: a human's search narrower
+    than the error is widened to it; see :func:`~teachfit.skills.search.recentred`)."""
+    out = {}
+    if "search_seed" in skill.params.context:
+        out["search_seed"] = float(episode_seed(job.seed, job.index))
+    if "search_radius" in skill.params.context:
+        out["search_radius"] = job.hole_error
+    return out
+
+
 def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
     """Run one trial in this process (task, robot and model cached per process)."""
     task = _task(job.task, job.overrides)
     robot = _robot(job.task, job.overrides, job.robot, job.robot_options)
     rng = episode_rng(job.seed, job.index)
     taught = taught_hole(task, job.hole_error, job.yaw_error, rng)
-    ctx = peg_in_hole.hole_context(task, rng)
+    base = method_skill(job.method, _model(job.model_json), job.skill, job.controller)
+    ctx = peg_in_hole.hole_context(task, rng, base.params.context)
     values = dict(ctx.values)
     if job.method == "search":  # start on the surface at the taught pose
         start = taught.compose(Pose(np.array([0.0, 0.0, task.surface_z - task.hole2world.pos[2]])))
@@ -223,9 +238,7 @@ def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
         jitter = rng.normal(0.0, 0.001, 2)
         above = task.surface_z - task.hole2world.pos[2] + START_HEIGHT
         start = taught.compose(Pose.from_xyz_rz(jitter[0], jitter[1], above, 0.0))
-    base = method_skill(job.method, _model(job.model_json), job.skill, job.controller)
-    if "search_seed" in base.params.context:
-        values["search_seed"] = float(episode_seed(job.seed, job.index))
+    values |= _search_context(job, base)
     sk = base.with_context({k: v for k, v in values.items() if k in base.params.context})
     learned = {k: v for k, v in job.learned if k in sk.params.learned}
     t_max = sk.params.context["t_max"].value

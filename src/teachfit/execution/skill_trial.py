@@ -65,8 +65,8 @@ def peg_in_hole_setup(
     integer or a seed sequence, :func:`numpy.random.default_rng`; several set-ups:
     :mod:`teachfit.execution.setups`)."""
     rng = np.random.default_rng(seed)
-    ctx = peg_in_hole.hole_context(task, rng)
     base = skill if skill is not None else peg_in_hole.build(controller)
+    ctx = peg_in_hole.hole_context(task, rng, base.params.context)
     starts = peg_in_hole.default_starts(task, n_starts, rng)
     deviate = getattr(task.protocol, "start_frames", None)
     frames = tuple(deviate(ctx.hole2world_est, starts)) if callable(deviate) else ()

@@ -43,7 +43,10 @@ upright about that rim into the hole. With ``R = r + c`` the hole's half width:
   the high rim clears the near edge for any depth (*Jams* in :mod:`teachfit.skills.tilt`);
 * ``t_lateral = (|lateral_offset| + R) / (v_lateral s_low)`` with ``s_low`` the lowest learned
   ``speed_factor``: the slowest move still reaches the far wall; ``t_max`` grows by as much as
-  ``t_lateral`` does over its default, plus two passes of ``t_lateral + 1 s``;
+  ``t_lateral`` does over its default, plus two passes of ``t_lateral + 1 s``; a skill that
+  gives the lateral move up early (the joined skill's switch to a search,
+  :mod:`teachfit.skills.peg_in_hole_search`) waits ``t_reach = |lateral_offset| / (v_lateral
+  s_low)``, the slowest move's time to the taught axis;
 * a sharp leading rim (``e < c``) is pressed with half the default ``f_push``: pressed with
   4 N it caught on the seam between the plate's convex pieces (a resistance of 4.2 N along
   +x with the TCP still on the top, 4 of 10 executions); with 2 N it slid over it (10/10).
@@ -145,6 +148,7 @@ def fit_context(
         "pass_end": big_r,
         "pass_y": pass_y,
         "t_lateral": t_lateral,
+        "t_reach": start / (defaults["v_lateral"] * speed_low),
         "t_max": defaults["t_max"]
         + t_lateral
         - defaults["t_lateral"]

@@ -39,6 +39,7 @@ its square).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TypedDict
 
@@ -337,10 +338,13 @@ def estimate_hole(task: Task, rng: np.random.Generator) -> Pose:
     return task.hole2world.compose(err)
 
 
-def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
+def hole_context(
+    task: Task, rng: np.random.Generator, context: Mapping[str, ContextParam] | None = None
+) -> HoleContext:
     """Context for ``task``: estimated hole pose, goal depth, approach height above the
     surface, part symmetry; for a task that knows its fit a low-rim-first lateral move
-    (:mod:`teachfit.skills.fit_context`); overrides from a task's optional ``skill_context``
+    (:mod:`teachfit.skills.fit_context`, extending the time limits of ``context``: the skill's
+    own context, default :data:`CONTEXT`); overrides from a task's optional ``skill_context``
     mapping, the
     learned parameters its optional ``skill_fixed`` mapping fixes and the ``(low, high)``
     domains its optional ``skill_domains`` mapping gives."""
@@ -360,7 +364,7 @@ def hole_context(task: Task, rng: np.random.Generator) -> HoleContext:
     fit = fit_of(task)
     fit_domains: dict[str, ParamDomain] = {}
     if fit is not None:
-        defaults = {n: p.value for n, p in CONTEXT.items()}
+        defaults = {n: p.value for n, p in (dict(CONTEXT) | dict(context or {})).items()}
         speed_low = LEARNED["speed_factor"].domain.low
         fit_values, fit_domains = fit_context(fit, defaults, speed_low, LEARNED["tilt"].domain)
         values.update(fit_values)

@@ -2,7 +2,7 @@
 methods joined).
 
 The graph is :func:`teachfit.skills.peg_in_hole.build`'s with one more node, ``search``
-(:class:`~teachfit.skills.search.LearnedSearch`), and three more transitions::
+(:class:`~teachfit.skills.search.LearnedSearch`), and more transitions::
 
     approach -> contact -> lateral --constrained--> align -> insert  (success: depth)
                               |                       ^        |
@@ -12,15 +12,26 @@ The graph is :func:`teachfit.skills.peg_in_hole.build`'s with one more node, ``s
                                       dropped in: drop_depth -> align
 
 ``lateral`` gives up after the learned ``t_switch`` (or on leaving the region of interest)
-instead of failing; ``insert`` gives up after pushing ``t_stuck`` without the part dropping
+instead of failing, but not before ``t_reach``, the time the move needs to reach the taught
+hole (0 for Johannsmeier et al.'s short move; a task that knows its fit starts the move a part's
+width and more before the hole, :mod:`teachfit.skills.fit_context`: switching after 0.8 s
+there searched before the part had reached the hole). Such a task's extra passes
+(``lateral_2``, ``lateral_3``) give up alike, and the last one's miss (``-pass_end``) searches
+too. ``insert`` gives up after pushing ``t_stuck`` without the part dropping
 below the surface (the lateral move stopped on a false constraint). Both enter the search,
 which ends with the part caught in the hole (``drop_depth`` below the entry) -> ``align`` ->
-``insert``, or with the tour done / ``t_search`` over -> error -> ``retract``.
+``insert``, or with ``t_search`` over -> error -> ``retract`` (a tour that ends without a catch
+is followed by a fresh one from where it ended, ``search_repeat``: a tight sharp-edged fit is
+caught only within about its clearance of the hole's axis, and one tour of the default points
+took 7-8 s of the 15 s on the parts suite's 8 mm round part; 0: the tour done ends it).
 
 Learned, besides Johannsmeier et al.'s: ``t_switch``, ``t_stuck`` (when to switch to search) and the
 search's ``search_points``, ``search_scale``, ``search_speed``, ``search_push``; the meta
-learners tune them with the rest. Context adds ``t_search``, ``search_seed`` and raises the
-skill's ``t_max`` to leave time for a search.
+learners tune them with the rest. Context adds ``t_search``, ``search_seed``,
+``search_radius`` (how far off the taught hole may be: the search's spread in the surface plane
+is scaled up to at least this RMS radius, as a human who searched a narrower region than the
+error needs; :func:`~teachfit.skills.search.recentred`) and raises the skill's ``t_max`` to
+leave time for a search.
 """
 
 from __future__ import annotations
@@ -30,7 +41,14 @@ from dataclasses import replace
 from teachfit.core.params import ParamDomain
 from teachfit.models.search_model import SearchModel
 from teachfit.skills import peg_in_hole
-from teachfit.skills.conditions import DepthAbove, Done, LateralAbove, TimeAbove
+from teachfit.skills.conditions import (
+    DepthAbove,
+    Done,
+    ForceAbove,
+    LateralAbove,
+    TimeAbove,
+    XBelow,
+)
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
 from teachfit.skills.search import LearnedSearch
@@ -42,6 +60,13 @@ CONTEXT: dict[str, ContextParam] = {
     "t_lateral": ContextParam(3.0, "s", "hard time limit of the lateral move"),
     "t_search": ContextParam(15.0, "s", "time limit of the search"),
     "search_seed": ContextParam(0.0, "", "seed of the search's samples"),
+    "search_repeat": ContextParam(
+        1.0, "", "1: a tour without a catch is followed by another until t_search (0: one)"
+    ),
+    "t_reach": ContextParam(0.0, "s", "lateral time before t_switch counts: to the hole"),
+    "search_radius": ContextParam(
+        0.0, "m", "least RMS radius of the search's spread: the taught hole's error (0: none)"
+    ),
 }
 
 LEARNED: dict[str, LearnedParam] = {
@@ -54,6 +79,10 @@ LEARNED: dict[str, LearnedParam] = {
 }
 
 
+#: the lateral moves of the base skill's passes (the extra two only for a task that knows its fit)
+LATERALS = ("lateral", "lateral_2", "lateral_3")
+
+
 def build(model: SearchModel, controller: str = "adaptive") -> Skill:
     """The joined skill with search ``model`` (learned on the same kind of task)."""
     base = peg_in_hole.build(controller)
@@ -62,8 +91,12 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
     )
     dropped = DepthAbove("drop_depth")
     nodes = tuple(
-        replace(n, error=TimeAbove("t_lateral")) if n.name == "lateral" else n for n in base.nodes
+        replace(n, error=TimeAbove("t_lateral")) if n.name in LATERALS else n for n in base.nodes
     )
+    # a resistance away from where the far wall is expected: the hole is off by more than
+    # the fit's sigma (pushing on reaches f_max), so search from here
+    stopped = TimeAbove("t_settle") & ForceAbove("f_lateral_rev", axis="+x")
+    gave_up = (TimeAbove("t_switch") & TimeAbove("t_reach")) | LateralAbove("roi") | stopped
     search = Node(
         "search",
         LearnedSearch(model),
@@ -71,7 +104,8 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
         "learned search (TSHIX + GMR feed-forward) from where the skill is",
     )
     transitions = base.transitions + (
-        Transition("lateral", "search", TimeAbove("t_switch") | LateralAbove("roi")),
+        *(Transition(lateral, "search", gave_up) for lateral in LATERALS),
+        Transition(LATERALS[-1], "search", XBelow("-pass_end")),
         Transition("insert", "search", TimeAbove("t_stuck") & ~dropped),
         Transition("search", "align", dropped),
     )

@@ -15,7 +15,11 @@ is relative to a skill that failed to align. What transfers is the *shape* of th
 (the feed-forward). So the mixture is re-centred on the skill's belief -- the estimated hole
 (task-frame origin, estimated yaw) -- keeping each component's offset from the mixture mean,
 and its covariances are scaled by ``scale²``: the learned ``search_scale`` matches the human's
-spread to the size of the taught-hole error. The tour itself starts at the current pose.
+spread to the size of the taught-hole error. That spread is the human's own, set by how far
+the teacher started from the hole (e.g. 4 mm: an RMS radius of about 2 mm); where the taught
+hole may be off by more, ``radius`` (the skill's ``search_radius``, m) scales the spread up to
+at least that RMS radius in the surface plane -- else the tour never reaches the hole. The
+tour itself starts at the current pose.
 
 Along the task z the set-point follows the measured TCP, so only ``push`` presses the part
 onto the surface and it can drop freely into the hole: a set-point held at a fixed height would
@@ -54,11 +58,27 @@ BLEND = 0.3
 WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rz": 5}
 
 
-def recentred(ex: ExplorationDistribution, scale: float) -> ExplorationDistribution:
+def surface_radius(ex: ExplorationDistribution) -> float:
+    """The RMS radius (m) of ``ex`` in the surface plane: ``sqrt(var x + var y)`` of the
+    mixture over its ``x`` and ``y`` DOFs (0 without either)."""
+    idx = [j for j, d in enumerate(ex.dims) if d in ("x", "y")]
+    return float(np.sqrt(np.trace(ex.cov[np.ix_(idx, idx)]))) if idx else 0.0
+
+
+def recentred(
+    ex: ExplorationDistribution, scale: float, radius: float = 0.0
+) -> ExplorationDistribution:
     """``ex`` moved so that its mixture mean is 0, covariances times ``scale²``; component
-    offsets from the mixture mean scale by ``scale`` too (the shape is kept)."""
+    offsets from the mixture mean scale by ``scale`` too (the shape is kept). ``radius`` (m,
+    0: none) is the least :func:`surface_radius` of the result: a smaller scaled spread is
+    scaled up to it (a human spread narrower than the taught hole's error)."""
     if not (math.isfinite(scale) and scale > 0):
         raise SkillError(f"search scale must be > 0, got {scale}")
+    if not (math.isfinite(radius) and radius >= 0):
+        raise SkillError(f"search radius must be >= 0 m, got {radius}")
+    spread = surface_radius(ex)
+    if spread > 0:
+        scale = max(scale, radius / spread)
     means = (ex.means - ex.mean) * scale
     return ExplorationDistribution(ex.dims, ex.weights, means, ex.covs * scale**2)
 
@@ -100,9 +120,12 @@ def states_to_setpoints(
 class LearnedSearch(Primitive):
     """Search with a learned model from where the skill is; see the module docstring.
 
-    ``n_points`` TSHIX samples (rounded), ``scale`` of the exploration spread, ``speed``
+    ``n_points`` TSHIX samples (rounded), ``scale`` of the exploration spread (``radius``:
+    its least RMS radius in the surface plane, m; see :func:`recentred`), ``speed``
     factor on the teacher's speeds, ``push`` (N) onto the surface, ``seed`` of the sampler
-    (each entry of the node draws fresh samples from it). ``follow`` sets the compliance
+    (each entry of the node draws fresh samples from it), ``repeat`` (> 0: a finished tour
+    without a catch plans the next from where it ended, so the search ends only by the node's
+    time limit; 0: one tour, done when it ends, as Ehlers et al.'s). ``follow`` sets the compliance
     (its ``push_force`` is replaced by ``push``). Built in code only (it holds a model).
     """
 
@@ -112,6 +135,8 @@ class LearnedSearch(Primitive):
     speed: Value = "search_speed"
     push: Value = "search_push"
     seed: Value = "search_seed"
+    radius: Value = "search_radius"
+    repeat: Value = "search_repeat"
     follow: FollowConfig = FollowConfig(settle_time=0.0)
     kind: ClassVar[str] = "learned_search"
 
@@ -123,7 +148,9 @@ class LearnedSearch(Primitive):
         push = resolve(self.push, values)
         if not (math.isfinite(speed) and speed > 0 and math.isfinite(push) and push >= 0):
             raise SkillError(f"search speed must be > 0 and push >= 0, got {speed}, {push}")
-        ex = recentred(self.model.exploration, resolve(self.scale, values))
+        ex = recentred(
+            self.model.exploration, resolve(self.scale, values), resolve(self.radius, values)
+        )
         ang = None if self.model.angular_speed is None else self.model.angular_speed * speed
         planner = TshixPlanner(ex, self.model.speed * speed, ang)
         if self.follow.tilt is not None:
@@ -132,7 +159,7 @@ class LearnedSearch(Primitive):
             )
         cfg = FollowConfig(**{**self.follow.__dict__, "push_force": push, "anchor": "frame"})
         rng = np.random.default_rng(int(resolve(self.seed, values)))
-        return _SearchRun(self.model, planner, n, cfg, rng)
+        return _SearchRun(self.model, planner, n, cfg, rng, resolve(self.repeat, values) > 0)
 
     def describe(self) -> str:
         return (
@@ -152,13 +179,21 @@ class _SearchRun(PrimitiveRun):
         n: int,
         cfg: FollowConfig,
         rng: np.random.Generator,
+        repeat: bool = False,
     ) -> None:
         self.model, self.planner, self.n, self.cfg, self.rng = model, planner, n, cfg, rng
+        self.repeat = repeat
+        self.t0 = 0.0
         self.dims = model.dims
         self.follow: _FollowRun | None = None
         self.trajectory: SetpointTrajectory | None = None
 
     def enter(self, pc: Percept) -> None:
+        self.t0 = 0.0
+        self._plan(pc)
+
+    def _plan(self, pc: Percept) -> None:
+        """A tour from the measured pose, followed from node time ``t0`` on."""
         here = {"x": pc.p[0], "y": pc.p[1], "z": pc.p[2], "rz": yaw_of(pc.q)}
         start = np.array([here[d] for d in self.dims])
         try:
@@ -173,6 +208,14 @@ class _SearchRun(PrimitiveRun):
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         assert self.follow is not None, "enter() first"
-        self.follow.command(pc, out)
+        t_node = pc.t_node
+        pc.t_node = t_node - self.t0  # the tour's own clock
+        try:
+            self.follow.command(pc, out)
+        finally:
+            pc.t_node = t_node
         pc.p_d[2] = pc.p[2]  # force control along z: only the push presses (see the docstring)
         out.twist[2] = 0.0
+        if pc.done and self.repeat:  # a tour without a catch: another one from here
+            self.t0 = t_node
+            self._plan(pc)
