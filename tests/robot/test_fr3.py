@@ -11,7 +11,7 @@ from teachfit.core.state import ImpedanceCommand
 from teachfit.robot import make_robot
 from teachfit.robot.fr3 import FR3Params, FR3Robot
 from teachfit.robot.fr3.model import HAND_CLEARANCE, JOINTS, PART_PREFIX, fixture_top, grasp_drop
-from teachfit.robot.fr3.params import DTAU_MAX, GAZ_PHI1, Q_MAX, Q_MIN, TAU_MAX
+from teachfit.robot.fr3.params import BREAKAWAY_RATIO, DTAU_MAX, GAZ_PHI1, Q_MAX, Q_MIN, TAU_MAX
 from teachfit.robot.interface import Robot
 from teachfit.tasks import get_task
 
@@ -136,13 +136,25 @@ def test_joint_friction_holds_a_small_disturbance(task):
 
 
 @pytest.mark.parametrize(
-    ("sensor", "friction"), [("joint-torques", 1.0), ("joint-torques", 0.0), ("wrist-ft", 1.0)]
+    ("sensor", "friction", "ratio"),
+    [
+        ("joint-torques", 1.0, 1.0),
+        ("joint-torques", 0.0, 1.0),
+        ("wrist-ft", 1.0, 1.0),
+        ("joint-torques", 1.0, BREAKAWAY_RATIO),  # a static peak and the Stribeck term
+    ],
 )
-def test_estimated_external_wrench_matches_an_applied_force(task, sensor, friction):
-    params = FR3Params(sensor=sensor, torque_noise=0.0, ft_noise=(0, 0), joint_friction=friction)
+def test_estimated_external_wrench_matches_an_applied_force(task, sensor, friction, ratio):
+    params = FR3Params(
+        sensor=sensor,
+        torque_noise=0.0,
+        ft_noise=(0, 0),
+        joint_friction=friction,
+        breakaway_ratio=ratio,
+    )
     robot = FR3Robot(task, params=params)
-    assert np.all(
-        robot.model.dof_frictionloss == pytest.approx(np.asarray(GAZ_PHI1) / 2 * friction)
+    assert np.all(  # MuJoCo's dry friction holds up to the static level
+        robot.model.dof_frictionloss == pytest.approx(np.asarray(GAZ_PHI1) / 2 * friction * ratio)
     )
     pose = free_pose(task)
     robot.reset(pose)

@@ -47,7 +47,7 @@ def test_compiled_fixed_gain_tick_equals_the_python_law(task):
     assert np.ptp(fast[:, 0]) > 1e-5  # it did move along x
 
 
-def test_replaying_the_torques_through_mj_step_gives_the_same_run(task):
+def test_replaying_the_torques_through_the_physics_gives_the_same_run(task):
     robot = FR3Robot(task)
     robot.reset(task.protocol.teacher_start(np.random.default_rng(0)))
     m, d = robot.model, robot.data
@@ -57,7 +57,7 @@ def test_replaying_the_torques_through_mj_step_gives_the_same_run(task):
     assert ticks.shape == (200,) and np.all(ticks > 0)
     d.qpos[:], d.qvel[:], d.qacc_warmstart[:], d.time = snapshot
     mujoco.mj_forward(m, d)
-    kernel.replay(kernel.routines(), m._address, d._address, d.ctrl, log)
+    robot.replay(log)
     np.testing.assert_allclose(d.qpos, end, atol=1e-12)
 
 

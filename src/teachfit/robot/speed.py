@@ -5,7 +5,7 @@ The raw loop keeps the last controller wrench applied (``qfrc_applied`` persists
 in the same contact; the controlled loop recomputes the impedance law every 1 ms tick.
 
 For the FR3 (``robot="fr3"``) the controlled loop runs the whole 1 ms tick (torque law, limits,
-wrench sensing) and the raw loop replays its torques through plain ``mj_step``; the torque
+wrench sensing) and the raw loop replays its torques through the bare physics step; the torque
 law's compute time per tick is also timed (median and 99th percentile).
 """
 
@@ -47,6 +47,8 @@ class _TimedRobot(_MujocoRobot, Protocol):
     """The FR3, whose compiled tick also times the torque law."""
 
     def step_timed(self, n: int) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def replay(self, log: np.ndarray) -> None: ...
 
 
 def _pressed_robot(task: Task, name: str) -> tuple[_MujocoRobot, ImpedanceCommand]:
@@ -117,19 +119,18 @@ def measure_sim_speed(
 
 
 def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSimSpeed:
-    """The FR3's figures: raw ``mj_step`` vs. the full controlled tick (best of ``repeats``,
+    """The FR3's figures: the raw physics step vs. the full controlled tick (best of ``repeats``,
     interleaved), and the torque law's compute time per tick (p50, p99 over all ticks).
 
     The controlled tick runs as one compiled loop (:mod:`teachfit.robot.fr3.kernel`), so the
     raw loop is compiled too: from the same pressed state it replays the controlled run's
-    torques through plain ``mj_step`` (the same states, contacts and solver work, no Python
-    per step), so the ratio is what the controller adds to the physics. Speeds are in CPU
+    torques through the bare physics step (:meth:`FR3Robot.replay`: ``mj_step1``, the joints'
+    Stribeck term, ``mj_step2``; the same states, contacts and solver work, no Python per
+    step), so the ratio is what the controller adds to the physics. Speeds are in CPU
     seconds of this thread (``time.thread_time``): on a shared machine other jobs' time does
     not count, and on an idle one it equals the wall clock. The compute time is measured
     inside the loop around the law and the torque map of each tick (wall clock, ns).
     """
-    from teachfit.robot.fr3 import kernel
-
     raw_best = ctl_best = 0.0
     contacts = 0
     samples: list[np.ndarray] = []
@@ -147,7 +148,7 @@ def measure_fr3_speed(task: Task, steps: int = 5000, repeats: int = 3) -> ArmSim
         d.qpos[:], d.qvel[:], d.ctrl[:], d.qacc_warmstart[:], d.time = snapshot
         mujoco.mj_forward(m, d)
         t0 = time.thread_time()
-        kernel.replay(kernel.routines(), m._address, d._address, d.ctrl, log)
+        robot.replay(log)
         raw_best = max(raw_best, steps / (time.thread_time() - t0))
     assert robot is not None
     rtf = ctl_best * robot.control_period

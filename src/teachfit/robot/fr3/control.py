@@ -92,15 +92,7 @@ class TorqueImpedance:
         self.tau_prev = np.zeros(nv)
         self.wrench = np.zeros(6)
         self._work = (np.zeros((6, nv)), np.zeros((6, 6)), np.zeros(nv), np.zeros(6), np.zeros(6))
-        self.dat = (
-            data.qpos,
-            data.qvel,
-            data.qfrc_bias,
-            data.ctrl,
-            data.sensordata,
-            data.site_xmat[site],
-            data.site_xpos[site],
-        )
+        self.dat = k.data_views(data, site)
         self.law = law
 
     @property

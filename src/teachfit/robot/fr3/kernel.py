@@ -109,6 +109,43 @@ _MONOTONIC = 1  # CLOCK_MONOTONIC on Linux
 OK, LIMIT, NOISE_EMPTY = 0, 1, 2
 
 
+def data_views(data: mujoco.MjData, site: int) -> tuple[np.ndarray, ...]:
+    """The MjData views every kernel reads (``dat``): qpos, qvel, qfrc_bias, ctrl, sensordata,
+    the TCP ``site``'s xmat and xpos, qfrc_passive."""
+    return (
+        data.qpos,
+        data.qvel,
+        data.qfrc_bias,
+        data.ctrl,
+        data.sensordata,
+        data.site_xmat[site],
+        data.site_xpos[site],
+        data.qfrc_passive,
+    )
+
+
+@numba.njit(cache=True, inline="always")
+def stribeck(qvel, passive, drop, inv_vs) -> None:  # noqa: ANN001
+    """Between ``mj_step1`` and ``mj_step2``: the joints' Stribeck decay, a passive torque
+    ``drop (1 - exp(-(dq / v_s)^2)) sign(dq)`` (N·m) along each joint's motion, added to
+    ``qfrc_passive`` (which ``mj_step1`` has just computed). With ``frictionloss`` at the static
+    level ``F_s`` and ``drop = F_s - F_c`` the sliding friction is the Stribeck curve
+    (:mod:`teachfit.robot.fr3.model`). ``inv_vs``: ``1 / v_s`` (s/rad) per joint."""
+    for j in range(qvel.shape[0]):
+        x = qvel[j] * inv_vs[j]
+        push = drop[j] * (1.0 - np.exp(-x * x))
+        passive[j] += push if x > 0.0 else -push
+
+
+@numba.njit(cache=True)
+def step_physics(fns, m, d, dat, joints) -> None:  # noqa: ANN001
+    """One physics step with the joints' Stribeck term: ``mj_step1``, :func:`stribeck`,
+    ``mj_step2`` (``ctrl`` as it stands). ``joints``: as :func:`run_fixed`'s ``lim``."""
+    fns[0](m, d)
+    stribeck(dat[1], dat[7], joints[3], joints[4])
+    fns[1](m, d)
+
+
 @numba.njit(cache=True)
 def kinematics(fns, m, d, site, jac, xmat, quat, twist, qvel):  # noqa: ANN001, ANN201
     """TCP Jacobian (world, rows ``[v; w]``), orientation and twist from current kinematics."""
@@ -211,7 +248,7 @@ def _biquad(coef, x, y, z) -> None:  # noqa: ANN001
 
 @numba.njit(cache=True, inline="always")
 def _outside(qpos, qvel, lim) -> bool:  # noqa: ANN001
-    q_min, q_max, dq_max = lim
+    q_min, q_max, dq_max = lim[0], lim[1], lim[2]
     for j in range(qpos.shape[0]):
         if qpos[j] < q_min[j] or qpos[j] > q_max[j] or abs(qvel[j]) > dq_max[j]:
             return True
@@ -220,9 +257,11 @@ def _outside(qpos, qvel, lim) -> bool:  # noqa: ANN001
 
 @numba.njit(cache=True, inline="always")
 def _actuate_and_step(fns, m, d, dat, ctl, obs, lim, sc) -> bool:  # noqa: ANN001
-    """``ctrl = tau``, ``mj_step2``, sensing; True if a joint left its limits."""
+    """``ctrl = tau``, the Stribeck term, ``mj_step2``, sensing; True if a joint left its
+    limits."""
     dat[3][:] = ctl[6]
     obs[0][:] = dat[1]
+    stribeck(dat[1], dat[7], lim[3], lim[4])
     fns[1](m, d)
     observe(fns, m, d, dat, obs, sc)
     return _outside(dat[0], dat[1], lim)
@@ -261,18 +300,19 @@ def _now(fns, ts) -> int:  # noqa: ANN001
 
 
 @numba.njit(cache=True)
-def replay(fns, m, d, ctrl, log):  # noqa: ANN001, ANN201
-    """Plain ``mj_step`` with the torques ``log[k]`` (n, nu) written into ``ctrl`` before step
-    ``k``, in a compiled loop: the physics alone of a controlled run, for comparison."""
+def replay(fns, m, d, dat, joints, log):  # noqa: ANN001, ANN201
+    """:func:`step_physics` with the torques ``log[k]`` (n, nu) written into ``ctrl`` before
+    step ``k``, in a compiled loop: the physics alone of a controlled run, for comparison."""
     for k in range(log.shape[0]):
-        ctrl[:] = log[k]
-        fns[12](m, d)
+        dat[3][:] = log[k]
+        step_physics(fns, m, d, dat, joints)
 
 
 @numba.njit(cache=True)
 def run_fixed(n, t, fns, m, d, site, dat, ctl, law, obs, lim, sc, times, log):  # noqa: ANN001, ANN201, E501
     """``n`` whole ticks with the fixed-gain law from time ``t``: ``(ticks done, status)``.
 
+    ``lim``: the joints' (q_min, q_max, dq_max, Stribeck ``F_s - F_c``, ``1 / v_s``).
     Stops early after a tick that left the joint limits (``LIMIT``) or before one that has no
     sensor noise left (``NOISE_EMPTY``: the caller draws more and calls again). When ``times``
     (int64) is not empty, ``times[k]`` gets tick ``k``'s law and torque compute time (ns), and

@@ -14,14 +14,22 @@ The kinematics and link inertias are Franka's published ones. Edits made here:
 - the position servos are replaced by torque motors: gain 1, no bias,
   ``ctrlrange = ±tau_max`` (87/87/87/87/12/12/12 N·m);
 - joint ranges are the FR3 datasheet's; joint friction is Gaz et al.'s identification
-  (RA-L 2019) as MuJoCo ``frictionloss`` = the Coulomb level ``phi1 / 2`` of their sigmoid and
-  no viscous ``damping``. Why ``frictionloss`` and not the sigmoid applied per tick: the sigmoid
-  is zero at zero speed, so applied as a torque it cannot hold anything still, whereas the real
-  arm's gears do hold small loads; MuJoCo solves ``frictionloss`` as a dry-friction constraint
-  (static and sliding, implicit, stable at 1 ms), which reproduces both the sticking and the
-  sigmoid's saturated level; the sigmoid's smooth ramp (|dq| < ~0.2 rad/s) is below what the
-  constraint resolves. Armature (reflected rotor inertia) keeps the Menagerie's values: Gaz et
-  al. identify link-side parameters only;
+  (RA-L 2019) with an optional static peak and Stribeck decay (:mod:`teachfit.robot.fr3.params`,
+  off by default: the joints break away at ``F_s = r F_c`` and slide at
+  ``F_c + (F_s - F_c) exp(-(dq/v_s)^2)``, ``F_c = phi1 / 2`` the Coulomb level of Gaz's
+  sigmoid), no viscous ``damping``. MuJoCo
+  ``frictionloss`` is set to the *static* level ``F_s``: MuJoCo solves it as a dry-friction
+  constraint (static and sliding, implicit, stable at 1 ms), so the joint sticks until the
+  load exceeds ``F_s``, and while it slides the constraint pushes back with ``F_s``. Each tick
+  (between ``mj_step1`` and ``mj_step2``, :func:`teachfit.robot.fr3.kernel.stribeck`) a
+  passive torque along the motion, ``(F_s - F_c) (1 - exp(-(dq/v_s)^2)) sign(dq)``, is added
+  to ``qfrc_passive``: the sliding friction is then the Stribeck curve, ``F_c`` once the joint
+  moves faster than a few ``v_s``. It is friction in the gears, on the motor side of the
+  link-side torque sensors, so they read past it as past the constraint (``sensing``). Why
+  not Gaz's sigmoid applied per tick: it is zero at zero speed, so applied as a torque it
+  cannot hold anything still, whereas the real arm's gears do hold small loads; the sigmoid's
+  smooth ramp (|dq| < ~0.2 rad/s) is below what the constraint resolves. Armature (reflected
+  rotor inertia) keeps the Menagerie's values: Gaz et al. identify link-side parameters only;
 - the arm's base stands at ``FR3Params.base_pos`` in the task's world frame, so the fixture
   stays where the task builds it; a wrist F/T site sits on the flange.
 
@@ -46,6 +54,13 @@ Landings are then absorbed over several ticks and the part stays on the surface;
 tens of micrometres under the press, which the 0.2 mm clearance tolerates. The joints' dry
 friction gets a 5 ms time constant (``joint_friction_solref``, MuJoCo's default is 20 ms): it
 then sticks crisply instead of creeping and slipping in bursts, which shook the sliding part.
+
+No stick-slip at the part/fixture contact: a MuJoCo contact has one friction coefficient per
+direction (sliding, torsional, rolling), the same for sticking and for sliding, and its cone is
+solved as a soft constraint without a velocity-dependent coefficient; a static coefficient above
+the kinetic one would need a per-contact force applied from outside the solver each tick
+(explicit, at the mesh pieces' many contact points), which is not done. Stick-slip on the arm
+comes from its joints.
 """
 
 from __future__ import annotations
@@ -60,7 +75,7 @@ import mujoco
 import numpy as np
 
 from teachfit.core.errors import TeachfitError
-from teachfit.robot.fr3.params import Q_MAX, Q_MIN, TAU_MAX, FR3Params, coulomb_friction
+from teachfit.robot.fr3.params import Q_MAX, Q_MIN, TAU_MAX, FR3Params
 from teachfit.tasks.base import Task
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml
 
@@ -121,7 +136,7 @@ def _arm_spec(params: FR3Params) -> mujoco.MjSpec:
         arm.delete(arm.body(name))
     for item in [*arm.actuators, *arm.tendons, *arm.equalities, *arm.keys]:
         arm.delete(item)
-    friction = coulomb_friction() * params.joint_friction
+    friction = params.static_friction()
     for i, name in enumerate(JOINTS):
         joint = arm.joint(name.removeprefix(ARM_PREFIX))
         joint.range = [Q_MIN[i], Q_MAX[i]]

@@ -94,7 +94,8 @@ class FR3Robot:
             self.params.null_damping,
         )
         self._build_sensing(flange)
-        self._limits = (self.q_min, self.q_max, self.dq_max)
+        # the joints' limits and Stribeck constants, as the compiled tick takes them
+        self._limits = (self.q_min, self.q_max, self.dq_max, *self.params.stribeck())
         self._warning_numbers = self.data.warning.number
         self._warnings = 0
         self._fault: RobotFault | ControlError | None = None
@@ -251,6 +252,13 @@ class FR3Robot:
         self._run_compiled(n, times, log)
         self._check_divergence()
         return times / 1e3, log
+
+    def replay(self, log: np.ndarray) -> None:
+        """The physics alone of a controlled run: one step per row of joint torques ``log``
+        (n, 7) (N·m) written into ``ctrl``, the joints' Stribeck term included, no law, no
+        sensing, no limit checks (compiled, :func:`teachfit.robot.fr3.kernel.replay`)."""
+        ctl = self.ctl
+        kernel.replay(ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.dat, self._limits, log)
 
     def _run_python_law(self, n: int) -> None:
         ctl, d, sc = self.ctl, self.data, self.ctl.sc

@@ -125,7 +125,8 @@ class TwinSimulator(BaseSimulator):
         super().__init__()
         self.params = params or TwinParams()
         self.task = task
-        self.model = fr3_model.build_fr3_model(task, cell_params(self.params))
+        cell = cell_params(self.params)
+        self.model = fr3_model.build_fr3_model(task, cell)
         self.data = mujoco.MjData(self.model)
         self.robot = TwinRobot(initial_q=tuple(float(v) for v in self.start_q()))
         rng = np.random.default_rng(self.params.seed)
@@ -142,6 +143,8 @@ class TwinSimulator(BaseSimulator):
         )
         self._hand = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, fr3_model.HAND)
         self._kernel_args = self._observer_args()
+        # the fr3 robot's joint constants, for the Stribeck term of each step (no limit checks)
+        self._joints = (np.zeros(0), np.zeros(0), np.zeros(0), *cell.stribeck())
         self._jac = np.zeros((6, self.model.nv))
 
     def start_q(self) -> np.ndarray:
@@ -154,15 +157,7 @@ class TwinSimulator(BaseSimulator):
         """The compiled observer's arguments (the fr3 robot's layout; no wrist sensor here)."""
         m, d, obs = self.model, self.data, self.observer
         tcp = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, fr3_model.TCP_SITE)
-        dat = (
-            d.qpos,
-            d.qvel,
-            d.qfrc_bias,
-            d.ctrl,
-            d.sensordata,
-            d.site_xmat[tcp],
-            d.site_xpos[tcp],
-        )
+        dat = kernel.data_views(d, tcp)
         z6 = np.zeros(6)
         bufs = (*obs.bufs, 0, z6, obs.coef, obs.tau_out, obs.tau_z, np.zeros(6), np.zeros((2, 6)))
         sc = np.zeros(kernel.N_SCALARS)
@@ -182,14 +177,15 @@ class TwinSimulator(BaseSimulator):
         return [self.robot]
 
     def _step(self) -> None:
-        """One physics step, then the observer on the step's torques (``qM``, ``qfrc_bias``
+        """One physics step (the joints' Stribeck term included, as on the fr3 robot), then
+        the observer on the step's torques (``qM``, ``qfrc_bias``
         still hold the step's start, as the observer expects)."""
         fns, m_ptr, d_ptr, dat, bufs, sc = self._kernel_args
         if sc[kernel.NOISE_I] >= len(self.observer.noise):
             self.observer.draw_noise()
             sc[kernel.NOISE_I] = 0.0
         bufs[0][:] = self.data.qvel  # dq before the step
-        mujoco.mj_step(self.model, self.data)
+        kernel.step_physics(fns, m_ptr, d_ptr, dat, self._joints)
         kernel.observe(fns, m_ptr, d_ptr, dat, bufs, sc)
 
     def joints(self) -> tuple[np.ndarray, np.ndarray]:
