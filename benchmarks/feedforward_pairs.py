@@ -6,8 +6,9 @@ Usage: ``python benchmarks/feedforward_pairs.py [--robot fr3] [--trajectories 20
 For each N, ``--trajectories`` TSHIX trajectories from Table II's start, each executed with
 and without the GMR feed-forward (the same seeds, start and demonstration:
 :func:`teachfit.bench.search.table2` with one size), printed as a markdown table with Wilson
-95 % intervals beside the paper's Table II (with) and ablation (without) figures, a row as each
-N finishes. ``--markdown FILE`` appends the table when all have finished, headed with where it
+95 % intervals, the discordant pairs and their exact sign test (:func:`teachfit.metrics.stats.
+paired_sign_test`), beside the paper's Table II (with) and ablation (without) figures, a row as
+each N finishes. ``--markdown FILE`` appends the table when all have finished, headed with where it
 came from (``benchmarks/results/feedforward-pairs-fr3.md`` feeds BENCHMARKS.md).
 """
 
@@ -18,9 +19,17 @@ import time
 
 from teachfit.bench import search
 from teachfit.cli.script_markdown import add_markdown_option, append_table, checked_markdown, table
-from teachfit.metrics.stats import wilson_interval
+from teachfit.metrics.stats import paired_sign_test, wilson_interval
 
-HEADER = ("N", "with feed-forward", "without", "paper with", "paper without", "wall")
+HEADER = (
+    "N",
+    "with feed-forward",
+    "without",
+    "pairs with : without (sign test p)",
+    "paper with",
+    "paper without",
+    "wall",
+)
 
 
 def _rate(s: int, n: int) -> str:
@@ -34,6 +43,8 @@ def pairs_row(seed: int, n: int, trajectories: int, workers: int) -> list[str]:
     (ff,), (no,) = search.table2(seed, (n,), trajectories, (n,), workers=workers)
     paper = [search.PAPER_TABLE2.get(n), search.PAPER_ABLATION.get(n)]
     cells = [_rate(r.ours.successes, r.ours.trials) for r in (ff, no)]
+    n_ff, n_no, p = paired_sign_test(ff.outcomes, no.outcomes)
+    cells.append(f"{n_ff} : {n_no} (p = {p:.3g})")
     cells += ["n/a" if p is None else _rate(*p) for p in paper]
     return [str(n), *cells, f"{time.monotonic() - t0:.0f} s"]
 

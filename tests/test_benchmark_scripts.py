@@ -83,7 +83,10 @@ def test_feedforward_pairs_appends_one_row_per_n(monkeypatch, capsys, tmp_path) 
     from teachfit.bench import search
 
     def rate(successes: int, trials: int) -> SimpleNamespace:
-        return SimpleNamespace(ours=SimpleNamespace(successes=successes, trials=trials))
+        outcomes = (True,) * successes + (False,) * (trials - successes)  # paired by seed
+        return SimpleNamespace(
+            ours=SimpleNamespace(successes=successes, trials=trials), outcomes=outcomes
+        )
 
     def table2(seed, sizes, n_traj, ablation, workers=None):
         (n,) = sizes
@@ -93,9 +96,13 @@ def test_feedforward_pairs_appends_one_row_per_n(monkeypatch, capsys, tmp_path) 
     args = ["--robot", "floating", "--trajectories", "4", "--sizes", "100,300"]
     body = _check(monkeypatch, capsys, tmp_path, "feedforward_pairs", args)
     assert "**Feed-forward ablation on the floating, 4 paired trajectories per N**" in body
-    assert "| 100 | 2/4 = 50 % [15, 85] | 0/4 = 0 % [0, 49] | 6/20 = 30 % [15, 52] |" in body
     assert (
-        "| 300 | 4/4 = 100 % [51, 100] | 1/4 = 25 % [5, 70] | 17/20 = 85 % [64, 95] | n/a |" in body
+        "| 100 | 2/4 = 50 % [15, 85] | 0/4 = 0 % [0, 49] | 2 : 0 (p = 0.5) | 6/20 = 30 % [15, 52] |"
+        in body
+    )
+    assert (
+        "| 300 | 4/4 = 100 % [51, 100] | 1/4 = 25 % [5, 70] | 3 : 0 (p = 0.25) | "
+        "17/20 = 85 % [64, 95] | n/a |" in body
     )
 
 

@@ -58,7 +58,8 @@ class Row:
     """One line of a table: ours beside the paper's ``(successes, trials)`` (None: no figure).
 
     ``plan_ms`` is the median planning wall time; ``length`` the mean path length (m, rz
-    unweighted); ``ergodic`` the mean ergodic metric of the executed plans.
+    unweighted); ``ergodic`` the mean ergodic metric of the executed plans; ``outcomes`` each
+    job's success in the order of its seeds (rows run on the same seeds pair up).
     """
 
     method: str
@@ -68,6 +69,7 @@ class Row:
     length: float
     ergodic: float
     paper_cpu_s: float | None = None
+    outcomes: tuple[bool, ...] = ()
 
 
 def _row(
@@ -85,6 +87,7 @@ def _row(
         float(np.mean([r.path_length for r in results])),
         float(np.mean([r.ergodic_metric for r in results])),
         paper_cpu_s,
+        tuple(bool(r.success) for r in results),
     )
 
 

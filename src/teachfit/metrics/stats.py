@@ -6,7 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import norm
+from scipy.stats import binomtest, norm
 
 from teachfit.core.errors import TeachfitError
 
@@ -26,6 +26,22 @@ def wilson_interval(successes: int, trials: int, confidence: float = 0.95) -> tu
     centre = (p + z * z / (2 * trials)) / denom
     half = z * np.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / denom
     return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def paired_sign_test(a: Sequence[bool], b: Sequence[bool]) -> tuple[int, int, float]:
+    """Exact two-sided sign test of paired successes ``a`` against ``b`` (same seeds).
+
+    Only the discordant pairs count: ``n_ab`` (``a`` succeeded, ``b`` did not) and ``n_ba``;
+    under the null hypothesis each is Binomial(n_ab + n_ba, 1/2) (McNemar's exact test).
+    Returns ``(n_ab, n_ba, p)``; ``p`` is 1 without a discordant pair.
+    """
+    if len(a) != len(b):
+        raise TeachfitError(f"paired_sign_test needs pairs: {len(a)} against {len(b)} outcomes")
+    n_ab = sum(1 for x, y in zip(a, b, strict=True) if x and not y)
+    n_ba = sum(1 for x, y in zip(a, b, strict=True) if y and not x)
+    if n_ab + n_ba == 0:
+        return 0, 0, 1.0
+    return n_ab, n_ba, float(binomtest(n_ab, n_ab + n_ba, 0.5).pvalue)
 
 
 @dataclass(frozen=True)
