@@ -41,9 +41,10 @@ from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
-from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
+from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints, col_major
 from teachfit.robot.franka.grasp import GraspWatch, connect_gripper
 from teachfit.robot.franka.loop import ControlLoop, fault_from
+from teachfit.robot.franka.reflex import ReflexThresholds, check_reflex_force, reflex_thresholds
 from teachfit.robot.franka.reset_path import ResetCell, ResetGuard, reset_via_points
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
@@ -69,7 +70,9 @@ class FrankaParams:
     ``tick_timeout`` (s) without a tick after which the connection counts as lost,
     ``connect_timeout`` (s, wall clock) a connect may take before the robot counts as not
     answering (:mod:`teachfit.robot.franka.connect`), ``reset_cell`` the hole a reset leaves
-    along its axis first (:mod:`teachfit.robot.franka.reset_path`; ``None``: straight lines).
+    along its axis first (:mod:`teachfit.robot.franka.reset_path`; ``None``: straight lines),
+    ``reflex_force`` (N) the firmware's collision reflex force threshold set on connect
+    (:mod:`teachfit.robot.franka.reflex`; ``None``: 1.25 x ``limits.max_force``, 75 N).
     """
 
     limits: FrankaLimits = field(default_factory=FrankaLimits)
@@ -83,6 +86,11 @@ class FrankaParams:
     tick_timeout: float = 1.5
     connect_timeout: float = CONNECT_TIMEOUT
     reset_cell: ResetCell | None = None
+    reflex_force: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.reflex_force is not None:
+            check_reflex_force(self.reflex_force)
 
 
 class FrankaRobot:
@@ -146,6 +154,8 @@ class FrankaRobot:
         #: lateral force watch while a reset leaves the hole; its ``peaks`` (N), one per reset
         self.reset_guard = ResetGuard(cell) if cell is not None else None
         self.robot_mode = "unknown"
+        #: the collision thresholds sent to the firmware (set on connect and each restart)
+        self.reflex: ReflexThresholds | None = None
         try:
             self._start()
         except BaseException:
@@ -371,9 +381,22 @@ class FrankaRobot:
         self.robot_mode = str(first.robot_mode).split(".")[-1]
         tick = self._loop.tick
         tick.kinematics(first, self._model)
+        self._set_reflex(first, tick.jacobian)
         tick.q_rest = np.asarray(first.q, dtype=float)
         here = Pose(tick.pos.copy(), tick.quat.copy())
         law = self._approach_law()
         stiff = np.asarray(self.params.reset_stiffness, dtype=float)
         law.set_command(self._hold(here, stiff), self._loop.t_abs)
         self._loop.start(self._robot, self._model, first, law)
+
+    def _set_reflex(self, first: Any, jacobian: np.ndarray) -> None:
+        """Send the collision thresholds (:mod:`~teachfit.robot.franka.reflex`) for the pose of
+        ``first`` (a state read while the robot is idle: the firmware takes them only then)."""
+        k_lever = col_major(first.EE_T_K)[:3, 3] - self.params.frames.ee2tcp.pos
+        self.reflex = reflex_thresholds(
+            self.params.limits, jacobian, float(np.linalg.norm(k_lever)), self.params.reflex_force
+        )
+        try:
+            self.reflex.send(self._robot)
+        except Exception as exc:  # noqa: BLE001 - a refusal is a robot fault
+            raise fault_from(exc, self._loop.robot) from exc
