@@ -164,7 +164,10 @@ def test_exec_per_cpu_runs_and_compares_fixed_executions(monkeypatch, capsys, tm
 
 @pytest.mark.parametrize(
     ("args", "said"),
-    [(["--trials", "0"], "error: --trials 0: give at least 1"), (["--task", "nope"], "nope")],
+    [
+        (["--trials", "0"], "error: --trials 0: give at least 1"),
+        (["--cases", "peg,nope"], "error: --cases peg,nope: known cases are peg, tshix-peg2d"),
+    ],
 )
 def test_twin_vs_fr3_refuses_bad_input_before_starting_anything(
     monkeypatch, capsys, args: list[str], said: str
