@@ -222,10 +222,11 @@ def main(argv: list[str] | None = None) -> None:
     print("| " + " | ".join(HEADER) + " |")
     for row in rows:
         print("| " + " | ".join(row) + " |")
+    what = {"peg": "the peg skill's default parameters on peg",
+            "tshix-peg2d": f"TSHIX (N = {args.points}) on peg2d"}  # fmt: skip
     title = (
         f"**fr3 in-process vs the franka driver on the twin**, the same {args.trials} starts "
-        f"per case (seed {args.seed}): the peg skill's default parameters on peg, TSHIX "
-        f"(N = {args.points}) on peg2d"
+        f"per case (seed {args.seed}): " + "; ".join(what[c] for c in cases)
     )
     append_table(ap, markdown, table(title, HEADER, rows))
 
