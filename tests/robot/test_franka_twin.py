@@ -368,3 +368,28 @@ def test_a_peg_skill_execution_in_contact_is_not_stopped_by_a_reflex(franka_twin
     assert not trace.reflex and trace.outcome is not Outcome.FAULT, trace.reason
     assert trace.peak_force > 15.0, trace.peak_force  # it was in contact
     assert "lateral" in [v.node for v in trace.visits]
+
+
+def test_the_laws_apparent_mass_is_the_arms_at_the_reset_pose(franka_twin: Twin) -> None:
+    """The driver's damping uses the operational-space inertia from libfranka's mass matrix
+    (the cell's own, up to the motors' rotor inertia the model leaves out), not 2 kg."""
+    import mujoco
+
+    from teachfit.robot.fr3 import model as fr3_model
+    from teachfit.robot.fr3.control import operational_inertia
+    from teachfit.robot.franka.twin_cell import TwinSimulator
+
+    franka_twin()
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        robot.reset(TASK.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.02]))
+        mass, q = robot.apparent_mass, robot.joint_positions
+    sim = TwinSimulator(TASK)
+    m, d = sim.model, sim.data
+    ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in fr3_model.JOINTS]
+    d.qpos[[m.jnt_qposadr[i] for i in ids]] = q
+    mujoco.mj_forward(m, d)
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, fr3_model.TCP_SITE)
+    cell = np.diag(operational_inertia(m, d, site))
+    assert mass[0] > 5.0, mass  # the FR3's TCP weighs 10-15 kg along x here
+    np.testing.assert_allclose(mass[:5], cell[:5], rtol=0.4)
+    assert mass[5] >= 0.05  # about the tool axis: the floor (the model reads 0.002)
