@@ -167,3 +167,19 @@ def test_exec_per_cpu_runs_and_compares_fixed_executions(monkeypatch, capsys, tm
         _run(monkeypatch, "exec_per_cpu", ["--compare", str(run), str(other)])
     err = capsys.readouterr().err
     assert stop.value.code == 2 and err.count("\n") == 1 and "other parameter sets" in err
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["--trials", "0"], "error: --trials 0: give at least 1"),
+        (["--cases", "peg,nope"], "error: --cases peg,nope: known cases are peg, tshix-peg2d"),
+    ],
+)
+def test_twin_vs_fr3_refuses_bad_input_before_starting_anything(
+    monkeypatch, capsys, args: list[str], said: str
+) -> None:
+    with pytest.raises(SystemExit) as stop:
+        _run(monkeypatch, "twin_vs_fr3", args)
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and said in err and err.count("\n") == 1, err

@@ -79,3 +79,17 @@ def test_libfranka_exceptions_become_typed_faults() -> None:
         type(fault_from(pf.NetworkException("libfranka: UDP receive: Timeout"))) is ConnectionLost
     )
     assert type(fault_from(ValueError("bad"))) is RobotFault
+
+
+def test_operational_mass_is_lambdas_diagonal_in_world_axes() -> None:
+    from teachfit.robot.franka.tick import operational_mass
+
+    rng = np.random.default_rng(3)
+    jac = rng.normal(size=(6, 7))
+    a = rng.normal(size=(7, 7))
+    mass = a @ a.T + 7 * np.eye(7)
+    lam = np.linalg.inv(jac @ np.linalg.inv(mass) @ jac.T)
+    np.testing.assert_allclose(operational_mass(mass, jac, np.eye(3)), np.diag(lam))
+    quarter = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # about z
+    turned = operational_mass(mass, jac, quarter)
+    np.testing.assert_allclose(turned[[1, 0, 2, 4, 3, 5]], np.diag(lam))  # x and y swap

@@ -304,3 +304,92 @@ def test_a_reset_out_of_an_inserted_hole_leaves_along_its_axis_under_5_n(
         peak = robot.reset_guard.peaks[-1]
     assert np.linalg.norm(done.pos - aside.pos) < 0.006
     assert peak <= 5.0, peak
+
+
+def _press_down(robot: Any, depth: float, ticks: int) -> Any:
+    """Hold the TCP ``depth`` m below the plate beside the boss at 2000 N/m (about
+    2000 * depth N down once it rests on the plate); the last state."""
+    above = TASK.contact_pose(np.zeros(2)).translated(list(BESIDE_BOSS))  # 2 mm above
+    robot.reset(above)
+    below = Pose(above.pos - [0.0, 0.0, 0.002 + depth], above.quat)
+    for pose in approach_waypoints(above, below, 0.02, 0.3, 0.01):
+        robot.command(ImpedanceCommand.hold(pose, stiffness=2000.0))
+        state = robot.step(10)
+    for _ in range(ticks // 10):
+        robot.command(ImpedanceCommand.hold(below, stiffness=2000.0))
+        state = robot.step(10)
+    return state
+
+
+def test_the_driver_sets_the_collision_reflex_above_its_force_limit_a_low_one_still_trips(
+    franka_twin: Twin,
+) -> None:
+    """libfranka's default 20 N would stop a 30 N press; the driver's default (75 N) does not,
+    and a reflex force of 10 N set through the driver makes the same press a reflex."""
+    from teachfit.core.errors import ReflexFault
+
+    franka_twin(start=BESIDE_BOSS)
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        assert robot.reflex is not None and robot.reflex.upper_force[:3] == (75.0,) * 3
+        state = _press_down(robot, depth=0.015, ticks=600)
+        robot.reset(TASK.contact_pose(np.zeros(2)).translated(list(BESIDE_BOSS)))  # off it
+    assert state.wrench[2] > 25.0, state.wrench  # the plate pushes back past 20 N: no reflex
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False, reflex_force=10.0) as robot:
+        with pytest.raises(ReflexFault, match="cartesian_reflex"):
+            _press_down(robot, depth=0.015, ticks=600)
+
+
+def test_the_hand_answers_while_the_driver_holds_the_arm_in_lock_step(franka_twin: Twin) -> None:
+    """pylibfranka's ``Gripper.read_once`` holds the GIL: the twin in lock-step gets no command
+    while it waits, and still sends the hand's state (a reset's grasp check timed out)."""
+    franka_twin()
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        assert robot.grasp is not None, robot.grasp_note
+        ticks = robot.ticks
+        widths = [robot.grasp.gripper.read_once().width for _ in range(20)]
+        robot.step(5)
+        assert robot.ticks > ticks  # the control loop ran on after the reads
+    assert len(widths) == 20
+
+
+def test_a_peg_skill_execution_in_contact_is_not_stopped_by_a_reflex(franka_twin: Twin) -> None:
+    """The skill's default parameters from the first start of seed 0: its lateral move pressed
+    19 N across, over libfranka's default 20 N thresholds with the estimate's noise."""
+    from teachfit.core.outcome import Outcome
+    from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
+
+    franka_twin()
+    setup = peg_in_hole_setup(TASK, 0, 1)
+    trial = SkillTrial(setup, robot="franka", host="127.0.0.1", realtime=False)
+    try:
+        trace = trial.run(None, setup.starts[0], setup.frame(0))
+    finally:
+        trial.robot.close()
+    assert not trace.reflex and trace.outcome is not Outcome.FAULT, trace.reason
+    assert trace.peak_force > 15.0, trace.peak_force  # it was in contact
+    assert "lateral" in [v.node for v in trace.visits]
+
+
+def test_the_laws_apparent_mass_is_the_arms_at_the_reset_pose(franka_twin: Twin) -> None:
+    """The driver's damping uses the operational-space inertia from libfranka's mass matrix
+    (the cell's own, up to the motors' rotor inertia the model leaves out), not 2 kg."""
+    import mujoco
+
+    from teachfit.robot.fr3 import model as fr3_model
+    from teachfit.robot.fr3.control import operational_inertia
+    from teachfit.robot.franka.twin_cell import TwinSimulator
+
+    franka_twin()
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        robot.reset(TASK.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.02]))
+        mass, q = robot.apparent_mass, robot.joint_positions
+    sim = TwinSimulator(TASK)
+    m, d = sim.model, sim.data
+    ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in fr3_model.JOINTS]
+    d.qpos[[m.jnt_qposadr[i] for i in ids]] = q
+    mujoco.mj_forward(m, d)
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, fr3_model.TCP_SITE)
+    cell = np.diag(operational_inertia(m, d, site))
+    assert mass[0] > 5.0, mass  # the FR3's TCP weighs 10-15 kg along x here
+    np.testing.assert_allclose(mass[:5], cell[:5], rtol=0.4)
+    assert mass[5] >= 0.05  # about the tool axis: the floor (the model reads 0.002)

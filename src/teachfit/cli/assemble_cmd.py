@@ -17,6 +17,7 @@ from teachfit.cli.common import (
     ConfirmOpt,
     HostOpt,
     RealtimeOpt,
+    ReflexForceOpt,
     RobotOpt,
     append_markdown,
     console,
@@ -90,6 +91,7 @@ def assemble(
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     confirm: ConfirmOpt = False,
+    reflex_force: ReflexForceOpt = None,
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
@@ -108,7 +110,7 @@ def assemble(
                "angle_error": angle_error, "trials": trials, "seed": seed})  # fmt: skip
         _assemble_plan(task, demo, err, ang, trials, seed, plot, render, rec)
         return
-    arm = tuple(robot_options(host, realtime, confirm).items())
+    arm = tuple(robot_options(host, realtime, confirm, reflex_force).items())
     if arm and workers:
         raise TeachfitError("--workers: a real robot runs its trials one at a time: leave it out")
     model, method, jobs = assembly_setup(

@@ -71,14 +71,48 @@ ConfirmOpt = Annotated[
 ]
 
 
-def robot_options(host: str | None, realtime: bool = True, confirm: bool = False) -> dict[str, Any]:
-    """The ``make_robot`` options the CLI's ``--host``/``--no-realtime``/``--confirm`` give
-    (none for simulated robots; ``--confirm`` without ``--host`` is refused)."""
+#: ``--reflex-force N``: the firmware's collision reflex threshold a real robot's driver sets
+ReflexForceOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--reflex-force",
+        help="real robot: the collision reflex's force threshold (N per axis; default 75, "
+        "1.25 x the driver's 60 N force limit)",
+    ),
+]
+
+
+def check_reflex_force(host: str | None, reflex_force: float | None) -> None:
+    """Refuse ``--reflex-force`` without ``--host`` or that is not a finite force > 0."""
+    if reflex_force is None:
+        return
+    if host is None:
+        raise TeachfitError("--reflex-force sets a real robot's collision reflex: give --host")
+    if not (math.isfinite(reflex_force) and reflex_force > 0):
+        raise TeachfitError(
+            f"--reflex-force {reflex_force:g}: give the collision reflex's force threshold in "
+            "N, a number > 0 (default 75)"
+        )
+
+
+def robot_options(
+    host: str | None,
+    realtime: bool = True,
+    confirm: bool = False,
+    reflex_force: float | None = None,
+) -> dict[str, Any]:
+    """The ``make_robot`` options the CLI's ``--host``/``--no-realtime``/``--confirm``/
+    ``--reflex-force`` give (none for simulated robots; ``--confirm`` or ``--reflex-force``
+    without ``--host`` is refused, as a reflex force that is not a number > 0)."""
     if confirm and host is None:
         raise TeachfitError("--confirm asks before a real robot's resets: give --host with it")
+    check_reflex_force(host, reflex_force)
     if host is None:
         return {}
-    return {"host": host, "realtime": realtime} | ({"confirm": True} if confirm else {})
+    opts: dict[str, Any] = {"host": host, "realtime": realtime}
+    if reflex_force is not None:
+        opts["reflex_force"] = reflex_force
+    return opts | ({"confirm": True} if confirm else {})
 
 
 #: options that name a file or folder a command writes: :func:`guarded` checks them before the

@@ -14,6 +14,7 @@ from teachfit.cli import options as o
 from teachfit.cli.common import (
     HostOpt,
     RealtimeOpt,
+    ReflexForceOpt,
     RobotOpt,
     check_output,
     console,
@@ -59,6 +60,7 @@ def record(
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
+    reflex_force: ReflexForceOpt = None,
     duration: Annotated[
         float | None,
         typer.Option(min=0, help="real robot: seconds to record (default: until Ctrl-C)"),
@@ -75,7 +77,9 @@ def record(
     if robot in ROBOTS and not ROBOTS[robot].simulated:
         from teachfit.demonstrations.kinesthetic import record_demonstration
 
-        arm = make_robot(robot, the_task, **robot_options(host, realtime))
+        arm = make_robot(
+            robot, the_task, **robot_options(host, realtime, reflex_force=reflex_force)
+        )
         try:
             console.print("guide the arm; Ctrl-C ends the recording")
             demos = [record_demonstration(arm, the_task.name, duration)]

@@ -14,8 +14,10 @@ from teachfit.cli.common import (
     ConfirmOpt,
     HostOpt,
     RealtimeOpt,
+    ReflexForceOpt,
     RobotOpt,
     append_markdown,
+    check_reflex_force,
     console,
     guarded,
 )
@@ -88,13 +90,15 @@ def learn_skill(
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     confirm: ConfirmOpt = False,
+    reflex_force: ReflexForceOpt = None,
 ) -> None:
     """Learn a skill's parameters on a task by trials; every trial is stored at once."""
     from teachfit.learning.launch import LearnRequest, open_learning
 
+    check_reflex_force(host, reflex_force)
     req = LearnRequest(
         task, skill, method, trials, study, resume, workers, ray, controller, seed, starts,
-        _overrides(task_param), robot, host or "", realtime, setups, confirm,
+        _overrides(task_param), robot, host or "", realtime, setups, confirm, reflex_force,
     )  # fmt: skip
     launch = open_learning(req)
     for note in launch.notes:

@@ -47,6 +47,7 @@ CANONICAL: dict[str, tuple[str, str]] = {
     "--robot": ("text", "robot to run on"),
     "--host": ("text", "address of a real robot"),
     "--realtime": ("flag", "real robot: require a real-time kernel"),
+    "--reflex-force": ("float", "real robot: the collision reflex's force threshold"),
     "--controller": ("text", "controller"),
     "--trials": ("int", "trials"),
     "--method": ("text", ""),

@@ -14,6 +14,7 @@ from teachfit.cli.common import (
     ConfirmOpt,
     HostOpt,
     RealtimeOpt,
+    ReflexForceOpt,
     RobotOpt,
     console,
     guarded,
@@ -167,6 +168,7 @@ def run(
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     confirm: ConfirmOpt = False,
+    reflex_force: ReflexForceOpt = None,
     log: LogOpt = None,
     rrd: RrdOpt = None,
     n: o.PointsOld = None,
@@ -196,7 +198,9 @@ def run(
             "[yellow]note:[/] Table I starts lie halfway between the demonstration's start and "
             "the hole; without --demo a nominal demonstration start is assumed"
         )
-    the_robot = make_robot(robot, the_task, seed=seed, **robot_options(host, realtime, confirm))
+    the_robot = make_robot(
+        robot, the_task, seed=seed, **robot_options(host, realtime, confirm, reflex_force)
+    )
     try:
         with progress_bar() as bar:
             job = bar.add_task(f"{method} from {starts} starts", total=starts)

@@ -14,6 +14,7 @@ from teachfit.cli.common import (
     ConfirmOpt,
     HostOpt,
     RealtimeOpt,
+    ReflexForceOpt,
     RobotOpt,
     console,
     guarded,
@@ -123,6 +124,7 @@ def run(
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
     confirm: ConfirmOpt = False,
+    reflex_force: ReflexForceOpt = None,
     log: LogOpt = None,
     rrd: RrdOpt = None,
 ) -> None:
@@ -150,7 +152,11 @@ def run(
     setup = drawn.setup
     learned = _learned(params, setup)
     trial = SkillTrial(
-        setup, controller, robot=robot, seed=seed, **robot_options(host, realtime, confirm)
+        setup,
+        controller,
+        robot=robot,
+        seed=seed,
+        **robot_options(host, realtime, confirm, reflex_force),
     )
     try:
         console.print(f"{setup.skill.name} on {the_task.name} ({controller} controller); "

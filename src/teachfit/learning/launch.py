@@ -57,6 +57,7 @@ class LearnRequest:
     realtime: bool = True
     setups: int = 1
     confirm: bool = False
+    reflex_force: float | None = None
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,7 @@ def open_learning(req: LearnRequest) -> Launch:
         workers = 0  # one arm: trials cannot run in parallel worker processes
     obj = SkillObjective(
         req.task, req.skill, req.controller, req.seed, req.starts, req.overrides, req.robot,
-        req.host, req.realtime, req.setups, req.confirm,
+        req.host, req.realtime, req.setups, req.confirm, req.reflex_force,
     )  # fmt: skip
     options = _options(req)
     try:

@@ -58,6 +58,9 @@ class SkillObjective:
         the cost is the mean over ``setups x n_starts`` executions.
     confirm : bool
         On a real robot, ask on the terminal before each reset (not part of the study).
+    reflex_force : float or None
+        On a real robot, the collision reflex's force threshold (N; ``None``: the driver's
+        default; not part of the study).
     """
 
     task: str
@@ -71,6 +74,7 @@ class SkillObjective:
     realtime: bool = True
     setups: int = 1
     confirm: bool = False
+    reflex_force: float | None = None
 
     def __post_init__(self) -> None:
         if self.n_starts < 1:
@@ -100,6 +104,8 @@ class SkillObjective:
             )
             if self.host and self.confirm:
                 options["confirm"] = True  # a person confirms each reset
+            if self.host and self.reflex_force is not None:
+                options["reflex_force"] = self.reflex_force
             # a simulated robot is reset before every execution: the recovery retract after a
             # failure would only cost compute (its robot time is not in the cost), a real one
             # needs it

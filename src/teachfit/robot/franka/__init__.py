@@ -38,6 +38,7 @@ def franka_for_task(
     limits: FrankaLimits | None = None,
     realtime: bool = True,
     confirm: bool = False,
+    reflex_force: float | None = None,
 ) -> Any:
     """A connected :class:`~teachfit.robot.franka.driver.FrankaRobot` for ``task``'s cell.
 
@@ -46,6 +47,8 @@ def franka_for_task(
     (default: the task's held part of ``held_part_length`` with its top at EE). Resets leave
     the task's hole along its axis first (:mod:`teachfit.robot.franka.reset_path`);
     ``confirm`` asks on the terminal before each one (:mod:`teachfit.robot.franka.confirm`).
+    ``reflex_force`` (N) the firmware's collision reflex threshold
+    (:mod:`teachfit.robot.franka.reflex`; ``None``: 1.25 x the driver's force limit, 75 N).
     """
     if not host:
         raise TeachfitError("robot 'franka' needs host=ADDRESS (the robot's or simulator's IP)")
@@ -65,7 +68,9 @@ def franka_for_task(
     # the part's tip 5 mm above the surface around the hole is clear of the fixture
     clear = float(task.surface_z - hole.pos[2]) + 0.005
     cell = ResetCell(hole, clear)
-    params = FrankaParams(limits=limits or FrankaLimits(), frames=frames, reset_cell=cell)
+    params = FrankaParams(
+        limits=limits or FrankaLimits(), frames=frames, reset_cell=cell, reflex_force=reflex_force
+    )
     ask = None
     if confirm:
         from teachfit.robot.franka.confirm import terminal_confirm

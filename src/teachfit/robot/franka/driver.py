@@ -41,40 +41,51 @@ from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
-from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints
+from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints, col_major
 from teachfit.robot.franka.grasp import GraspWatch, connect_gripper
 from teachfit.robot.franka.loop import ControlLoop, fault_from
+from teachfit.robot.franka.reflex import ReflexThresholds, check_reflex_force, reflex_thresholds
 from teachfit.robot.franka.reset_path import ResetCell, ResetGuard, reset_via_points
 from teachfit.robot.franka.safety import FrankaLimits
-from teachfit.robot.franka.tick import TorqueTick
+from teachfit.robot.franka.tick import TorqueTick, operational_mass
 
 if TYPE_CHECKING:
     from teachfit.tasks.base import Task
 
 #: GIL switch interval (s) while a driver runs
 SWITCH_INTERVAL = 2e-4
-#: nominal apparent mass/inertia at the TCP (kg, kg·m²) for critical damping
-FRANKA_APPARENT_MASS = (2.0, 2.0, 2.0, 0.05, 0.05, 0.05)
+
+
+#: the least apparent mass/inertia (kg, kg·m²) the law's damping assumes: libfranka's mass
+#: matrix leaves the motors' rotor inertia out, so about the tool axis it reads 0.002 kg·m²
+#: where the twin's cell (with the joints' armature) has 0.075
+MIN_APPARENT_MASS = (2.0, 2.0, 2.0, 0.05, 0.05, 0.05)
 
 
 @dataclass(frozen=True)
 class FrankaParams:
     """Driver settings.
 
-    ``limits`` the safety limits, ``frames`` base/world and EE/TCP, ``apparent_mass`` (6,)
-    (kg, kg·m²) for critical damping, ``reset_stiffness`` (N/m, N·m/rad) of the approach in
-    :meth:`FrankaRobot.reset`, ``reset_tolerance`` (m, rad) it must reach, ``settle_timeout``
-    (s of robot time) it may take after the set-point arrived, ``bias_ticks`` how many ticks
-    the wrench bias averages, ``stop_hold`` (s) the hold before the loop ends on Ctrl-C,
-    ``tick_timeout`` (s) without a tick after which the connection counts as lost,
-    ``connect_timeout`` (s, wall clock) a connect may take before the robot counts as not
-    answering (:mod:`teachfit.robot.franka.connect`), ``reset_cell`` the hole a reset leaves
-    along its axis first (:mod:`teachfit.robot.franka.reset_path`; ``None``: straight lines).
+    ``limits`` the safety limits, ``frames`` base/world and EE/TCP, ``apparent_mass`` (6,) (kg,
+    kg·m²) for the law's critical damping (``None``: the diagonal of the operational-space
+    inertia at the TCP from libfranka's mass matrix, at connect and at each reset's goal, as the
+    fr3 robot takes it; a constant 2 kg / 0.05 kg·m² under-damped the FR3, whose TCP weighs 5-15
+    kg and 0.08-1.2 kg·m² over the cell; at least :data:`MIN_APPARENT_MASS`),
+    ``reset_stiffness`` (N/m, N·m/rad) of the approach in :meth:`FrankaRobot.reset`,
+    ``reset_tolerance`` (m, rad) it must reach, ``settle_timeout`` (s of robot time) it may take
+    after the set-point arrived, ``bias_ticks`` how many ticks the wrench bias averages,
+    ``stop_hold`` (s) the hold before the loop ends on Ctrl-C, ``tick_timeout`` (s) without a
+    tick after which the connection counts as lost, ``connect_timeout`` (s, wall clock) a
+    connect may take before the robot counts as not answering
+    (:mod:`teachfit.robot.franka.connect`), ``reset_cell`` the hole a reset leaves along its
+    axis first (:mod:`teachfit.robot.franka.reset_path`; ``None``: straight lines),
+    ``reflex_force`` (N) the firmware's collision reflex force threshold set on connect
+    (:mod:`teachfit.robot.franka.reflex`; ``None``: 1.25 x ``limits.max_force``, 75 N).
     """
 
     limits: FrankaLimits = field(default_factory=FrankaLimits)
     frames: FrankaFrames = field(default_factory=FrankaFrames)
-    apparent_mass: tuple[float, ...] = FRANKA_APPARENT_MASS
+    apparent_mass: tuple[float, ...] | None = None
     reset_stiffness: tuple[float, ...] = (2000.0,) * 3 + (100.0,) * 3
     reset_tolerance: tuple[float, float] = (0.005, 0.05)
     settle_timeout: float = 3.0
@@ -83,6 +94,11 @@ class FrankaParams:
     tick_timeout: float = 1.5
     connect_timeout: float = CONNECT_TIMEOUT
     reset_cell: ResetCell | None = None
+    reflex_force: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.reflex_force is not None:
+            check_reflex_force(self.reflex_force)
 
 
 class FrankaRobot:
@@ -136,7 +152,8 @@ class FrankaRobot:
         # delay a tick by up to 5 periods. Process-wide; restored by close().
         self._switch_interval = sys.getswitchinterval()
         sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL))
-        self._mass = np.asarray(self.params.apparent_mass, dtype=float)
+        fixed = self.params.apparent_mass
+        self._mass = np.ones(6) if fixed is None else np.asarray(fixed, dtype=float)
         tick = TorqueTick(self.params.frames, self.params.limits, self.control_period)
         where = f"the Franka at {host}"
         self._loop = ControlLoop(tick, self.params.limits, self.control_period, robot=where)
@@ -146,6 +163,8 @@ class FrankaRobot:
         #: lateral force watch while a reset leaves the hole; its ``peaks`` (N), one per reset
         self.reset_guard = ResetGuard(cell) if cell is not None else None
         self.robot_mode = "unknown"
+        #: the collision thresholds sent to the firmware (set on connect and each restart)
+        self.reflex: ReflexThresholds | None = None
         try:
             self._start()
         except BaseException:
@@ -216,6 +235,7 @@ class FrankaRobot:
             bias += self.step(1).wrench + tick.bias
         tick.bias = bias / self.params.bias_ticks
         tick.q_rest = self._loop.q.copy()
+        self._update_mass(self._loop.raw, tick)
         law = make_law(self.controller_spec, self._mass, self.control_period)
         self._loop.install(law, ImpedanceCommand.hold(pose), restart_clock=True)
         self.step(1)  # this tick may have begun before the install: the next one adopted it
@@ -259,6 +279,11 @@ class FrankaRobot:
     def law(self) -> Controller | None:
         """The control law running in the loop (inspection and tests)."""
         return self._loop.law
+
+    @property
+    def apparent_mass(self) -> np.ndarray:
+        """The apparent mass/inertia (6,) (kg, kg·m², world axes) the law's damping uses."""
+        return self._mass.copy()
 
     @property
     def running(self) -> bool:
@@ -371,9 +396,31 @@ class FrankaRobot:
         self.robot_mode = str(first.robot_mode).split(".")[-1]
         tick = self._loop.tick
         tick.kinematics(first, self._model)
+        self._set_reflex(first, tick.jacobian)
+        self._update_mass(first, tick)
         tick.q_rest = np.asarray(first.q, dtype=float)
         here = Pose(tick.pos.copy(), tick.quat.copy())
         law = self._approach_law()
         stiff = np.asarray(self.params.reset_stiffness, dtype=float)
         law.set_command(self._hold(here, stiff), self._loop.t_abs)
         self._loop.start(self._robot, self._model, first, law)
+
+    def _set_reflex(self, first: Any, jacobian: np.ndarray) -> None:
+        """Send the collision thresholds (:mod:`~teachfit.robot.franka.reflex`) for the pose of
+        ``first`` (a state read while the robot is idle: the firmware takes them only then)."""
+        k_lever = col_major(first.EE_T_K)[:3, 3] - self.params.frames.ee2tcp.pos
+        self.reflex = reflex_thresholds(
+            self.params.limits, jacobian, float(np.linalg.norm(k_lever)), self.params.reflex_force
+        )
+        try:
+            self.reflex.send(self._robot)
+        except Exception as exc:  # noqa: BLE001 - a refusal is a robot fault
+            raise fault_from(exc, self._loop.robot) from exc
+
+    def _update_mass(self, raw: Any, tick: TorqueTick) -> None:
+        """The apparent mass (6,) for the law at the pose of ``raw`` (a pylibfranka state; the
+        tick's Jacobian of that pose), unless ``params.apparent_mass`` fixes it."""
+        if self.params.apparent_mass is None:
+            mass = np.asarray(self._model.mass(raw), dtype=float).reshape(7, 7, order="F")
+            lam = operational_mass(mass, tick.jacobian, tick.r_wo)
+            self._mass = np.maximum(lam, MIN_APPARENT_MASS)

@@ -92,6 +92,8 @@ class ControlLoop:
         self.t_abs = 0.0
         self.t0 = 0.0
         self.latest: RobotState | None = None
+        #: the last tick's pylibfranka ``RobotState`` (what the model's functions take)
+        self.raw: Any = None
         self.fault: RobotFault | None = None
         self.q = np.zeros(7)
         self._finish = False
@@ -116,6 +118,7 @@ class ControlLoop:
         self.tick.tau_prev = np.zeros(7)
         self.law = law
         self.latest = self.tick.robot_state(self.t_abs - self.t0, first)
+        self.raw = first
         self.fault = None
         self._finish = False
         try:
@@ -219,6 +222,7 @@ class ControlLoop:
         latest = self.tick.robot_state(self.t_abs - self.t0, state)
         with self.cond:
             self.latest = latest
+            self.raw = state  # libfranka's state of this tick (for the model's mass)
             self.ticks += 1
             if self._tap_every and self.ticks % self._tap_every == 0:
                 self._tapped.append(latest)

@@ -28,6 +28,19 @@ from teachfit.robot.franka.libfranka_types import LibfrankaModel, LibfrankaState
 from teachfit.robot.franka.safety import FrankaLimits, clip_wrench_norm, limit_torque
 
 
+def operational_mass(mass: np.ndarray, jacobian: np.ndarray, r_wo: np.ndarray) -> np.ndarray:
+    """The diagonal (6,) (kg, kg·m²) of the operational-space inertia at the TCP in world axes,
+    ``Lambda = (J M^-1 J^T)^-1``, for the joint-space inertia ``mass`` (7, 7) (libfranka's
+    ``Model.mass``), the TCP Jacobian ``jacobian`` (6, 7) (base frame) and the base->world
+    rotation ``r_wo``: the apparent mass the law's critical damping needs, as the fr3 robot
+    takes it from its model (:func:`teachfit.robot.fr3.control.operational_inertia`)."""
+    rot = np.zeros((6, 6))
+    rot[:3, :3] = rot[3:, 3:] = r_wo
+    jac = rot @ np.asarray(jacobian, dtype=float)
+    jminv = np.linalg.solve(np.asarray(mass, dtype=float), jac.T).T
+    return np.diag(np.linalg.inv(jminv @ jac.T)).copy()
+
+
 class TorqueTick:
     """The per-tick computation; holds buffers and the last sent torques.
 
@@ -71,6 +84,7 @@ class TorqueTick:
         self.lin_vel = np.zeros(3)
         self.ang_vel = np.zeros(3)
         self.wrench_cmd = np.zeros(6)
+        self.r_wo = self._r_wo  # the base->world rotation (read-only)
 
     # ------------------------------------------------------------------ kinematics
     def kinematics(self, state: LibfrankaState, model: LibfrankaModel) -> None:

@@ -125,14 +125,16 @@ class TwinProcess(SimServer):
         start: tuple[float, float, float] = TwinParams.start,
         host: str = HOST,
         startup_timeout: float = 120.0,
+        seed: int = 0,
     ) -> None:
         super().__init__(startup_timeout=startup_timeout)
         self.task, self.realtime, self.start_offset = task, realtime, start
+        self.seed = seed  # the sensors' noise and offsets
         self.host = check_host(host)
 
     def command(self) -> list[str]:
         cmd = [sys.executable, "-m", "teachfit.robot.franka.twin", "--task", self.task]
-        cmd += ["--host", self.host]
+        cmd += ["--host", self.host, "--seed", str(self.seed)]
         cmd += ["--start", *(repr(float(v)) for v in self.start_offset)]
         cmd += ["--parent", str(os.getpid())]  # ends with this process
         return cmd + ([] if self.realtime else ["--no-realtime"])

@@ -311,6 +311,10 @@ class TwinSimulationServer(SimulationServer):
     machine without a real-time kernel) a running torque motion is stepped in lock-step with
     the client: after its first command, each tick waits for the client's next command, so a
     late client slows the twin down instead of missing ticks (at most 1 kHz either way).
+    While it waits, the hand still sends its state every 10 ms, as a Franka Hand does on its
+    own clock: a client that reads the hand (``Gripper.read_once``, which holds the GIL in
+    pylibfranka) from the thread beside its control loop would otherwise wait for a hand
+    state that only the next arm tick sends, and time out.
     """
 
     def __init__(
@@ -336,6 +340,9 @@ class TwinSimulationServer(SimulationServer):
         twin.process_commands()
         if not self.realtime and twin.awaiting_command():
             twin.wait_for_command(0.01)  # the client is late: wait, the physics does not move
+            hand = twin.gripper_server
+            if hand is not None:  # the hand keeps sending its state on its own clock
+                hand.send_state()
             return
         self.sim.step()
         twin.tick_done()
