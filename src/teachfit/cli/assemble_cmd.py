@@ -210,6 +210,7 @@ def _trial_figures(
         console.print(f"video of trial {pick.index} -> {path}")
 
 
+# long (> 60 lines) only by the declarations of its options: the runs are in execution/
 @guarded
 def bench_assembly(
     tasks: Annotated[str, typer.Option(help="tasks, comma-separated")] = "peg2d,socket3d",

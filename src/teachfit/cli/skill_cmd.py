@@ -99,6 +99,7 @@ def show(
         console.print(f"graph -> {plot_skill_graph(sk, plot)}")
 
 
+# long (> 60 lines) only by the declarations of its options: the body checks, runs, prints
 @skill_app.command("run")
 @guarded
 def run(
