@@ -54,3 +54,11 @@ def test_a_missing_or_unheaded_result_file_is_named(tmp_path) -> None:
     (tmp_path / "bare.md").write_text("| a |\n")
     with pytest.raises(rp.PageError, match="bare.md: no provenance header"):
         rp.build("<!-- include bare.md -->", tmp_path)
+
+
+def test_the_page_shows_only_command_output() -> None:
+    """A table copied from an earlier record (``source=transcribed``) is history: it belongs
+    in the notes, not among the current figures."""
+    rp = _script()
+    page = rp.build(rp.PAGE.read_text(encoding="utf-8"))
+    assert "source=transcribed" not in page
