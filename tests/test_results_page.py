@@ -61,4 +61,5 @@ def test_the_page_shows_only_command_output() -> None:
     in the notes, not among the current figures."""
     rp = _script()
     page = rp.build(rp.PAGE.read_text(encoding="utf-8"))
-    assert "source=transcribed" not in page
+    assert "<!-- teachfit-run source=command " in page
+    assert "<!-- teachfit-run source=transcribed" not in page
