@@ -26,7 +26,10 @@ from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.core.state import ImpedanceCommand  # noqa: E402
 from teachfit.robot.franka import DEFAULT_BASE2WORLD, franka_for_task  # noqa: E402
 from teachfit.robot.franka.check import check_robot  # noqa: E402
-from teachfit.robot.franka.frames import approach_waypoints  # noqa: E402
+from teachfit.robot.franka.frames import (  # noqa: E402
+    approach_waypoints,
+    ee2tcp_for_part,
+)
 from teachfit.robot.franka.sim import SimServer  # noqa: E402
 from teachfit.tasks import get_task  # noqa: E402
 
@@ -393,3 +396,24 @@ def test_the_laws_apparent_mass_is_the_arms_at_the_reset_pose(franka_twin: Twin)
     assert mass[0] > 5.0, mass  # the FR3's TCP weighs 10-15 kg along x here
     np.testing.assert_allclose(mass[:5], cell[:5], rtol=0.4)
     assert mass[5] >= 0.05  # about the tool axis: the floor (the model reads 0.002)
+
+
+def test_the_driver_sends_the_held_part_as_the_firmwares_load(franka_twin: Twin) -> None:
+    """On connect the driver sends the task's held part with ``setLoad``: the firmware's state
+    then carries its mass and centre of mass (flange frame), which its gravity model uses."""
+    from teachfit.robot.franka.load import part_load
+
+    franka_twin(start=(0.0, 0.0, 0.05))
+    raw, _ = _client()
+    assert raw.read_once().m_load == 0.0  # a fresh twin carries no load
+    del raw
+    load = part_load(TASK)
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        f_t_ee = np.asarray(robot._robot.read_once().F_T_EE).reshape(4, 4, order="F")
+    mass, com, _ = load.in_flange(f_t_ee @ ee2tcp_for_part(TASK.scene.held_part_length).matrix)
+    raw, _ = _client()
+    state = raw.read_once()
+    del raw
+    assert state.m_load == pytest.approx(mass) and mass > 0.03
+    np.testing.assert_allclose(state.F_x_Cload, com, atol=1e-9)
+    assert com[2] == pytest.approx(0.1034 + 0.06 - 0.03, abs=1e-3)  # down the flange axis

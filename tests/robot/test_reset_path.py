@@ -4,9 +4,14 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from teachfit.core.errors import RobotFault
+from teachfit.core.errors import RobotFault, TeachfitError
 from teachfit.core.geometry import Pose, rotation_to_wxyz
-from teachfit.robot.franka.reset_path import ResetCell, ResetGuard, reset_via_points
+from teachfit.robot.franka.reset_path import (
+    ResetCell,
+    ResetGuard,
+    leave_stiffness,
+    reset_via_points,
+)
 
 # a hole tilted 20 degrees about x, its entry at (0.1, 0, 0.05): the way out follows its axis
 HOLE = Pose(np.array([0.1, 0.0, 0.05]), rotation_to_wxyz(Rotation.from_euler("x", 20, True)))
@@ -59,3 +64,44 @@ def test_guard_keeps_each_resets_peak_and_stops_past_the_limit():
     with pytest.raises(RobotFault, match="reset stopped leaving the hole: 20.0 N"):
         guard.watch(np.r_[4 * lateral, 0, 0, 0])
     assert guard.peaks[-1] == pytest.approx(20.0)
+
+
+def test_leaving_is_stiff_along_the_axis_and_compliant_across_and_about_it():
+    k = leave_stiffness(CELL, along=2000.0)
+    rot = HOLE.rotation.as_matrix()
+    # in the hole frame: 200 N/m across its axis, the reset's 2000 along it, 10 N·m/rad turning
+    np.testing.assert_allclose(rot.T @ k[:3, :3] @ rot, np.diag([200.0, 200.0, 2000.0]), atol=1e-9)
+    np.testing.assert_allclose(k[3:, 3:], 10.0 * np.eye(3))
+    assert not k[:3, 3:].any() and not k[3:, :3].any()
+    # a 1 mm offset across the tilted axis pulls 0.2 N, the same offset along it 2 N
+    across = HOLE.rotation.apply([0.001, 0.0, 0.0])
+    assert np.linalg.norm(k[:3, :3] @ across) == pytest.approx(0.2)
+    assert np.linalg.norm(k[:3, :3] @ HOLE.rotation.apply([0.0, 0.0, 0.001])) == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"leave_stiffness": (0.0, 10.0)},
+        {"release_stiffness": -1.0},
+        {"release_time": (0.5, 0.1)},
+        {"handover_time": 0.1},
+    ],
+)
+def test_a_cell_with_a_bad_compliance_or_release_time_is_refused(kwargs):
+    with pytest.raises(TeachfitError, match="reset cell"):
+        ResetCell(HOLE, clear_height=0.02, **kwargs)
+
+
+def test_the_skills_force_at_the_hand_over_is_kept_apart_from_the_resets_own():
+    guard = ResetGuard(CELL)
+    lateral = HOLE.rotation.apply([0.6, 0.8, 0.0])  # 1 N across the hole's axis
+    guard.watch(np.r_[9.0 * lateral, 0, 0, 0], handover=True)  # what the skill left: 9 N
+    guard.watch(np.r_[2.0 * lateral, 0, 0, 0])
+    assert guard.finish() == pytest.approx(2.0)
+    assert guard.peaks == pytest.approx([2.0]) and guard.handover_peaks == pytest.approx([9.0])
+    guard.watch(np.r_[lateral, 0, 0, 0])  # the next reset starts both at zero
+    guard.finish()
+    assert guard.handover_peaks == pytest.approx([9.0, 0.0])
+    with pytest.raises(RobotFault, match="16.0 N"):  # the abort holds at the hand-over too
+        guard.watch(np.r_[16.0 * lateral, 0, 0, 0], handover=True)

@@ -12,9 +12,10 @@ insertion (s) on success, ``t_max + k_d * remaining distance`` on failure. A tri
 feasible if any start succeeded. ``info`` carries ``success_rate``, ``sim_s`` (simulated robot
 seconds of all executions; on a simulated robot the recovery retract after a failure is
 skipped, as every execution starts from a reset) and ``wall_s``; on a real arm also
-``reflex_retries`` (executions run again after a safety reflex) and ``reset_peak_lateral_n``
+``reflex_retries`` (executions run again after a safety reflex), ``reset_peak_lateral_n``
 (the largest lateral force, N, while a reset left the hole,
-:mod:`teachfit.robot.franka.reset_path`).
+:mod:`teachfit.robot.franka.reset_path`) and ``reset_handover_lateral_n`` (the largest the
+skill left at the hand-over to a reset, read in the reset's first 20 ms).
 """
 
 from __future__ import annotations
@@ -197,4 +198,5 @@ class SkillObjective:
             info["reflex_retries"] = float(out.retries)
         if guard is not None and len(guard.peaks) > seen:
             info["reset_peak_lateral_n"] = float(max(guard.peaks[seen:]))
+            info["reset_handover_lateral_n"] = float(max(guard.handover_peaks[seen:]))
         return TrialResult(out.cost, any(out.successes), info)

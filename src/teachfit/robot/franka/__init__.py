@@ -49,6 +49,7 @@ def franka_for_task(
     ``confirm`` asks on the terminal before each one (:mod:`teachfit.robot.franka.confirm`).
     ``reflex_force`` (N) the firmware's collision reflex threshold
     (:mod:`teachfit.robot.franka.reflex`; ``None``: 1.25 x the driver's force limit, 75 N).
+    The task's held part is sent as the firmware's load (:mod:`teachfit.robot.franka.load`).
     """
     if not host:
         raise TeachfitError("robot 'franka' needs host=ADDRESS (the robot's or simulator's IP)")
@@ -68,8 +69,14 @@ def franka_for_task(
     # the part's tip 5 mm above the surface around the hole is clear of the fixture
     clear = float(task.surface_z - hole.pos[2]) + 0.005
     cell = ResetCell(hole, clear)
+    from teachfit.robot.franka.load import part_load
+
     params = FrankaParams(
-        limits=limits or FrankaLimits(), frames=frames, reset_cell=cell, reflex_force=reflex_force
+        limits=limits or FrankaLimits(),
+        frames=frames,
+        reset_cell=cell,
+        reflex_force=reflex_force,
+        load=part_load(task),
     )
     ask = None
     if confirm:

@@ -43,9 +43,15 @@ from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
 from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints, col_major
 from teachfit.robot.franka.grasp import GraspWatch, connect_gripper
+from teachfit.robot.franka.load import PartLoad
 from teachfit.robot.franka.loop import ControlLoop, fault_from
 from teachfit.robot.franka.reflex import ReflexThresholds, check_reflex_force, reflex_thresholds
-from teachfit.robot.franka.reset_path import ResetCell, ResetGuard, reset_via_points
+from teachfit.robot.franka.reset_path import (
+    ResetCell,
+    ResetGuard,
+    leave_stiffness,
+    reset_via_points,
+)
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick, operational_mass
 
@@ -80,7 +86,10 @@ class FrankaParams:
     (:mod:`teachfit.robot.franka.connect`), ``reset_cell`` the hole a reset leaves along its
     axis first (:mod:`teachfit.robot.franka.reset_path`; ``None``: straight lines),
     ``reflex_force`` (N) the firmware's collision reflex force threshold set on connect
-    (:mod:`teachfit.robot.franka.reflex`; ``None``: 1.25 x ``limits.max_force``, 75 N).
+    (:mod:`teachfit.robot.franka.reflex`; ``None``: 1.25 x ``limits.max_force``, 75 N),
+    ``load`` the held part, sent as the firmware's load (``setLoad``) on connect and after each
+    recovery so its gravity model carries it (:mod:`teachfit.robot.franka.load`; ``None``:
+    none sent, the firmware keeps the load it has).
     """
 
     limits: FrankaLimits = field(default_factory=FrankaLimits)
@@ -95,6 +104,7 @@ class FrankaParams:
     connect_timeout: float = CONNECT_TIMEOUT
     reset_cell: ResetCell | None = None
     reflex_force: float | None = None
+    load: PartLoad | None = None
 
     def __post_init__(self) -> None:
         if self.reflex_force is not None:
@@ -327,20 +337,46 @@ class FrankaRobot:
 
     # ------------------------------------------------------------------ internals
     def _move_to(self, start: Pose, pose: Pose, stiff: np.ndarray) -> None:
-        """The reset's motion: via points out of the hole along its axis (the lateral force
-        watched on the way out), then to ``pose`` (:mod:`~teachfit.robot.franka.reset_path`)."""
-        lim, guard = self.params.limits, self.reset_guard
-        for leg, end in reset_via_points(start, pose, self.params.reset_cell):
+        """The reset's motion: a release and via points out of the hole along its axis,
+        compliant across it (the lateral force watched), then to ``pose``
+        (:mod:`~teachfit.robot.franka.reset_path`)."""
+        lim, guard, cell = self.params.limits, self.reset_guard, self.params.reset_cell
+        legs = reset_via_points(start, pose, cell)
+        soft = stiff
+        if cell is not None and legs[0][0] == "out":
+            soft = leave_stiffness(cell, float(stiff[2]))
+            release = leave_stiffness(cell, cell.release_stiffness)
+            start = self._release(start, release, cell)
+            legs = reset_via_points(start, pose, cell)
+        for leg, end in legs:
+            k = soft if leg == "out" else stiff
             for waypoint in approach_waypoints(
                 start, end, lim.reset_speed, lim.reset_ang_speed, 0.01
             ):
-                self.command(self._hold(waypoint, stiff))
+                self.command(self._hold(waypoint, k))
                 state = self.step(10)
                 if guard is not None and leg == "out":
                     guard.watch(state.wrench)
             start = end
         if guard is not None:
             guard.finish()
+
+    def _release(self, here: Pose, soft: np.ndarray, cell: ResetCell) -> Pose:
+        """Hold ``here`` at the ``soft`` stiffness until the TCP is at rest (at least and at
+        most ``cell.release_time``), the lateral force watched (the first
+        ``cell.handover_time`` as the hand-over's); the pose it settled at."""
+        dt = 10 * self.control_period
+        least, most = (int(round(t / dt)) for t in cell.release_time)
+        state = self.state()
+        for i in range(max(most, 1)):
+            self.command(self._hold(here, soft))
+            state = self.step(10)
+            if self.reset_guard is not None:
+                self.reset_guard.watch(state.wrench, (i + 1) * dt <= cell.handover_time + 1e-9)
+            still = np.linalg.norm(state.lin_vel) < 0.002 and np.linalg.norm(state.ang_vel) < 0.02
+            if i + 1 >= least and still:
+                break
+        return Pose(state.pos.copy(), state.quat.copy())
 
     def _hold(self, pose: Pose, stiffness: np.ndarray) -> ImpedanceCommand:
         return ImpedanceCommand.hold(pose, stiffness=stiffness, expires_after=1.0)
@@ -397,6 +433,7 @@ class FrankaRobot:
         tick = self._loop.tick
         tick.kinematics(first, self._model)
         self._set_reflex(first, tick.jacobian)
+        self._set_load(first)
         self._update_mass(first, tick)
         tick.q_rest = np.asarray(first.q, dtype=float)
         here = Pose(tick.pos.copy(), tick.quat.copy())
@@ -414,6 +451,18 @@ class FrankaRobot:
         )
         try:
             self.reflex.send(self._robot)
+        except Exception as exc:  # noqa: BLE001 - a refusal is a robot fault
+            raise fault_from(exc, self._loop.robot) from exc
+
+    def _set_load(self, first: Any) -> None:
+        """Send ``params.load`` (the held part) as the firmware's load, for where the TCP sits
+        on the flange (``F_T_EE`` of ``first``, then ``frames.ee2tcp``)."""
+        load = self.params.load
+        if load is None:
+            return
+        f_t_tcp = col_major(first.F_T_EE) @ self.params.frames.matrices()[1]
+        try:
+            self._robot.set_load(*load.in_flange(f_t_tcp))
         except Exception as exc:  # noqa: BLE001 - a refusal is a robot fault
             raise fault_from(exc, self._loop.robot) from exc
 

@@ -6,14 +6,23 @@ while it is still engaged: it levers on the hole's wall, loads the fixture and t
 can pull the part out of the fingers. The reset therefore goes through via points in the hole
 frame ``H`` (origin at the entry centre, z out of the hole):
 
-1. **out**: from the current TCP straight along the hole's z to ``clear_height`` above the
-   entry, keeping x, y and the orientation (a pure motion along the insertion axis);
+0. **release** (when the TCP starts below the clearance plane): hold where the skill left
+   the part, soft along the hole's axis (``release_stiffness``) and compliant across it and
+   about every axis (:func:`leave_stiffness`), until the TCP is at rest: the skill's press
+   is let go, and a part the skill left still sliding into the hole (up to 0.16 m/s on the
+   peg twin) is braked gently over a few mm: braked in 30 ms at the reset's 2000 N/m, the
+   arm's own inertia pressed the part 7-13 N on the hole's wall;
+1. **out**: from where the release settled straight along the hole's z to ``clear_height``
+   above the entry, keeping x, y and the orientation (a pure motion along the insertion
+   axis), with the same compliance across the axis, so the hole guides the part;
 2. **over**: at that height to above the next start, turning to its orientation there;
 3. **down** to the start, if the start lies below the clearance plane.
 
 A TCP already above the clearance plane goes straight to the start. While the part leaves
 the hole, the lateral force it sees is watched (:class:`ResetGuard`): every reset's peak is
-recorded, and one beyond ``abort_force`` stops the reset before it pulls harder.
+recorded, and one beyond ``abort_force`` stops the reset before it pulls harder. The first
+``handover_time`` of the release reads the force the *skill* left (libfranka's estimate is
+filtered: it lags 10-20 ms); those readings are kept apart as the hand-over peak.
 """
 
 from __future__ import annotations
@@ -22,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from teachfit.core.errors import NeedsAPerson
+from teachfit.core.errors import NeedsAPerson, TeachfitError
 from teachfit.core.geometry import Pose
 
 
@@ -32,12 +41,48 @@ class ResetCell:
 
     ``hole2world`` the hole frame (world); ``clear_height`` (m) the height above the entry,
     along the hole's z, from which the TCP (the part's tip) is clear of the fixture;
-    ``abort_force`` (N) the lateral force in the hole frame at which the way out stops.
+    ``abort_force`` (N) the lateral force in the hole frame at which the way out stops;
+    ``leave_stiffness`` (N/m across the hole's axis, N·m/rad about every axis) of the release
+    and the way out (:func:`leave_stiffness`); ``release_time`` (s of robot time) the least
+    and the most the release holds before the way out starts (the least lets the wrench
+    estimate's filters catch up with the let-go press); ``release_stiffness`` (N/m) along
+    the hole's axis during the release; ``handover_time`` (s) from the release's start during
+    which the reading is the skill's force, not the reset's (:class:`ResetGuard`).
     """
 
     hole2world: Pose
     clear_height: float
     abort_force: float = 15.0
+    leave_stiffness: tuple[float, float] = (200.0, 10.0)
+    release_time: tuple[float, float] = (0.05, 0.5)
+    release_stiffness: float = 300.0
+    handover_time: float = 0.02
+
+    def __post_init__(self) -> None:
+        lo, hi = self.release_time
+        soft = (*self.leave_stiffness, self.release_stiffness)
+        if min(soft) <= 0 or not 0 <= lo <= hi or not 0 <= self.handover_time <= lo:
+            raise TeachfitError(
+                f"reset cell: leave_stiffness {self.leave_stiffness} and release_stiffness "
+                f"{self.release_stiffness} must be > 0, release_time {self.release_time} a "
+                f"(least, most) pair >= 0 s, handover_time {self.handover_time} s in [0, least]"
+            )
+
+
+def leave_stiffness(cell: ResetCell, along: float) -> np.ndarray:
+    """The (6, 6) stiffness (world axes; N/m, N·m/rad) of the release and the way out:
+    ``along`` N/m along the hole's z, ``cell.leave_stiffness`` across it and about every axis.
+
+    At the reset's own stiffness across the axis (2000 N/m, 100 N·m/rad) an arm that holds a
+    tilted part still sliding into the hole, or pressed on a wall, levers it there: 5-13 N
+    lateral on the peg twin. Compliant across the axis the walls, not the arm, set where the
+    part goes, and the lateral force stays that of the arm's small disturbances."""
+    across, turn = cell.leave_stiffness
+    rot = cell.hole2world.rotation.as_matrix()
+    k = np.zeros((6, 6))
+    k[:3, :3] = rot @ np.diag([across, across, float(along)]) @ rot.T
+    k[3:, 3:] = np.eye(3) * turn
+    return k
 
 
 def reset_via_points(current: Pose, goal: Pose, cell: ResetCell | None) -> list[tuple[str, Pose]]:
@@ -63,21 +108,28 @@ def reset_via_points(current: Pose, goal: Pose, cell: ResetCell | None) -> list[
 class ResetGuard:
     """Watches the lateral force (N, hole frame x-y) while a reset leaves the hole.
 
-    :meth:`watch` takes each measured wrench (world frame, force first) of the ``out`` leg;
-    ``peak`` is the largest lateral force seen; ``peaks`` keeps every finished reset's. Past
-    ``abort_force`` it raises :class:`~teachfit.core.errors.NeedsAPerson`.
+    :meth:`watch` takes each measured wrench (world frame, force first) of the release and the
+    ``out`` leg; ``peak`` is the largest lateral force seen, ``handover`` the largest of the
+    readings marked ``handover`` (the skill's force, read in the release's first
+    ``handover_time``); ``peaks`` and ``handover_peaks`` keep every finished reset's. Past
+    ``abort_force`` either raises :class:`~teachfit.core.errors.NeedsAPerson`.
     """
 
     cell: ResetCell
     peak: float = 0.0
+    handover: float = 0.0
     peaks: list[float] = field(default_factory=list)
+    handover_peaks: list[float] = field(default_factory=list)
 
-    def watch(self, wrench_world: np.ndarray) -> None:
-        """Record the lateral force of ``wrench_world``; raise :class:`NeedsAPerson` past
-        ``abort_force``."""
+    def watch(self, wrench_world: np.ndarray, handover: bool = False) -> None:
+        """Record the lateral force of ``wrench_world`` (in the hand-over peak if
+        ``handover``); raise :class:`NeedsAPerson` past ``abort_force``."""
         f_hole = self.cell.hole2world.inverse().rotation.apply(np.asarray(wrench_world)[:3])
         lateral = float(np.hypot(f_hole[0], f_hole[1]))
-        self.peak = max(self.peak, lateral)
+        if handover:
+            self.handover = max(self.handover, lateral)
+        else:
+            self.peak = max(self.peak, lateral)
         if lateral > self.cell.abort_force:
             self.finish()
             raise NeedsAPerson(
@@ -87,7 +139,9 @@ class ResetGuard:
             )
 
     def finish(self) -> float:
-        """Close the current reset: keep its peak, start the next at zero; the peak (N)."""
+        """Close the current reset: keep its peaks, start the next at zero; the peak (N)."""
         peak, self.peak = self.peak, 0.0
         self.peaks.append(peak)
+        self.handover_peaks.append(self.handover)
+        self.handover = 0.0
         return peak

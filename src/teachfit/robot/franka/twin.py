@@ -12,9 +12,11 @@ What of the firmware it does *not* do: the acceleration-phase collision threshol
 ones are used), Cartesian position/velocity limits, self-collision avoidance, the joint and
 Cartesian impedance controllers (``setJointImpedance`` / ``setCartesianImpedance`` are
 acknowledged, the motion generators run franky-sim's stiff joint servo), the brakes, guiding
-mode, the power and ``tau_J`` range limits, the load set by ``setLoad`` (gravity compensation is
-franky-sim's model of the arm and the Franka Hand; the held part is not compensated) and the
-gripper (it does not move).
+mode, the power and ``tau_J`` range limits and the gripper (it does not move). The load set by
+``setLoad`` is honoured as the firmware does: franky-sim adds it to its gravity model of the arm
+and the Franka Hand (and reports it in the state's ``m_load``); the teachfit driver sends the
+held part (:mod:`teachfit.robot.franka.load`), so the part no longer hangs on the law's
+stiffness.
 
 Loopback only, as the franky-sim launcher (:mod:`teachfit.robot.franka.sim`): every socket of
 the process is confined to 127.0.0.1. ``python -m teachfit.robot.franka.twin --task NAME`` is
