@@ -5,8 +5,8 @@ franky-sim (MuJoCo FR3) is started once per run through teachfit's loopback laun
 own process group, and stopped by its PID and group at the end. libfranka's port (1337) cannot
 be changed, so one test process at a time owns it (a machine-wide lock, for pytest-xdist
 workers): the simulator, or a test's own listener there (:func:`robot_port`, which stops the
-simulator for the test and starts it again after). Tests that need the simulator are skipped
-when the ``franka`` extra (pylibfranka, franky-sim) is not installed.
+simulator for the test; the next test that needs it starts it again). Tests that need the
+simulator are skipped when the ``franka`` extra (pylibfranka, franky-sim) is not installed.
 
 The fixtures are registered once, by the top ``tests/conftest.py``: a second registration would
 start a second simulator that waits for the lock the first one holds.
@@ -71,14 +71,10 @@ def franka_sim(franka_port: SimServer) -> SimServer:
 @pytest.fixture
 def robot_port(franka_port: SimServer) -> Iterator[int]:
     """127.0.0.1:1337 free for the test's own listener; yields the port. A running simulator
-    is stopped for the test and started again after it."""
-    was_running = franka_port.pid is not None
+    is stopped for the test; the next test that needs it starts it again
+    (:func:`franka_sim`), so consecutive twin tests pay no simulator start-up."""
     franka_port.stop()
-    try:
-        yield ROBOT_PORT
-    finally:
-        if was_running:
-            franka_port.start()
+    yield ROBOT_PORT
 
 
 @pytest.fixture
@@ -86,8 +82,8 @@ def franka_twin(robot_port: int) -> Iterator[Callable[..., SimServer]]:
     """``start(start=(dx, dy, dz), realtime=False) -> TwinProcess``: the Franka twin of task
     ``peg`` (``teachfit.robot.franka.twin``; lock-step ``--no-realtime`` unless ``realtime``)
     with its TCP ``start`` (m) from the hole's contact pose, on 127.0.0.1:1337 in its own
-    process group, stopped by its PID after the test (franky-sim is stopped for the test and
-    started again after it, :func:`robot_port`)."""
+    process group, stopped by its PID after the test (franky-sim is stopped for the test,
+    :func:`robot_port`)."""
     from teachfit.robot.franka.twin import TwinProcess
 
     started: list[SimServer] = []

@@ -11,6 +11,14 @@ from teachfit.core.errors import TeachfitError
 from teachfit.tasks.mesh.suite import write_suite
 
 
+@pytest.fixture(scope="module")
+def round12(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The round 12 mm chamfered part's meshes and task file, written once for the tests that
+    search it."""
+    (task,) = write_suite(tmp_path_factory.mktemp("suite"), ["round12-chamfer-blind"])
+    return Path(task)
+
+
 def test_the_default_skill_runs_on_held_out_setups_of_a_suite_part(tmp_path: Path) -> None:
     (task,) = write_suite(tmp_path, ["rect12x8-sharp-through"])
     ticks = []
@@ -26,10 +34,10 @@ def test_the_default_skill_runs_on_held_out_setups_of_a_suite_part(tmp_path: Pat
     assert len(ticks) == bp.Sizes(setups=1).units(["skill"]) == 1
 
 
-def test_search_and_assemble_run_on_the_robot_asked_for(tmp_path: Path) -> None:
+def test_search_and_assemble_run_on_the_robot_asked_for(round12: Path) -> None:
     from teachfit.bench import search as bs
 
-    (task,) = write_suite(tmp_path, ["round12-chamfer-blind"])
+    task = round12
     sizes = bp.Sizes(starts=1, points=50)
     rows = bp.bench_part("round12", task, "fr3", sizes, methods=["search", "assemble"])
     assert [(r.robot, r.method, r.summary.trials) for r in rows] == [
@@ -44,11 +52,11 @@ def test_sizes_below_one_are_refused() -> None:
         bp.Sizes(train_setups=0)
 
 
-def test_the_search_rows_come_from_the_same_starts_as_bench_search_task(tmp_path: Path) -> None:
+def test_the_search_rows_come_from_the_same_starts_as_bench_search_task(round12: Path) -> None:
     from teachfit.bench.search_jobs import run_jobs
     from teachfit.bench.search_task import task_demos, task_jobs, task_table
 
-    (task,) = write_suite(tmp_path, ["round12-chamfer-blind"])
+    task = round12
     demos = task_demos(str(task), 0)
     res = run_jobs(task_jobs(str(task), demos, 0, n_starts=1, n_points=50), workers=0)
     rows = task_table(str(task), demos, 0, n_starts=1, n_points=50, workers=0)

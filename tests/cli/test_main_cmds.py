@@ -67,8 +67,18 @@ def test_record_show_round_trip(recorded, tmp_path):
     np.testing.assert_array_equal(read_dataset(demos)[0].pos, demo.pos)
 
 
-def test_render_writes_the_recorded_motion(recorded, tmp_path, needs_gl):
-    demos, _ = recorded
+def _moving_demo(task: str, n: int = 120) -> Demonstration:
+    """A 1.2 s demonstration of ``task`` at 100 Hz: 20 mm across and 20 mm down onto the hole."""
+    s = np.linspace(0.0, 1.0, n)[:, None]
+    pos = (1.0 - s) * np.array([0.02, 0.0, 0.02])
+    quat = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
+    return Demonstration(
+        np.arange(n) / 100.0, pos, quat, np.zeros((n, 6)), task=task, source="synthetic"
+    )
+
+
+def test_render_writes_the_recorded_motion(tmp_path, needs_gl):
+    demos = write_dataset(tmp_path / "moving.h5", [_moving_demo("peg2d")])
     out = tmp_path / "demo0.mp4"
     res = invoke(
         "render",
@@ -144,7 +154,19 @@ def test_unknown_task_is_a_clear_error(tmp_path):
 
 
 def test_quickstart_small(tmp_path):
-    res = invoke("quickstart", "--out", tmp_path, "--count", "2", "--starts", "2", "--points", "60")
+    res = invoke(
+        "quickstart",
+        "--out",
+        tmp_path,
+        "--count",
+        "2",
+        "--seed",
+        "1",
+        "--starts",
+        "2",
+        "--points",
+        "20",
+    )
     assert res.exit_code == 0, res.output
     out = _flat(res.output)
     assert "from all 2 demonstrations" in out and "What this showed" in out

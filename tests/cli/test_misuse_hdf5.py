@@ -163,7 +163,7 @@ def _commands(name: str, kind: str) -> list[list[str]]:
         ["learn", "search", f"in/{name}.h5", "--out", "o/m.model"],
         ["plan", "--demo", f"in/{name}.h5:0"],
         ["demo", "import", *csv, "--append", "--out", f"o/{name}.h5"],
-        ["demo", "record", "--count", "1", "--append", "--out", f"o/{name}.h5"],
+        ["demo", "record", "--count", "1", "--seed", "1", "--append", "--out", f"o/{name}.h5"],
     ]
 
 
@@ -211,11 +211,13 @@ def test_a_file_size_limit_is_one_line_naming_the_output(root: Path, tmp_path: P
     """``demo record`` (its recording read from the teacher cache the in-process run filled)
     and ``demo import --append`` under ``ulimit -f``: the old file is left as it was."""
     shutil.copytree(root / "in", tmp_path / "in")
-    runner.invoke(app, ["demo", "record", "--count", "1", "--out", str(tmp_path / "warm.h5")])
+    runner.invoke(
+        app, ["demo", "record", "--count", "1", "--seed", "1", "--out", str(tmp_path / "warm.h5")]
+    )
     old = (tmp_path / "in" / "good.h5").read_bytes()
     csv = ["in/good.csv", "--columns", "in/good_columns.toml", "--task", "peg2d"]
     cases = [
-        (["demo", "record", "--count", "1", "--out", "o/rec.h5"], "o/rec.h5"),
+        (["demo", "record", "--count", "1", "--seed", "1", "--out", "o/rec.h5"], "o/rec.h5"),
         (["demo", "import", *csv, "--append", "--out", "in/good.h5"], "in/good.h5"),
     ]
     for args, out in cases:
@@ -247,7 +249,10 @@ def test_outputs_follow_the_umask_and_an_append_keeps_the_mode(root: Path, tmp_p
         results = [
             runner.invoke(app, ["demo", "import", *csv, "--out", str(tmp_path / "new.h5")]),
             runner.invoke(app, ["demo", "import", *csv, "--append", "--out", str(shared)]),
-            runner.invoke(app, ["demo", "record", "--count", "1", "--out", str(tmp_path / "r.h5")]),
+            runner.invoke(
+                app,
+                ["demo", "record", "--count", "1", "--seed", "1", "--out", str(tmp_path / "r.h5")],
+            ),
             runner.invoke(app, ["demo", "export", f"{shared}:1", "--out", str(tmp_path / "d.csv")]),
         ]
     finally:
