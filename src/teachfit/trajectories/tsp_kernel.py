@@ -29,12 +29,10 @@ points costs exactly the open tour. Moves (all in O(segment) time on arrays):
 
 all restricted to candidate lists (nearest and Delaunay neighbours) with don't-look bits
 (a queue of nodes to look at). Then **iterated local search**: a kick swapping two adjacent
-segments of any length (``A B C D -> A C B D``; whole clusters of points move; the first cut
-at the longer of two random tour edges, a little closer to LKH-3 than one random edge; with
-both path ends fixed this changes three edges, a random segment insertion, not the 4-opt
-double bridge ``A B C D E -> A D C B E``, which was tried and came out further from LKH-3 at
-the same number of kicks, whether its segments were of any length, short or chosen along
-candidate edges),
+segments of any length (``A B C D -> A C B D``; whole clusters of points move; with both path
+ends fixed this changes three edges, a random segment insertion, not the 4-opt double bridge
+``A B C D E -> A D C B E``, which was tried and came out further from LKH-3 at the same number
+of kicks, whether its segments were of any length, short or chosen along candidate edges),
 local search from its six end nodes, kept when at most ``threshold`` longer (threshold
 accepting); the shortest tour seen is returned. Distances are read from a matrix when one is
 given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`).
@@ -219,9 +217,7 @@ def improve_tour(
     breadth: int = 3,
     or_any: bool = True,
 ) -> np.ndarray:
-    """Local search, then one kick per row of ``draws`` (three non-negative ints < 2^30 each:
-    the first segment's start, of two drawn from the first int's low and high bits the one
-    after the longer tour edge; the two segments' lengths).
+    """Local search, then one kick per row of ``draws`` (three non-negative ints each).
 
     A kicked tour is kept when it is at most ``threshold`` longer than before (threshold
     accepting); the shortest tour seen is returned.
@@ -261,11 +257,7 @@ def improve_tour(
         lc = 1 + draws[r, 2] % max(1, window - lb)
         if lb + lc > inner:
             continue
-        span = inner - lb - lc + 1
-        a = 1 + draws[r, 0] % span  # B = tour[a..a+lb-1], C follows
-        a2 = 1 + (draws[r, 0] >> 15) % span  # of two starts, the one after the longer edge
-        if _d(x, tour[a2 - 1], tour[a2], dummy) > _d(x, tour[a - 1], tour[a], dummy):
-            a = a2
+        a = 1 + draws[r, 0] % (inner - lb - lc + 1)  # B = tour[a..a+lb-1], C follows
         b_end, c_end = a + lb - 1, a + lb + lc - 1
         pa, na = tour[a - 1], tour[c_end + 1]
         b0, b1, c0, c1 = tour[a], tour[b_end], tour[b_end + 1], tour[c_end]
