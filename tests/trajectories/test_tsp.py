@@ -122,3 +122,29 @@ def test_formerly_worst_instances_are_within_1_percent_of_lkh(key):
     r = open_tour(pts)
     assert sorted(r.order.tolist()) == list(range(n))
     assert r.length <= 1.01 * _LKH[key]
+
+
+def test_distance_matrix_gives_the_tour_of_the_coordinates(monkeypatch):
+    # up to tsp._MATRIX_UP_TO nodes the kernel reads distances from a matrix (faster); it must
+    # find the same tour as from the coordinates, and a valid one
+    import teachfit.trajectories.tsp as tsp
+
+    pts = np.random.default_rng(4).normal(0.0, 0.01, (120, 2))
+    assert tsp._distances(np.vstack([np.zeros(2), pts])).shape == (122, 122)
+    with_matrix = open_tour(pts)
+    monkeypatch.setattr(tsp, "_MATRIX_UP_TO", 0)
+    assert tsp._distances(np.vstack([np.zeros(2), pts])).shape == (121, 2)
+    with_coords = open_tour(pts)
+    np.testing.assert_array_equal(with_matrix.order, with_coords.order)
+    assert sorted(with_matrix.order.tolist()) == list(range(120))
+    assert with_matrix.length == pytest.approx(path_length(np.zeros(2), pts, with_matrix.order))
+
+
+def test_more_kicks_never_give_a_longer_tour():
+    # the default 5.5 N kicks at 300 points begin with the former 5 N ones (the same seeded
+    # draws) and the shortest tour seen is kept: no instance may come out longer
+    pts = np.random.default_rng((0, 1, 300)).normal(0.0, 0.01, (300, 2))
+    five_n = open_tour(pts, n_kicks=1500)
+    default = open_tour(pts)
+    assert default.length <= five_n.length
+    assert sorted(default.order.tolist()) == list(range(300))

@@ -8,7 +8,8 @@ tour ``start → p_1 → … → p_N → dummy → start`` then costs exactly th
 of :mod:`teachfit.trajectories.tsp_kernel` (2-opt, Or-opt (of any segment up to 300 points)
 and Lin-Kernighan chains over the
 nearest and Delaunay neighbours from ``scipy.spatial``, then a fixed number of seeded
-double-bridge kicks; why it is written here is said there). ``solver="lkh"`` calls LKH-3
+segment-swap kicks; up to 300 points it reads a distance matrix; why it is written here is said
+there). ``solver="lkh"`` calls LKH-3
 through ``elkai`` (slow, the reference quality of the benchmark).
 
 Distances are Euclidean after scaling each coordinate by ``weights`` (e.g. ``(1, 1, ℓ)`` to
@@ -108,11 +109,31 @@ def _candidates(x: np.ndarray, k: int, width: int = 10) -> np.ndarray:
 _WINDOW = 1 << 30  # segments of any length (clusters move as a whole)
 _THRESHOLD = 0.1  # of the mean nearest-neighbour edge
 _DEPTH, _BREADTH = 3, 1  # Lin-Kernighan chain: flips at most, alternatives at its first step
-# up to this many points the chain is off and the kicks are 5 N: as close to LKH as 3 N kicks
-# with chains, in half the time (300 points, benchmarks/search_speed.py)
+# up to this many points the chain is off and the kicks are 5.5 N (5 N were as close to LKH
+# as 3 N kicks with chains, in half the time: 300 points, benchmarks/search_speed.py)
 _LK_FROM = 300
 #: at least this many kicks (small sets: 1500 kicks of 100 points take about 15 ms)
 _MIN_KICKS = 1500
+#: kicks per point up to _LK_FROM points: 5.5 N since the distance matrix made each kick ~15 %
+#: cheaper (5 N before): less CPU than before, and as the kicks' draws begin with the former
+#: 5 N ones and the shortest tour seen is kept, no tour longer than before
+_KICKS_PER_POINT = 5.5
+#: up to this many nodes (the start and 300 points) the kernel reads a distance matrix: 15-19 %
+#: less CPU at 100 and 300 points, the same tours; slower at 600 and 1000 points (the matrix
+#: leaves the cache), so coordinates there (benchmarks/search_speed.py point sets)
+_MATRIX_UP_TO = 301
+
+
+def _distances(x: np.ndarray) -> np.ndarray:
+    """What the kernel measures with: up to :data:`_MATRIX_UP_TO` nodes the distance matrix
+    with the dummy's zero row and column (shape (n + 1, n + 1); a look-up is cheaper than the
+    square root), else the coordinates (shape (n, D))."""
+    n = x.shape[0]
+    if n > _MATRIX_UP_TO:
+        return np.ascontiguousarray(x)
+    dm = np.zeros((n + 1, n + 1))
+    dm[:n, :n] = cdist(x, x)
+    return dm
 
 
 def _compiled(
@@ -129,7 +150,7 @@ def _compiled(
     scale = float(np.ptp(x, axis=0).max()) or 1.0
     d0 = np.linalg.norm(np.diff(x[tour[:-1]], axis=0), axis=1).mean()
     out = improve_tour(
-        np.ascontiguousarray(x),
+        _distances(x),
         neigh,
         tour,
         draws,
@@ -144,12 +165,12 @@ def _compiled(
 
 
 def _default_kicks(n: int) -> int:
-    """Kicks of the iterated local search: max(5 N, 1500) up to 300 points (≈ 20-30 ms, no LK
-    chains, Or-opt of any segment), then 3 N (N / 300)^0.75 (measured in
+    """Kicks of the iterated local search: max(5.5 N, 1500) up to 300 points (≈ 20-30 ms, no LK
+    chains, Or-opt of any segment, distance matrix), then 3 N (N / 300)^0.75 (measured in
     benchmarks/search_speed.py: larger sets need more kicks per point to stay within 1 % of
     LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
     if n <= _LK_FROM:
-        return max(5 * n, _MIN_KICKS)
+        return max(int(_KICKS_PER_POINT * n), _MIN_KICKS)
     return int(round(3 * n * (n / _LK_FROM) ** 0.75))
 
 
@@ -197,7 +218,7 @@ def open_tour(
     n_neighbours : int
         Candidate-list size K of the local search.
     n_kicks : int, optional
-        Iterated-local-search kicks; default ``max(5 N, 1500)`` up to 300 points (≈ 20-30 ms
+        Iterated-local-search kicks; default ``max(5.5 N, 1500)`` up to 300 points (≈ 20-30 ms
         CPU), ``3 N (N / 300)^0.75`` beyond. A fixed count,
         not a time budget: the same input gives the same tour on every machine.
     lkh_runs : int

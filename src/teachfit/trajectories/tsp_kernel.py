@@ -28,10 +28,14 @@ points costs exactly the open tour. Moves (all in O(segment) time on arrays):
   dummy (the free end of the open tour) the chain may break the longest edge of the tour.
 
 all restricted to candidate lists (nearest and Delaunay neighbours) with don't-look bits
-(a queue of nodes to look at). Then **iterated local search**: a double bridge (two adjacent
-segments of any length swapped, ``A B C D -> A C B D``; whole clusters of points move), local
-search from its six end nodes, kept when at most ``threshold`` longer (threshold accepting);
-the shortest tour seen is returned.
+(a queue of nodes to look at). Then **iterated local search**: a kick swapping two adjacent
+segments of any length (``A B C D -> A C B D``; whole clusters of points move; with both path
+ends fixed this changes three edges, a random segment insertion, not the 4-opt double bridge
+``A B C D E -> A D C B E``, which was tried and came out further from LKH-3 at the same number
+of kicks, whether its segments were of any length, short or chosen along candidate edges),
+local search from its six end nodes, kept when at most ``threshold`` longer (threshold
+accepting); the shortest tour seen is returned. Distances are read from a matrix when one is
+given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`).
 """
 
 from __future__ import annotations
@@ -221,7 +225,8 @@ def improve_tour(
     Parameters
     ----------
     x : ndarray, shape (M - 1, D)
-        Weighted coordinates of the start (row 0) and the points.
+        Weighted coordinates of the start (row 0) and the points, or their distance matrix
+        with the dummy's zero row and column, shape (M, M) (see ``_d`` in ``tsp_moves``).
     neigh : ndarray of int, shape (M - 1, K)
         K nearest other nodes of each node, nearest first.
     tour : ndarray of int, shape (M,)

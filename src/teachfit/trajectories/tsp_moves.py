@@ -12,6 +12,11 @@ from numba import njit
 
 @njit(cache=True)
 def _d(x: np.ndarray, a: int, b: int, dummy: int) -> float:
+    """Distance of nodes ``a`` and ``b``: ``x[a, b]`` when ``x`` is the distance matrix (a row
+    per node, the dummy's included: ``dummy + 1`` rows), else Euclidean between the rows of the
+    coordinates ``x`` (``dummy`` rows), 0 to the dummy (``dummy = -1``: none)."""
+    if x.shape[0] == dummy + 1:
+        return x[a, b]
     if a == dummy or b == dummy:
         return 0.0
     s = 0.0
