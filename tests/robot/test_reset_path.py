@@ -9,7 +9,11 @@ from teachfit.core.geometry import Pose, rotation_to_wxyz
 from teachfit.robot.franka.reset_path import (
     ResetCell,
     ResetGuard,
+    brake_decel,
+    brake_profile,
+    brake_time,
     leave_stiffness,
+    release_command,
     reset_via_points,
 )
 
@@ -86,6 +90,8 @@ def test_leaving_is_stiff_along_the_axis_and_compliant_across_and_about_it():
         {"release_stiffness": -1.0},
         {"release_time": (0.5, 0.1)},
         {"handover_time": 0.1},
+        {"brake_decel": 0.0},
+        {"release_fade": -0.1},
     ],
 )
 def test_a_cell_with_a_bad_compliance_or_release_time_is_refused(kwargs):
@@ -105,3 +111,64 @@ def test_the_skills_force_at_the_hand_over_is_kept_apart_from_the_resets_own():
     assert guard.handover_peaks == pytest.approx([9.0, 0.0])
     with pytest.raises(RobotFault, match="16.0 N"):  # the abort holds at the hand-over too
         guard.watch(np.r_[16.0 * lateral, 0, 0, 0], handover=True)
+
+
+@pytest.mark.parametrize("speed", [-0.2, 0.05])
+def test_the_brake_stops_smoothly_at_most_at_its_deceleration(speed):
+    decel = 8.0
+    big_t = brake_time(speed, decel)
+    t = np.linspace(0.0, big_t, 2001)
+    dist, vel, acc = np.array([brake_profile(speed, decel, ti) for ti in t]).T
+    # from the part's speed with no step in the force (zero acceleration) to rest, at rest after
+    assert vel[0] == speed and acc[0] == 0.0 and vel[-1] == pytest.approx(0.0, abs=1e-12)
+    assert acc[-1] == pytest.approx(0.0, abs=1e-12)
+    assert np.max(np.abs(acc)) == pytest.approx(decel, rel=1e-4)
+    assert np.all(acc * speed <= 0.0)  # against the motion only
+    assert dist[-1] == pytest.approx(speed * big_t / 2)
+    # the parts agree: the distance is the speed's integral, the speed the acceleration's
+    np.testing.assert_allclose(np.gradient(dist, t), vel, atol=1e-3 * abs(speed))
+    np.testing.assert_allclose(np.gradient(vel, t), acc, atol=2e-2 * decel)
+    assert brake_profile(speed, decel, 2 * big_t) == (dist[-1], 0.0, 0.0)
+    assert brake_profile(0.0, decel, 0.1) == (0.0, 0.0, 0.0)
+
+
+def _inertia() -> np.ndarray:
+    """An operational-space inertia (6, 6) whose force along one axis also turns and shifts."""
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(6, 6))
+    return a @ a.T + np.diag([8.0, 8.0, 8.0, 0.5, 0.5, 0.5])
+
+
+def test_the_release_brakes_along_the_axis_alone_and_lets_the_skills_wrench_go():
+    start = HOLE.compose(Pose(np.array([0.0003, -0.0002, -0.015])))
+    axis = HOLE.rotation.apply([0.0, 0.0, 1.0])
+    lam, skill = _inertia(), np.array([1.0, -2.0, -12.0, 0.1, 0.0, -0.05])
+    speed, decel = -0.16, 8.0
+    first = release_command(CELL, start, speed, lam, skill, decel, 0.0)
+    # the hand-over: where the part is, at its speed, the skill's wrench (no step)
+    np.testing.assert_allclose(first.pos, start.pos)
+    np.testing.assert_allclose(first.lin_vel, speed * axis)
+    np.testing.assert_allclose(first.wrench_ff, skill, atol=1e-12)
+    np.testing.assert_allclose(first.stiffness, leave_stiffness(CELL, CELL.release_stiffness))
+    mid_t = brake_time(speed, decel) / 2
+    mid = release_command(CELL, start, speed, lam, skill, decel, mid_t)
+    dist, vel, acc = brake_profile(speed, decel, mid_t)
+    np.testing.assert_allclose(mid.pos, start.pos + dist * axis, atol=1e-12)
+    np.testing.assert_allclose(mid.quat, start.quat)
+    assert acc == pytest.approx(decel)  # the part moves down the axis: braked upwards
+    keep = 0.5 * (1 + np.cos(np.pi * mid_t / CELL.release_fade))
+    brake = mid.wrench_ff - keep * skill
+    # the inertia's response to the brake: along the axis alone (no turn, no push across)
+    np.testing.assert_allclose(np.linalg.solve(lam, brake), np.r_[acc * axis, 0, 0, 0], atol=1e-9)
+    late = release_command(CELL, start, speed, lam, skill, decel, CELL.release_fade + 0.2)
+    np.testing.assert_allclose(late.wrench_ff, 0.0, atol=1e-12)  # the skill's wrench let go
+    np.testing.assert_allclose(late.lin_vel, 0.0, atol=1e-12)
+
+
+def test_the_brake_is_gentler_where_its_feed_forward_would_pass_the_force_limit():
+    lam = _inertia()
+    per = np.linalg.norm(lam[:3, :3] @ HOLE.rotation.apply([0.0, 0.0, 1.0]))
+    assert brake_decel(CELL, lam, np.zeros(6), 1000.0, 1000.0) == CELL.brake_decel
+    skill = np.array([0.0, 0.0, -30.0, 0.0, 0.0, 0.0])
+    decel = brake_decel(CELL, lam, skill, 60.0, 1000.0)
+    assert decel == pytest.approx((0.9 * 60.0 - 30.0) / per) and decel < CELL.brake_decel

@@ -6,12 +6,18 @@ while it is still engaged: it levers on the hole's wall, loads the fixture and t
 can pull the part out of the fingers. The reset therefore goes through via points in the hole
 frame ``H`` (origin at the entry centre, z out of the hole):
 
-0. **release** (when the TCP starts below the clearance plane): hold where the skill left
-   the part, soft along the hole's axis (``release_stiffness``) and compliant across it and
-   about every axis (:func:`leave_stiffness`), until the TCP is at rest: the skill's press
-   is let go, and a part the skill left still sliding into the hole (up to 0.16 m/s on the
-   peg twin) is braked gently over a few mm: braked in 30 ms at the reset's 2000 N/m, the
-   arm's own inertia pressed the part 7-13 N on the hole's wall;
+0. **release** (when the TCP starts below the clearance plane): the part the skill left
+   still sliding into the hole (up to 0.2 m/s on the peg twin) is braked along the hole's
+   axis alone, then held where it stopped, soft along the axis (``release_stiffness``) and
+   compliant across it and about every axis (:func:`leave_stiffness`), until the TCP is at
+   rest; the skill's last wrench is let go over ``release_fade``. The brake is a set-point
+   that follows a smooth stop (:func:`brake_profile`: no step in the force, at most
+   ``brake_decel``) with the arm's operational-space inertia times that deceleration as the
+   feed-forward (:func:`release_command`): any force along the axis alone would also
+   accelerate the arm across it (the inertia's off-diagonal terms: 0.3 m/s² across per N along
+   on the peg twin), and the hole's wall would take that up. Braked by the impedance alone
+   the part pressed 4-14 N on the wall, or reached the hole's bottom still moving and pressed
+   7-11 N on it;
 1. **out**: from where the release settled straight along the hole's z to ``clear_height``
    above the entry, keeping x, y and the orientation (a pure motion along the insertion
    axis), with the same compliance across the axis, so the hole guides the part;
@@ -33,6 +39,7 @@ import numpy as np
 
 from teachfit.core.errors import NeedsAPerson, TeachfitError
 from teachfit.core.geometry import Pose
+from teachfit.core.state import ImpedanceCommand
 
 
 @dataclass(frozen=True)
@@ -47,7 +54,10 @@ class ResetCell:
     and the most the release holds before the way out starts (the least lets the wrench
     estimate's filters catch up with the let-go press); ``release_stiffness`` (N/m) along
     the hole's axis during the release; ``handover_time`` (s) from the release's start during
-    which the reading is the skill's force, not the reset's (:class:`ResetGuard`).
+    which the reading is the skill's force, not the reset's (:class:`ResetGuard`);
+    ``brake_decel`` (m/s²) the largest deceleration along the axis that stops a part still
+    sliding at the hand-over (:func:`brake_profile`); ``release_fade`` (s) over which the
+    skill's last wrench is let go.
     """
 
     hole2world: Pose
@@ -57,16 +67,21 @@ class ResetCell:
     release_time: tuple[float, float] = (0.05, 0.5)
     release_stiffness: float = 300.0
     handover_time: float = 0.02
+    brake_decel: float = 8.0
+    release_fade: float = 0.1
 
     def __post_init__(self) -> None:
         lo, hi = self.release_time
-        soft = (*self.leave_stiffness, self.release_stiffness)
+        soft = (*self.leave_stiffness, self.release_stiffness, self.brake_decel)
         if min(soft) <= 0 or not 0 <= lo <= hi or not 0 <= self.handover_time <= lo:
             raise TeachfitError(
-                f"reset cell: leave_stiffness {self.leave_stiffness} and release_stiffness "
-                f"{self.release_stiffness} must be > 0, release_time {self.release_time} a "
-                f"(least, most) pair >= 0 s, handover_time {self.handover_time} s in [0, least]"
+                f"reset cell: leave_stiffness {self.leave_stiffness}, release_stiffness "
+                f"{self.release_stiffness} and brake_decel {self.brake_decel} must be > 0, "
+                f"release_time {self.release_time} a (least, most) pair >= 0 s, handover_time "
+                f"{self.handover_time} s in [0, least]"
             )
+        if not self.release_fade >= 0:
+            raise TeachfitError(f"reset cell: release_fade {self.release_fade} s must be >= 0")
 
 
 def leave_stiffness(cell: ResetCell, along: float) -> np.ndarray:
@@ -83,6 +98,85 @@ def leave_stiffness(cell: ResetCell, along: float) -> np.ndarray:
     k[:3, :3] = rot @ np.diag([across, across, float(along)]) @ rot.T
     k[3:, 3:] = np.eye(3) * turn
     return k
+
+
+def brake_time(speed: float, decel: float) -> float:
+    """How long (s) :func:`brake_profile` takes to stop ``speed`` (m/s) at most ``decel`` (m/s²)."""
+    return 1.5 * abs(speed) / decel
+
+
+def brake_profile(speed: float, decel: float, t: float) -> tuple[float, float, float]:
+    """Distance (m), speed (m/s) and acceleration (m/s²) along an axis ``t`` s into a stop from
+    ``speed`` (m/s, signed along the axis) at most ``decel`` (m/s²).
+
+    The speed falls as a smoothstep, ``v = speed (1 - 3u² + 2u³)`` with ``u = t / T`` and
+    ``T`` = :func:`brake_time`: the acceleration starts and ends at zero (the hand-over's force
+    has no step) and peaks at ``decel``; the stop takes ``speed T / 2``. After ``T``: at rest
+    there."""
+    big_t = brake_time(speed, decel)
+    if big_t <= 0.0:
+        return 0.0, 0.0, 0.0
+    u = min(max(t / big_t, 0.0), 1.0)
+    dist = speed * big_t * (u - u**3 + 0.5 * u**4)
+    vel = speed * (1.0 - 3.0 * u * u + 2.0 * u**3)
+    acc = -6.0 * speed * u * (1.0 - u) / big_t
+    return dist, vel, acc
+
+
+def release_command(
+    cell: ResetCell,
+    start: Pose,
+    speed: float,
+    inertia: np.ndarray,
+    skill_wrench: np.ndarray,
+    decel: float,
+    t: float,
+) -> ImpedanceCommand:
+    """The release's command ``t`` s after the hand-over at ``start`` (world TCP pose) of a
+    part moving at ``speed`` (m/s along the hole's z).
+
+    The set-point follows :func:`brake_profile` along the hole's z from ``start`` (x, y and the
+    orientation kept), at the release's stiffness (:func:`leave_stiffness`); the feed-forward
+    is ``inertia @ [a; 0]`` (``inertia`` the TCP's operational-space inertia (6, 6), world,
+    ``a`` the profile's acceleration along the axis), which brakes along the axis alone,
+    plus the skill's last commanded wrench ``skill_wrench`` (6,) (world, N, N·m) let go over
+    ``cell.release_fade`` (a half cosine)."""
+    axis = cell.hole2world.rotation.apply([0.0, 0.0, 1.0])
+    dist, vel, acc = brake_profile(speed, decel, t)
+    fade = cell.release_fade
+    keep = 0.5 * (1.0 + np.cos(np.pi * min(t / fade, 1.0))) if fade > 0 else 0.0
+    wrench = keep * np.asarray(skill_wrench, dtype=float)
+    wrench += np.asarray(inertia, dtype=float)[:, :3] @ (acc * axis)
+    return ImpedanceCommand(
+        pos=start.pos + dist * axis,
+        quat=start.quat,
+        lin_vel=vel * axis,
+        wrench_ff=wrench,
+        stiffness=leave_stiffness(cell, cell.release_stiffness),
+        expires_after=1.0,
+    )
+
+
+def brake_decel(
+    cell: ResetCell,
+    inertia: np.ndarray,
+    skill_wrench: np.ndarray,
+    max_force: float,
+    max_torque: float,
+) -> float:
+    """The deceleration (m/s²) the release brakes at: ``cell.brake_decel``, less where its
+    feed-forward (:func:`release_command`) with the skill's wrench ``skill_wrench`` would pass
+    90 % of ``max_force`` (N) or ``max_torque`` (N·m): the driver refuses a feed-forward past
+    them. The caller keeps ``skill_wrench`` within half of each."""
+    axis = cell.hole2world.rotation.apply([0.0, 0.0, 1.0])
+    per = np.asarray(inertia, dtype=float)[:, :3] @ axis  # wrench per m/s² along the axis
+    decel = cell.brake_decel
+    for part, cap in ((slice(0, 3), max_force), (slice(3, 6), max_torque)):
+        room = 0.9 * cap - float(np.linalg.norm(np.asarray(skill_wrench)[part]))
+        need = float(np.linalg.norm(per[part]))
+        if need * decel > room:
+            decel = room / need
+    return decel
 
 
 def reset_via_points(current: Pose, goal: Pose, cell: ResetCell | None) -> list[tuple[str, Pose]]:
