@@ -55,7 +55,7 @@ from teachfit.robot.franka.reset_path import (
     release_command,
     reset_via_points,
 )
-from teachfit.robot.franka.safety import FrankaLimits, clip_wrench_norm
+from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import (
     ROTOR_INERTIA,
     TorqueTick,
@@ -370,27 +370,25 @@ class FrankaRobot:
             guard.finish()
 
     def _release(self, cell: ResetCell) -> Pose:
-        """Take over from the skill where the TCP is: brake a part still sliding in along the
-        hole's axis alone, let the skill's wrench go, then hold until the TCP is at rest (at
+        """Take over from the skill where the TCP is (its press let go at once): brake a part
+        still sliding in along the hole's axis alone, then hold until the TCP is at rest (at
         least and at most ``cell.release_time`` after the brake;
         :func:`~teachfit.robot.franka.reset_path.release_command`), the lateral force watched
         (the first ``cell.handover_time`` as the hand-over's); the pose it settled at."""
         lim, dt = self.params.limits, 10 * self.control_period
-        skill = self._loop.tick.wrench_cmd.copy()  # the skill's last commanded wrench (world)
-        clip_wrench_norm(skill, 0.5 * lim.max_force, 0.5 * lim.max_torque)
         state = self.state()
         here = state.pose
         speed = float(state.lin_vel @ cell.hole2world.rotation.apply([0.0, 0.0, 1.0]))
         inertia = self._inertia()
-        decel = brake_decel(cell, inertia, skill, lim.max_force, lim.max_torque)
+        decel = brake_decel(cell, inertia, lim.max_force, lim.max_torque)
         braking = int(np.ceil(brake_time(speed, decel) / dt))
         least, most = (int(round(t / dt)) for t in cell.release_time)
-        first = release_command(cell, here, speed, inertia, skill, decel, 0.0)
+        first = release_command(cell, here, speed, inertia, decel, 0.0)
         lim.check_command(first)
         self._loop.install(self._approach_law(), first)
         for i in range(braking + max(most, 1)):
             if i:
-                self.command(release_command(cell, here, speed, inertia, skill, decel, i * dt))
+                self.command(release_command(cell, here, speed, inertia, decel, i * dt))
             state = self.step(10)
             if self.reset_guard is not None:
                 self.reset_guard.watch(state.wrench, (i + 1) * dt <= cell.handover_time + 1e-9)

@@ -10,7 +10,7 @@ frame ``H`` (origin at the entry centre, z out of the hole):
    still sliding into the hole (up to 0.2 m/s on the peg twin) is braked along the hole's
    axis alone, then held where it stopped, soft along the axis (``release_stiffness``) and
    compliant across it and about every axis (:func:`leave_stiffness`), until the TCP is at
-   rest; the skill's last wrench is let go over ``release_fade``. The brake is a set-point
+   rest; the skill's press is let go at once. The brake is a set-point
    that follows a smooth stop (:func:`brake_profile`: no step in the force, at most
    ``brake_decel``) with the arm's operational-space inertia times that deceleration as the
    feed-forward (:func:`release_command`): any force along the axis alone would also
@@ -56,8 +56,7 @@ class ResetCell:
     the hole's axis during the release; ``handover_time`` (s) from the release's start during
     which the reading is the skill's force, not the reset's (:class:`ResetGuard`);
     ``brake_decel`` (m/s²) the largest deceleration along the axis that stops a part still
-    sliding at the hand-over (:func:`brake_profile`); ``release_fade`` (s) over which the
-    skill's last wrench is let go.
+    sliding at the hand-over (:func:`brake_profile`).
     """
 
     hole2world: Pose
@@ -68,7 +67,6 @@ class ResetCell:
     release_stiffness: float = 300.0
     handover_time: float = 0.02
     brake_decel: float = 8.0
-    release_fade: float = 0.1
 
     def __post_init__(self) -> None:
         lo, hi = self.release_time
@@ -80,8 +78,6 @@ class ResetCell:
                 f"release_time {self.release_time} a (least, most) pair >= 0 s, handover_time "
                 f"{self.handover_time} s in [0, least]"
             )
-        if not self.release_fade >= 0:
-            raise TeachfitError(f"reset cell: release_fade {self.release_fade} s must be >= 0")
 
 
 def leave_stiffness(cell: ResetCell, along: float) -> np.ndarray:
@@ -124,58 +120,38 @@ def brake_profile(speed: float, decel: float, t: float) -> tuple[float, float, f
 
 
 def release_command(
-    cell: ResetCell,
-    start: Pose,
-    speed: float,
-    inertia: np.ndarray,
-    skill_wrench: np.ndarray,
-    decel: float,
-    t: float,
+    cell: ResetCell, start: Pose, speed: float, inertia: np.ndarray, decel: float, t: float
 ) -> ImpedanceCommand:
     """The release's command ``t`` s after the hand-over at ``start`` (world TCP pose) of a
-    part moving at ``speed`` (m/s along the hole's z).
+    part moving at ``speed`` (m/s along the hole's z), braked at most at ``decel`` (m/s²).
 
     The set-point follows :func:`brake_profile` along the hole's z from ``start`` (x, y and the
     orientation kept), at the release's stiffness (:func:`leave_stiffness`); the feed-forward
-    is ``inertia @ [a; 0]`` (``inertia`` the TCP's operational-space inertia (6, 6), world,
-    ``a`` the profile's acceleration along the axis), which brakes along the axis alone,
-    plus the skill's last commanded wrench ``skill_wrench`` (6,) (world, N, N·m) let go over
-    ``cell.release_fade`` (a half cosine)."""
+    ``inertia @ [a; 0]`` (``inertia`` the TCP's operational-space inertia (6, 6), world;
+    ``a`` the profile's acceleration along the axis) brakes along the axis alone."""
     axis = cell.hole2world.rotation.apply([0.0, 0.0, 1.0])
     dist, vel, acc = brake_profile(speed, decel, t)
-    fade = cell.release_fade
-    keep = 0.5 * (1.0 + np.cos(np.pi * min(t / fade, 1.0))) if fade > 0 else 0.0
-    wrench = keep * np.asarray(skill_wrench, dtype=float)
-    wrench += np.asarray(inertia, dtype=float)[:, :3] @ (acc * axis)
     return ImpedanceCommand(
         pos=start.pos + dist * axis,
         quat=start.quat,
         lin_vel=vel * axis,
-        wrench_ff=wrench,
+        wrench_ff=np.asarray(inertia, dtype=float)[:, :3] @ (acc * axis),
         stiffness=leave_stiffness(cell, cell.release_stiffness),
         expires_after=1.0,
     )
 
 
-def brake_decel(
-    cell: ResetCell,
-    inertia: np.ndarray,
-    skill_wrench: np.ndarray,
-    max_force: float,
-    max_torque: float,
-) -> float:
+def brake_decel(cell: ResetCell, inertia: np.ndarray, max_force: float, max_torque: float) -> float:
     """The deceleration (m/s²) the release brakes at: ``cell.brake_decel``, less where its
-    feed-forward (:func:`release_command`) with the skill's wrench ``skill_wrench`` would pass
-    90 % of ``max_force`` (N) or ``max_torque`` (N·m): the driver refuses a feed-forward past
-    them. The caller keeps ``skill_wrench`` within half of each."""
+    feed-forward (:func:`release_command`) would pass 80 % of ``max_force`` (N) or
+    ``max_torque`` (N·m), which the driver refuses."""
     axis = cell.hole2world.rotation.apply([0.0, 0.0, 1.0])
     per = np.asarray(inertia, dtype=float)[:, :3] @ axis  # wrench per m/s² along the axis
     decel = cell.brake_decel
     for part, cap in ((slice(0, 3), max_force), (slice(3, 6), max_torque)):
-        room = 0.9 * cap - float(np.linalg.norm(np.asarray(skill_wrench)[part]))
         need = float(np.linalg.norm(per[part]))
-        if need * decel > room:
-            decel = room / need
+        if need * decel > 0.8 * cap:
+            decel = 0.8 * cap / need
     return decel
 
 
