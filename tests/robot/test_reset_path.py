@@ -101,15 +101,24 @@ def test_a_cell_with_a_bad_compliance_or_release_time_is_refused(kwargs):
 def test_the_skills_force_at_the_hand_over_is_kept_apart_from_the_resets_own():
     guard = ResetGuard(CELL)
     lateral = HOLE.rotation.apply([0.6, 0.8, 0.0])  # 1 N across the hole's axis
-    guard.watch(np.r_[9.0 * lateral, 0, 0, 0], handover=True)  # what the skill left: 9 N
-    guard.watch(np.r_[2.0 * lateral, 0, 0, 0])
-    assert guard.finish() == pytest.approx(2.0)
-    assert guard.peaks == pytest.approx([2.0]) and guard.handover_peaks == pytest.approx([9.0])
-    guard.watch(np.r_[lateral, 0, 0, 0])  # the next reset starts both at zero
+    guard.take_over(np.r_[9.0 * lateral, 0, 0, 0])  # what the skill left: 9 N
+    guard.watch(np.r_[6.0 * lateral, 0, 0, 0], handover=True)  # fading out of the estimate
+    guard.watch(np.r_[2.0 * lateral, 0, 0, 0], handover=True)
+    guard.watch(np.r_[1.0 * lateral, 0, 0, 0])  # past handover_time: the reset's own
+    assert guard.finish() == pytest.approx(1.0)
+    assert guard.peaks == pytest.approx([1.0]) and guard.handover_peaks == pytest.approx([9.0])
+    # a reading that rises ends the hand-over: it and all later ones are the reset's own
+    guard.take_over(np.r_[3.0 * lateral, 0, 0, 0])
+    guard.watch(np.r_[4.0 * lateral, 0, 0, 0], handover=True)
+    guard.watch(np.r_[2.5 * lateral, 0, 0, 0], handover=True)
+    assert guard.finish() == pytest.approx(4.0) and guard.handover_peaks[-1] == pytest.approx(3.0)
+    guard.watch(np.r_[lateral, 0, 0, 0], handover=True)  # without a take-over: the reset's
     guard.finish()
-    assert guard.handover_peaks == pytest.approx([9.0, 0.0])
+    assert guard.peaks[-1] == pytest.approx(1.0) and guard.handover_peaks[-1] == 0.0
+    guard.take_over(np.r_[20.0 * lateral, 0, 0, 0])  # the skill's: no abort, the press let go
     with pytest.raises(RobotFault, match="16.0 N"):  # the abort holds at the hand-over too
         guard.watch(np.r_[16.0 * lateral, 0, 0, 0], handover=True)
+    assert guard.handover_peaks[-1] == pytest.approx(20.0)
 
 
 @pytest.mark.parametrize("speed", [-0.2, 0.05])

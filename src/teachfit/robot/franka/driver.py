@@ -374,7 +374,7 @@ class FrankaRobot:
         still sliding in along the hole's axis alone, then hold until the TCP is at rest (at
         least and at most ``cell.release_time`` after the brake;
         :func:`~teachfit.robot.franka.reset_path.release_command`), the lateral force watched
-        (the first ``cell.handover_time`` as the hand-over's); the pose it settled at."""
+        (from the reading at the take-over: :class:`ResetGuard`); the pose it settled at."""
         lim, dt = self.params.limits, 10 * self.control_period
         state = self.state()
         here = state.pose
@@ -385,6 +385,8 @@ class FrankaRobot:
         least, most = (int(round(t / dt)) for t in cell.release_time)
         first = release_command(cell, here, speed, inertia, decel, 0.0)
         lim.check_command(first)
+        if self.reset_guard is not None:
+            self.reset_guard.take_over(state.wrench)
         self._loop.install(self._approach_law(), first)
         for i in range(braking + max(most, 1)):
             if i:

@@ -27,10 +27,12 @@ frame ``H`` (origin at the entry centre, z out of the hole):
 A TCP already above the clearance plane goes straight to the start. While the part leaves
 the hole, the lateral force it sees is watched (:class:`ResetGuard`): every reset's peak is
 recorded, and one beyond ``abort_force`` stops the reset before it pulls harder. The first
-``handover_time`` of the release reads the force the *skill* left (libfranka's estimate is
-filtered: it lags 10-20 ms); those readings are kept apart as the hand-over peak. (On the
-peg twin, every hand-over peak over 5 N was, within 0.4 N, the reading taken before the
-reset's first command: the skill's own force at the end of its execution.)
+release reads the force the *skill* left, fading out of libfranka's filtered estimate (on
+the peg twin a 13 N press let go still reads 8 N after 20 ms, 3 N after 30 ms); while the
+readings since the hand-over keep falling, within ``handover_time``, they are kept apart as
+the hand-over peak. (On the peg twin every hand-over peak over 5 N was, within 0.4 N, the
+reading taken before the reset's first command: the skill's own force at the end of its
+execution.)
 """
 
 from __future__ import annotations
@@ -55,8 +57,8 @@ class ResetCell:
     and the way out (:func:`leave_stiffness`); ``release_time`` (s of robot time) the least
     and the most the release holds before the way out starts (the least lets the wrench
     estimate's filters catch up with the let-go press); ``release_stiffness`` (N/m) along
-    the hole's axis during the release; ``handover_time`` (s) from the release's start during
-    which the reading is the skill's force, not the reset's (:class:`ResetGuard`);
+    the hole's axis during the release; ``handover_time`` (s) from the release's start within
+    which a falling reading is the skill's force fading, not the reset's (:class:`ResetGuard`);
     ``brake_decel`` (m/s²) the largest deceleration along the axis that stops a part still
     sliding at the hand-over (:func:`brake_profile`).
     """
@@ -67,7 +69,7 @@ class ResetCell:
     leave_stiffness: tuple[float, float] = (200.0, 10.0)
     release_time: tuple[float, float] = (0.05, 0.5)
     release_stiffness: float = 300.0
-    handover_time: float = 0.02
+    handover_time: float = 0.05
     brake_decel: float = 8.0
 
     def __post_init__(self) -> None:
@@ -180,11 +182,15 @@ def reset_via_points(current: Pose, goal: Pose, cell: ResetCell | None) -> list[
 class ResetGuard:
     """Watches the lateral force (N, hole frame x-y) while a reset leaves the hole.
 
-    :meth:`watch` takes each measured wrench (world frame, force first) of the release and the
-    ``out`` leg; ``peak`` is the largest lateral force seen, ``handover`` the largest of the
-    readings marked ``handover`` (the skill's force, read in the release's first
-    ``handover_time``); ``peaks`` and ``handover_peaks`` keep every finished reset's. Past
-    ``abort_force`` either raises :class:`~teachfit.core.errors.NeedsAPerson`.
+    :meth:`take_over` takes the reading at the hand-over (before the reset's first command:
+    the skill's force), :meth:`watch` each measured wrench (world frame, force first) of the
+    release and the ``out`` leg. A reading belongs to the hand-over while the readings since
+    the take-over keep falling, within the release's first ``handover_time`` (``handover``):
+    the skill's force fading out of the filtered estimate. The first that does not fall ends
+    the hand-over; it and every later one are the reset's own. ``peak`` is the largest lateral
+    force of the reset's own, ``handover`` the hand-over's; ``peaks`` and ``handover_peaks``
+    keep every finished reset's. Past ``abort_force`` a watched reading raises
+    :class:`~teachfit.core.errors.NeedsAPerson`.
     """
 
     cell: ResetCell
@@ -192,15 +198,30 @@ class ResetGuard:
     handover: float = 0.0
     peaks: list[float] = field(default_factory=list)
     handover_peaks: list[float] = field(default_factory=list)
+    _fading: float | None = field(default=None, repr=False)  # the hand-over's last reading
+
+    def lateral(self, wrench_world: np.ndarray) -> float:
+        """The lateral force (N) of ``wrench_world`` (6,) (world, force first)."""
+        f_hole = self.cell.hole2world.inverse().rotation.apply(np.asarray(wrench_world)[:3])
+        return float(np.hypot(f_hole[0], f_hole[1]))
+
+    def take_over(self, wrench_world: np.ndarray) -> None:
+        """Start the hand-over at the reading before the reset's first command (the skill's
+        force; never an abort: the release lets the skill's press go)."""
+        self._fading = self.lateral(wrench_world)
+        self.handover = max(self.handover, self._fading)
 
     def watch(self, wrench_world: np.ndarray, handover: bool = False) -> None:
-        """Record the lateral force of ``wrench_world`` (in the hand-over peak if
-        ``handover``); raise :class:`NeedsAPerson` past ``abort_force``."""
-        f_hole = self.cell.hole2world.inverse().rotation.apply(np.asarray(wrench_world)[:3])
-        lateral = float(np.hypot(f_hole[0], f_hole[1]))
-        if handover:
+        """Record the lateral force of ``wrench_world``: in the hand-over's peak if
+        ``handover`` (within the release's first ``handover_time``) and it is below the
+        hand-over's last reading, else in the reset's own; raise :class:`NeedsAPerson` past
+        ``abort_force``."""
+        lateral = self.lateral(wrench_world)
+        if handover and self._fading is not None and lateral < self._fading:
+            self._fading = lateral
             self.handover = max(self.handover, lateral)
         else:
+            self._fading = None
             self.peak = max(self.peak, lateral)
         if lateral > self.cell.abort_force:
             self.finish()
@@ -215,5 +236,5 @@ class ResetGuard:
         peak, self.peak = self.peak, 0.0
         self.peaks.append(peak)
         self.handover_peaks.append(self.handover)
-        self.handover = 0.0
+        self.handover, self._fading = 0.0, None
         return peak
