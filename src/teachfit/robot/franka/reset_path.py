@@ -26,13 +26,13 @@ frame ``H`` (origin at the entry centre, z out of the hole):
 
 A TCP already above the clearance plane goes straight to the start. While the part leaves
 the hole, the lateral force it sees is watched (:class:`ResetGuard`): every reset's peak is
-recorded, and one beyond ``abort_force`` stops the reset before it pulls harder. The first
-release reads the force the *skill* left, fading out of libfranka's filtered estimate (on
-the peg twin a 13 N press let go still reads 8 N after 20 ms, 3 N after 30 ms); while the
-readings since the hand-over keep falling, within ``handover_time``, they are kept apart as
-the hand-over peak. (On the peg twin every hand-over peak over 5 N was, within 0.4 N, the
-reading taken before the reset's first command: the skill's own force at the end of its
-execution.)
+recorded, and one beyond ``abort_force`` stops the reset before it pulls harder. The start of
+the release reads the force the *skill* left, fading out of libfranka's filtered estimate
+(on the peg twin a 13 N press let go still reads 8 N after 20 ms, 3 N after 30 ms); the
+first reading after the hand-over (the estimate lags) and those that keep falling from it,
+within ``handover_time``, are kept apart as the hand-over peak. (On the peg twin every
+hand-over peak over 5 N was, within 0.4 N, the reading taken before the reset's first
+command: the skill's own force at the end of its execution.)
 """
 
 from __future__ import annotations
@@ -184,13 +184,15 @@ class ResetGuard:
 
     :meth:`take_over` takes the reading at the hand-over (before the reset's first command:
     the skill's force), :meth:`watch` each measured wrench (world frame, force first) of the
-    release and the ``out`` leg. A reading belongs to the hand-over while the readings since
-    the take-over keep falling, within the release's first ``handover_time`` (``handover``):
-    the skill's force fading out of the filtered estimate. The first that does not fall ends
-    the hand-over; it and every later one are the reset's own. ``peak`` is the largest lateral
-    force of the reset's own, ``handover`` the hand-over's; ``peaks`` and ``handover_peaks``
-    keep every finished reset's. Past ``abort_force`` a watched reading raises
-    :class:`~teachfit.core.errors.NeedsAPerson`.
+    release and the ``out`` leg. A reading within the release's first ``handover_time``
+    (``handover``) belongs to the hand-over if it is the first after the take-over (the
+    estimate lags 10-20 ms: it still shows the skill's force, rising if that was rising) or
+    falls from the one before (the skill's force fading out of the filtered estimate). The
+    first that does neither ends the hand-over; it and every later one are the reset's own.
+    ``peak`` is the largest lateral force of the reset's own, ``handover`` the hand-over's;
+    ``peaks`` and ``handover_peaks`` keep every finished reset's. A reading of the reset's
+    own past ``abort_force`` raises :class:`~teachfit.core.errors.NeedsAPerson` (the skill's
+    force is let go at the take-over: a part caught in the hole pulls when the reset moves).
     """
 
     cell: ResetCell
@@ -199,6 +201,7 @@ class ResetGuard:
     peaks: list[float] = field(default_factory=list)
     handover_peaks: list[float] = field(default_factory=list)
     _fading: float | None = field(default=None, repr=False)  # the hand-over's last reading
+    _first: bool = field(default=False, repr=False)  # no reading watched since the take-over
 
     def lateral(self, wrench_world: np.ndarray) -> float:
         """The lateral force (N) of ``wrench_world`` (6,) (world, force first)."""
@@ -206,23 +209,25 @@ class ResetGuard:
         return float(np.hypot(f_hole[0], f_hole[1]))
 
     def take_over(self, wrench_world: np.ndarray) -> None:
-        """Start the hand-over at the reading before the reset's first command (the skill's
-        force; never an abort: the release lets the skill's press go)."""
+        """Start the hand-over at the reading before the reset's first command."""
         self._fading = self.lateral(wrench_world)
+        self._first = True
         self.handover = max(self.handover, self._fading)
 
     def watch(self, wrench_world: np.ndarray, handover: bool = False) -> None:
         """Record the lateral force of ``wrench_world``: in the hand-over's peak if
-        ``handover`` (within the release's first ``handover_time``) and it is below the
-        hand-over's last reading, else in the reset's own; raise :class:`NeedsAPerson` past
-        ``abort_force``."""
+        ``handover`` (within the release's first ``handover_time``) and it is the first
+        reading after the take-over or below the one before, else in the reset's own; raise
+        :class:`NeedsAPerson` when the reset's own passes ``abort_force``."""
         lateral = self.lateral(wrench_world)
-        if handover and self._fading is not None and lateral < self._fading:
+        fading = self._fading is not None and (self._first or lateral < self._fading)
+        self._first = False
+        if handover and fading:
             self._fading = lateral
             self.handover = max(self.handover, lateral)
-        else:
-            self._fading = None
-            self.peak = max(self.peak, lateral)
+            return
+        self._fading = None
+        self.peak = max(self.peak, lateral)
         if lateral > self.cell.abort_force:
             self.finish()
             raise NeedsAPerson(
@@ -236,5 +241,5 @@ class ResetGuard:
         peak, self.peak = self.peak, 0.0
         self.peaks.append(peak)
         self.handover_peaks.append(self.handover)
-        self.handover, self._fading = 0.0, None
+        self.handover, self._fading, self._first = 0.0, None, False
         return peak
