@@ -93,3 +93,22 @@ def test_operational_mass_is_lambdas_diagonal_in_world_axes() -> None:
     quarter = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # about z
     turned = operational_mass(mass, jac, quarter)
     np.testing.assert_allclose(turned[[1, 0, 2, 4, 3, 5]], np.diag(lam))  # x and y swap
+
+
+def test_operational_inertia_is_the_full_lambda_in_world_axes() -> None:
+    from teachfit.robot.franka.tick import operational_inertia
+
+    rng = np.random.default_rng(4)
+    jac = rng.normal(size=(6, 7))
+    a = rng.normal(size=(7, 7))
+    mass = a @ a.T + 7 * np.eye(7)
+    quarter = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])  # about z
+    lam = operational_inertia(mass, jac, quarter)
+    rot = np.kron(np.eye(2), quarter)
+    # the world wrench lam @ acc accelerates the TCP by acc: J M^-1 J^T (world) undoes it
+    acc = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    mobility = rot @ jac @ np.linalg.solve(mass, jac.T) @ rot.T
+    np.testing.assert_allclose(mobility @ lam @ acc, acc, atol=1e-9)
+    np.testing.assert_allclose(lam, lam.T)
+    # not diagonal: accelerating along z alone takes force along x and y too
+    assert np.count_nonzero(np.abs(lam[:3, 2]) > 1e-6) == 3

@@ -281,20 +281,30 @@ def test_robot_twin_stops_on_sigterm_and_ctrl_c_with_nothing_left(
         os.killpg(proc.pid, 0)  # no process of its group is left
 
 
+def _into_the_hole(robot: Any, stiffness: np.ndarray) -> tuple[Pose, Pose]:
+    """Reset 5 mm above the hole's entry and lower the part 4 mm into it at 2 cm/s at
+    ``stiffness``; the entry's contact pose and the pose 4 mm in."""
+    entry = TASK.contact_pose(np.array([0.0, 0.0]))
+    start, into = entry.translated([0.0, 0.0, 0.005]), entry.translated([0.0, 0.0, -0.004])
+    robot.reset(start)
+    for pose in approach_waypoints(start, into, 0.02, 0.3, 0.01):
+        robot.command(ImpedanceCommand.hold(pose, stiffness=stiffness))
+        robot.step(10)
+    return entry, into
+
+
 def test_a_reset_out_of_an_inserted_hole_leaves_along_its_axis_under_5_n(
     franka_twin: Twin,
 ) -> None:
     """The part inserted 8 mm deep, the next start 20 mm to the side: the reset pulls it out
     along the hole's axis first; the largest lateral force on the way out stays under 5 N."""
     franka_twin(start=(0.0, 0.0, 0.005))
-    entry = TASK.contact_pose(np.array([0.0, 0.0]))
-    deep = Pose(entry.pos - [0.0, 0.0, 0.008], entry.quat)
     with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
-        start = entry.translated([0.0, 0.0, 0.005])
-        robot.reset(start)
         # compliant across (the chamfer centres the peg), stiff along the axis
         soft = np.array([150.0, 150.0, 800.0, 30.0, 30.0, 100.0])
-        for pose in approach_waypoints(start, deep, 0.02, 0.3, 0.01):
+        entry, into = _into_the_hole(robot, soft)
+        deep = entry.translated([0.0, 0.0, -0.008])
+        for pose in approach_waypoints(into, deep, 0.02, 0.3, 0.01):
             robot.command(ImpedanceCommand.hold(pose, stiffness=soft))
             state = robot.step(10)
         for _ in range(50):
@@ -307,6 +317,33 @@ def test_a_reset_out_of_an_inserted_hole_leaves_along_its_axis_under_5_n(
         peak = robot.reset_guard.peaks[-1]
     assert np.linalg.norm(done.pos - aside.pos) < 0.006
     assert peak <= 5.0, peak
+
+
+def test_a_part_handed_over_still_sliding_into_the_hole_is_stopped_under_5_n(
+    franka_twin: Twin,
+) -> None:
+    """The last command pushes the part into the hole (15 N down, compliant across); the
+    reset takes over 18 mm deep with the part sliding in at about 0.2 m/s, as a skill's
+    insertion leaves it at its success depth. The reset brakes along the hole's axis alone
+    (the arm's inertia times the deceleration), so the lateral force of the whole reset, the
+    hand-over included, stays under 5 N; braked by its impedance alone it read 10-11 N (the
+    arm's inertia turned the brake along the axis into a push on the wall, and the part hit
+    the hole's bottom still moving)."""
+    franka_twin(start=(0.0, 0.0, 0.005))
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+        soft = np.array([150.0, 150.0, 300.0, 150.0, 150.0, 150.0])
+        entry, _ = _into_the_hole(robot, soft)
+        deep, push = entry.translated([0.0, 0.0, -0.03]), np.array([0, 0, -15.0, 0, 0, 0])
+        for _ in range(300):
+            robot.command(ImpedanceCommand.hold(deep, stiffness=soft, wrench_ff=push))
+            state = robot.step(1)
+            if state.pos[2] < TASK.surface_z - 0.018:
+                break
+        assert state.lin_vel[2] < -0.15, state.lin_vel  # handed over still sliding in
+        robot.reset(entry.translated([0.02, 0.0, 0.025]))
+        guard = robot.reset_guard
+    assert guard is not None
+    assert guard.peaks[-1] <= 5.0 and guard.handover_peaks[-1] <= 5.0, guard
 
 
 def _press_down(robot: Any, depth: float, ticks: int) -> Any:

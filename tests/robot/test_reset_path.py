@@ -9,7 +9,11 @@ from teachfit.core.geometry import Pose, rotation_to_wxyz
 from teachfit.robot.franka.reset_path import (
     ResetCell,
     ResetGuard,
+    brake_decel,
+    brake_profile,
+    brake_time,
     leave_stiffness,
+    release_command,
     reset_via_points,
 )
 
@@ -86,6 +90,7 @@ def test_leaving_is_stiff_along_the_axis_and_compliant_across_and_about_it():
         {"release_stiffness": -1.0},
         {"release_time": (0.5, 0.1)},
         {"handover_time": 0.1},
+        {"brake_decel": 0.0},
     ],
 )
 def test_a_cell_with_a_bad_compliance_or_release_time_is_refused(kwargs):
@@ -96,12 +101,88 @@ def test_a_cell_with_a_bad_compliance_or_release_time_is_refused(kwargs):
 def test_the_skills_force_at_the_hand_over_is_kept_apart_from_the_resets_own():
     guard = ResetGuard(CELL)
     lateral = HOLE.rotation.apply([0.6, 0.8, 0.0])  # 1 N across the hole's axis
-    guard.watch(np.r_[9.0 * lateral, 0, 0, 0], handover=True)  # what the skill left: 9 N
-    guard.watch(np.r_[2.0 * lateral, 0, 0, 0])
-    assert guard.finish() == pytest.approx(2.0)
-    assert guard.peaks == pytest.approx([2.0]) and guard.handover_peaks == pytest.approx([9.0])
-    guard.watch(np.r_[lateral, 0, 0, 0])  # the next reset starts both at zero
+
+    def watch(*newtons: float, handover: bool = True) -> None:
+        for n in newtons:
+            guard.watch(np.r_[n * lateral, 0, 0, 0], handover=handover)
+
+    guard.take_over(np.r_[9.0 * lateral, 0, 0, 0])  # what the skill left: 9 N
+    watch(9.5, 6.0, 2.0)  # the lagging estimate: still rising once, then fading
+    watch(1.0, handover=False)  # past handover_time: the reset's own
+    assert guard.finish() == pytest.approx(1.0)
+    assert guard.peaks == pytest.approx([1.0]) and guard.handover_peaks == pytest.approx([9.5])
+    # a reading that rises (after the first) ends the hand-over: it and all later are the reset's
+    guard.take_over(np.r_[3.0 * lateral, 0, 0, 0])
+    watch(2.0, 4.0, 2.5)
+    assert guard.finish() == pytest.approx(4.0) and guard.handover_peaks[-1] == pytest.approx(3.0)
+    watch(1.0)  # without a take-over: the reset's own
     guard.finish()
-    assert guard.handover_peaks == pytest.approx([9.0, 0.0])
-    with pytest.raises(RobotFault, match="16.0 N"):  # the abort holds at the hand-over too
-        guard.watch(np.r_[16.0 * lateral, 0, 0, 0], handover=True)
+    assert guard.peaks[-1] == pytest.approx(1.0) and guard.handover_peaks[-1] == 0.0
+    # the skill's force past the limit is no reason to stop (let go at the take-over) ...
+    guard.take_over(np.r_[28.0 * lateral, 0, 0, 0])
+    watch(27.9, 20.0)
+    with pytest.raises(RobotFault, match="16.0 N"):  # ... the reset's own is
+        watch(16.0, handover=False)
+    assert guard.handover_peaks[-1] == pytest.approx(28.0)
+    assert guard.peaks[-1] == pytest.approx(16.0)
+
+
+@pytest.mark.parametrize("speed", [-0.2, 0.05])
+def test_the_brake_stops_smoothly_at_most_at_its_deceleration(speed):
+    decel = 8.0
+    big_t = brake_time(speed, decel)
+    t = np.linspace(0.0, big_t, 2001)
+    dist, vel, acc = np.array([brake_profile(speed, decel, ti) for ti in t]).T
+    # from the part's speed with no step in the force (zero acceleration) to rest, at rest after
+    assert vel[0] == speed and acc[0] == 0.0 and vel[-1] == pytest.approx(0.0, abs=1e-12)
+    assert acc[-1] == pytest.approx(0.0, abs=1e-12)
+    assert np.max(np.abs(acc)) == pytest.approx(decel, rel=1e-4)
+    assert np.all(acc * speed <= 0.0)  # against the motion only
+    assert dist[-1] == pytest.approx(speed * big_t / 2)
+    # the parts agree: the distance is the speed's integral, the speed the acceleration's
+    np.testing.assert_allclose(np.gradient(dist, t), vel, atol=1e-3 * abs(speed))
+    np.testing.assert_allclose(np.gradient(vel, t), acc, atol=2e-2 * decel)
+    assert brake_profile(speed, decel, 2 * big_t) == (dist[-1], 0.0, 0.0)
+    assert brake_profile(0.0, decel, 0.1) == (0.0, 0.0, 0.0)
+
+
+def _inertia() -> np.ndarray:
+    """An operational-space inertia (6, 6) whose force along one axis also turns and shifts."""
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(6, 6))
+    return a @ a.T + np.diag([8.0, 8.0, 8.0, 0.5, 0.5, 0.5])
+
+
+def test_the_release_brakes_along_the_axis_alone():
+    start = HOLE.compose(Pose(np.array([0.0003, -0.0002, -0.015])))
+    axis = HOLE.rotation.apply([0.0, 0.0, 1.0])
+    lam, speed, decel = _inertia(), -0.16, 8.0
+    first = release_command(CELL, start, speed, lam, decel, 0.0)
+    # the hand-over: where the part is, at its speed, no force yet (the skill's press let go)
+    np.testing.assert_allclose(first.pos, start.pos)
+    np.testing.assert_allclose(first.lin_vel, speed * axis)
+    np.testing.assert_allclose(first.wrench_ff, 0.0, atol=1e-12)
+    np.testing.assert_allclose(first.stiffness, leave_stiffness(CELL, CELL.release_stiffness))
+    mid_t = brake_time(speed, decel) / 2
+    mid = release_command(CELL, start, speed, lam, decel, mid_t)
+    dist, _, acc = brake_profile(speed, decel, mid_t)
+    np.testing.assert_allclose(mid.pos, start.pos + dist * axis, atol=1e-12)
+    np.testing.assert_allclose(mid.quat, start.quat)
+    assert acc == pytest.approx(decel)  # the part moves down the axis: braked upwards
+    # the inertia's response to the brake: along the axis alone (no turn, no push across)
+    response = np.linalg.solve(lam, mid.wrench_ff)
+    np.testing.assert_allclose(response, np.r_[acc * axis, 0, 0, 0], atol=1e-9)
+    assert np.linalg.norm(mid.wrench_ff[:3] - (mid.wrench_ff[:3] @ axis) * axis) > 1.0
+    late = release_command(CELL, start, speed, lam, decel, 1.0)
+    np.testing.assert_allclose(late.wrench_ff, 0.0, atol=1e-12)  # at rest, held there
+    np.testing.assert_allclose(late.lin_vel, 0.0, atol=1e-12)
+    stop = speed * brake_time(speed, decel) / 2
+    np.testing.assert_allclose(late.pos, start.pos + stop * axis, atol=1e-12)
+
+
+def test_the_brake_is_gentler_where_its_feed_forward_would_pass_the_force_limit():
+    lam = _inertia()
+    per = np.linalg.norm(lam[:3, :3] @ HOLE.rotation.apply([0.0, 0.0, 1.0]))
+    assert brake_decel(CELL, lam, 1000.0, 1000.0) == CELL.brake_decel
+    decel = brake_decel(CELL, lam, 5.0 * per, 1000.0)
+    assert decel == pytest.approx(0.8 * 5.0) and decel < CELL.brake_decel

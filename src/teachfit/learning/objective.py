@@ -15,7 +15,9 @@ skipped, as every execution starts from a reset) and ``wall_s``; on a real arm a
 ``reflex_retries`` (executions run again after a safety reflex), ``reset_peak_lateral_n``
 (the largest lateral force, N, while a reset left the hole,
 :mod:`teachfit.robot.franka.reset_path`) and ``reset_handover_lateral_n`` (the largest the
-skill left at the hand-over to a reset, read in the reset's first 20 ms).
+skill left at the hand-over to a reset: the reading at the take-over, the next, and those
+still falling from it in the reset's first 50 ms,
+:class:`~teachfit.robot.franka.reset_path.ResetGuard`).
 """
 
 from __future__ import annotations

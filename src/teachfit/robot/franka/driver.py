@@ -49,11 +49,19 @@ from teachfit.robot.franka.reflex import ReflexThresholds, check_reflex_force, r
 from teachfit.robot.franka.reset_path import (
     ResetCell,
     ResetGuard,
+    brake_decel,
+    brake_time,
     leave_stiffness,
+    release_command,
     reset_via_points,
 )
 from teachfit.robot.franka.safety import FrankaLimits
-from teachfit.robot.franka.tick import TorqueTick, operational_mass
+from teachfit.robot.franka.tick import (
+    ROTOR_INERTIA,
+    TorqueTick,
+    operational_inertia,
+    operational_mass,
+)
 
 if TYPE_CHECKING:
     from teachfit.tasks.base import Task
@@ -235,9 +243,7 @@ class FrankaRobot:
         if self._loop.fault is not None or not self._loop.running:
             self._restart()
         stiff = np.asarray(self.params.reset_stiffness, dtype=float)
-        start = self.state().pose
-        self._loop.install(self._approach_law(), self._hold(start, stiff))
-        self._move_to(start, pose, stiff)
+        self._move_to(self.state().pose, pose, stiff)
         self._settle(pose)
         tick = self._loop.tick
         bias = np.zeros(6)
@@ -339,15 +345,17 @@ class FrankaRobot:
     def _move_to(self, start: Pose, pose: Pose, stiff: np.ndarray) -> None:
         """The reset's motion: a release and via points out of the hole along its axis,
         compliant across it (the lateral force watched), then to ``pose``
-        (:mod:`~teachfit.robot.franka.reset_path`)."""
+        (:mod:`~teachfit.robot.franka.reset_path`); installs the reset's law (the skill's runs
+        until then)."""
         lim, guard, cell = self.params.limits, self.reset_guard, self.params.reset_cell
         legs = reset_via_points(start, pose, cell)
         soft = stiff
         if cell is not None and legs[0][0] == "out":
             soft = leave_stiffness(cell, float(stiff[2]))
-            release = leave_stiffness(cell, cell.release_stiffness)
-            start = self._release(start, release, cell)
+            start = self._release(cell)
             legs = reset_via_points(start, pose, cell)
+        else:
+            self._loop.install(self._approach_law(), self._hold(start, stiff))
         for leg, end in legs:
             k = soft if leg == "out" else stiff
             for waypoint in approach_waypoints(
@@ -361,22 +369,42 @@ class FrankaRobot:
         if guard is not None:
             guard.finish()
 
-    def _release(self, here: Pose, soft: np.ndarray, cell: ResetCell) -> Pose:
-        """Hold ``here`` at the ``soft`` stiffness until the TCP is at rest (at least and at
-        most ``cell.release_time``), the lateral force watched (the first
-        ``cell.handover_time`` as the hand-over's); the pose it settled at."""
-        dt = 10 * self.control_period
-        least, most = (int(round(t / dt)) for t in cell.release_time)
+    def _release(self, cell: ResetCell) -> Pose:
+        """Take over from the skill where the TCP is (its press let go at once): brake a part
+        still sliding in along the hole's axis alone, then hold until the TCP is at rest (at
+        least and at most ``cell.release_time`` after the brake;
+        :func:`~teachfit.robot.franka.reset_path.release_command`), the lateral force watched
+        (from the reading at the take-over: :class:`ResetGuard`); the pose it settled at."""
+        lim, dt = self.params.limits, 10 * self.control_period
         state = self.state()
-        for i in range(max(most, 1)):
-            self.command(self._hold(here, soft))
+        here = state.pose
+        speed = float(state.lin_vel @ cell.hole2world.rotation.apply([0.0, 0.0, 1.0]))
+        inertia = self._inertia()
+        decel = brake_decel(cell, inertia, lim.max_force, lim.max_torque)
+        braking = int(np.ceil(brake_time(speed, decel) / dt))
+        least, most = (int(round(t / dt)) for t in cell.release_time)
+        first = release_command(cell, here, speed, inertia, decel, 0.0)
+        lim.check_command(first)
+        if self.reset_guard is not None:
+            self.reset_guard.take_over(state.wrench)
+        self._loop.install(self._approach_law(), first)
+        for i in range(braking + max(most, 1)):
+            if i:
+                self.command(release_command(cell, here, speed, inertia, decel, i * dt))
             state = self.step(10)
             if self.reset_guard is not None:
                 self.reset_guard.watch(state.wrench, (i + 1) * dt <= cell.handover_time + 1e-9)
             still = np.linalg.norm(state.lin_vel) < 0.002 and np.linalg.norm(state.ang_vel) < 0.02
-            if i + 1 >= least and still:
+            if i + 1 >= braking + least and still:
                 break
         return Pose(state.pos.copy(), state.quat.copy())
+
+    def _inertia(self) -> np.ndarray:
+        """The TCP's operational-space inertia (6, 6) (world; kg, kg·m, kg·m²) at the last
+        tick's pose, from libfranka's mass matrix with the motors' rotor inertia added."""
+        tick = self._loop.tick
+        mass = np.asarray(self._model.mass(self._loop.raw), dtype=float).reshape(7, 7, order="F")
+        return operational_inertia(mass + np.diag(ROTOR_INERTIA), tick.jacobian, tick.r_wo)
 
     def _hold(self, pose: Pose, stiffness: np.ndarray) -> ImpedanceCommand:
         return ImpedanceCommand.hold(pose, stiffness=stiffness, expires_after=1.0)

@@ -27,6 +27,24 @@ from teachfit.robot.franka.frames import FrankaFrames, col_major, skew
 from teachfit.robot.franka.libfranka_types import LibfrankaModel, LibfrankaState
 from teachfit.robot.franka.safety import FrankaLimits, clip_wrench_norm, limit_torque
 
+#: the motors' rotor inertia reflected to the joints (kg·m²), which libfranka's mass matrix
+#: leaves out: the FR3 model's armature (MuJoCo Menagerie's ``franka_fr3``, the twin's cell)
+ROTOR_INERTIA = (0.195, 0.195, 0.195, 0.195, 0.074, 0.074, 0.074)
+
+
+def operational_inertia(mass: np.ndarray, jacobian: np.ndarray, r_wo: np.ndarray) -> np.ndarray:
+    """The operational-space inertia (6, 6) at the TCP in world axes (kg, kg·m, kg·m²),
+    ``Lambda = (J M^-1 J^T)^-1``, for the joint-space inertia ``mass`` (7, 7), the TCP Jacobian
+    ``jacobian`` (6, 7) (base frame) and the base->world rotation ``r_wo``: the wrench
+    ``Lambda a`` at the TCP accelerates it by ``a`` (6,) alone, where a wrench along one axis
+    alone also accelerates the TCP along the others (the off-diagonal terms)."""
+    rot = np.zeros((6, 6))
+    rot[:3, :3] = rot[3:, 3:] = r_wo
+    jac = rot @ np.asarray(jacobian, dtype=float)
+    jminv = np.linalg.solve(np.asarray(mass, dtype=float), jac.T).T
+    lam = np.linalg.inv(jminv @ jac.T)
+    return 0.5 * (lam + lam.T)
+
 
 def operational_mass(mass: np.ndarray, jacobian: np.ndarray, r_wo: np.ndarray) -> np.ndarray:
     """The diagonal (6,) (kg, kg·m²) of the operational-space inertia at the TCP in world axes,
@@ -34,11 +52,7 @@ def operational_mass(mass: np.ndarray, jacobian: np.ndarray, r_wo: np.ndarray) -
     ``Model.mass``), the TCP Jacobian ``jacobian`` (6, 7) (base frame) and the base->world
     rotation ``r_wo``: the apparent mass the law's critical damping needs, as the fr3 robot
     takes it from its model (:func:`teachfit.robot.fr3.control.operational_inertia`)."""
-    rot = np.zeros((6, 6))
-    rot[:3, :3] = rot[3:, 3:] = r_wo
-    jac = rot @ np.asarray(jacobian, dtype=float)
-    jminv = np.linalg.solve(np.asarray(mass, dtype=float), jac.T).T
-    return np.diag(np.linalg.inv(jminv @ jac.T)).copy()
+    return np.diag(operational_inertia(mass, jacobian, r_wo)).copy()
 
 
 class TorqueTick:
