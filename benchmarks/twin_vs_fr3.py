@@ -1,8 +1,8 @@
 """Same physics, same answer? fr3 in-process vs the franka driver on the Franka twin, the same
 seeds.
 
-Usage: ``python benchmarks/twin_vs_fr3.py [--trials 10] [--seed 0] [--cases peg,tshix-peg2d]
-[--points 100] [--markdown FILE]``
+Usage: ``python benchmarks/twin_vs_fr3.py [--trials 10] [--seed 0]
+[--cases peg,tshix-peg2d,assemble-peg2d] [--points 100] [--markdown FILE]``
 
 Each case runs ``--trials`` executions on ``--robot fr3`` (the task's FR3 cell in this process,
 its sensor noise seeded with ``--seed``) and then the same ones on ``--robot franka``: teachfit's
@@ -17,7 +17,10 @@ machine-wide lock the tests take on it. Cases:
 * ``tshix-peg2d``: TSHIX (``--points`` N, 100 by default; feed-forward on) from ``--trials``
   of Table I's starts on ``peg2d``, the model learned from one seeded teacher demonstration
   recorded on the fr3 robot (both sides search with it; the samples are drawn per start from
-  ``--seed``).
+  ``--seed``);
+* ``assemble-peg2d``: ``teachfit assemble``'s joined skill (peg-in-hole with the learned
+  search as its recovery, that same model) on ``peg2d`` with the taught hole
+  :data:`HOLE_ERROR` off in a seeded direction per trial, as ``assemble --hole-error 2mm``.
 
 Columns: successes k/n with Wilson 95 % intervals and whether the two sides' intervals
 overlap; the executions a safety reflex (or another robot fault) stopped; the wrench the method
@@ -25,11 +28,10 @@ sees (the log's measured force at 100 Hz, world frame): the mean of ‖F‖ over
 contact (‖F‖ >= 1 N) and the per-execution peak ‖F‖ and peak lateral ‖F_xy‖, their means over
 the executions; wall time. What differs by construction: the fr3 robot's reset puts the arm at
 the start (a simulation's free reset), the driver's drives it there through the cell (joint
-friction stops it up to ~1 mm off); the driver's law runs in its own 1 kHz thread with a
-constant apparent mass (2 kg) for its damping and reads libfranka's estimate where the fr3
-robot's runs in the physics step with the operational-space inertia; the firmware's gravity
-model does not carry the held part. ``--markdown FILE`` appends the table with its provenance
-header.
+friction stops it up to ~1 mm off); the driver's law runs in its own 1 kHz thread, its
+apparent mass from libfranka's mass matrix at each reset, and reads libfranka's estimate where
+the fr3 robot's runs in the physics step with the operational-space inertia. ``--markdown FILE``
+appends the table with its provenance header.
 """
 
 from __future__ import annotations
@@ -161,10 +163,34 @@ def _tshix_runs(name: str, arm: Arm, task: Task, seed: int, trials: int) -> list
     return [r.result for r in runs]
 
 
+#: the taught hole's error of the ``assemble-peg2d`` case (m)
+HOLE_ERROR = 0.002
+
+
+def _assemble_runs(
+    name: str, arm: Arm, task: Task, seed: int, trials: int
+) -> list[ExecutionResult]:
+    """``assemble``'s joined skill, the taught hole :data:`HOLE_ERROR` off, ``trials`` trials
+    (trial ``i``'s direction and start drawn from ``seed`` as ``assemble`` draws them)."""
+    from teachfit.execution.assembly import assembly_jobs, close_robots, run_assembly_job
+
+    _, model = _tshix_model(task, seed)
+    jobs = assembly_jobs(
+        task.name, ["joined"], [HOLE_ERROR], trials, model, seed=seed, robot=name,
+        keep_log=True, robot_options=tuple(arm.items()),
+    )  # fmt: skip
+    try:
+        done = [run_assembly_job(job) for job in jobs]
+    finally:
+        close_robots()
+    return [_said(t.result) for t in done if t.result is not None]
+
+
 #: case -> (task, runs): what each side runs
 CASES: dict[str, tuple[str, Callable[[str, Arm, Task, int, int], list[ExecutionResult]]]] = {
     "peg": ("peg", _peg_runs),
     "tshix-peg2d": ("peg2d", _tshix_runs),
+    "assemble-peg2d": ("peg2d", _assemble_runs),
 }
 
 
@@ -222,8 +248,11 @@ def main(argv: list[str] | None = None) -> None:
     print("| " + " | ".join(HEADER) + " |")
     for row in rows:
         print("| " + " | ".join(row) + " |")
-    what = {"peg": "the peg skill's default parameters on peg",
-            "tshix-peg2d": f"TSHIX (N = {args.points}) on peg2d"}  # fmt: skip
+    what = {
+        "peg": "the peg skill's default parameters on peg",
+        "tshix-peg2d": f"TSHIX (N = {args.points}) on peg2d",
+        "assemble-peg2d": f"the joined skill on peg2d, hole {HOLE_ERROR * 1e3:g} mm off",
+    }
     title = (
         f"**fr3 in-process vs the franka driver on the twin**, the same {args.trials} starts "
         f"per case (seed {args.seed}): " + "; ".join(what[c] for c in cases)
