@@ -13,6 +13,7 @@ from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
+from teachfit.skills.tilt_context import KEY, TiltContext
 from teachfit.tasks import get_task
 
 
@@ -152,3 +153,50 @@ def test_a_search_without_a_catch_tours_again_from_where_it_ended(peg):
     assert np.allclose(run.trajectory.pos[0, :2], pc.p[:2], atol=1e-9)
     _, _, pc_once = _tour(model, 0.0)  # Ehlers et al.'s: one tour, done
     assert pc_once.done
+
+
+def _tilted_search(model, tilt: float):
+    """The joined skill's search node entered at the origin with ``search_tilt`` ``tilt``,
+    one command given."""
+    sk = peg_in_hole_search.build(model, "impedance")
+    values = sk.resolve({"search_points": 10.0}) | {"search_tilt": tilt, "search_lead": 0.001}
+    run = sk.node("search").primitive.compile(values)
+    pc, out = Percept(Pose(np.zeros(3)), 0.01), MPCommand()
+    pc.p[2] = 0.001
+    run.enter(pc)
+    pc.t = pc.t_node = 0.01
+    pc.p[2] = 0.0008  # the TCP sinks: the set-point's height follows it
+    run.command(pc, out)
+    return sk, values, run, pc, out
+
+
+def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
+    _, model = peg
+    sk, values, run, pc, _ = _tilted_search(model, 0.25)
+    edges = {(t.source, t.target) for t in sk.transitions}
+    assert {
+        ("search", "search_slide"),
+        ("search_slide", "search_align"),
+        ("search_slide", "search"),
+        ("search_align", "search"),
+        ("search_align", "align"),
+    } <= edges
+    ctx = pc.shared[KEY]
+    assert isinstance(ctx, TiltContext) and ctx.cfg.angle == 0.25
+    assert ctx.cfg.retry_angle is None  # search_retry_tilt 0: none
+    assert 2.0 * np.degrees(np.arccos(abs(pc.q_d[0]))) == pytest.approx(np.degrees(0.25))
+    assert pc.p_d[2] == pytest.approx(0.0008)  # only the push presses along z
+    felt = next(
+        t.condition for t in sk.transitions if (t.source, t.target) == ("search", "search_slide")
+    ).compile(values)
+    pc.p[2] = ctx.z_top - 3e-4  # 0.3 mm below the resting height, past the tilt's settling
+    pc.t = 0.5
+    assert felt(pc)
+    # a tour without a catch: a fresh tilted search from here
+    pc.t = ctx.traj.duration + 0.1
+    run.command(pc, MPCommand())
+    assert pc.shared[KEY] is not ctx and not pc.done
+    # upright (the default, every built-in task): no tilted context, the drop never felt
+    _, _, upright, pc_up, _ = _tilted_search(model, 0.0)
+    assert KEY not in pc_up.shared and np.allclose(np.abs(pc_up.q_d), [1, 0, 0, 0], atol=1e-6)
+    assert not felt(pc_up)

@@ -51,7 +51,7 @@ from teachfit.skills.conditions import (
 )
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
-from teachfit.skills.search import LearnedSearch
+from teachfit.skills.search_tilted import LearnedTiltSearch, tilt_nodes
 
 NAME = "peg-in-hole+search"
 
@@ -67,6 +67,12 @@ CONTEXT: dict[str, ContextParam] = {
     "search_radius": ContextParam(
         0.0, "m", "least RMS radius of the search's spread: the taught hole's error (0: none)"
     ),
+    "search_tilt": ContextParam(0.0, "rad", "tilt of the searching part (0: upright)"),
+    "search_retry_tilt": ContextParam(0.0, "rad", "tilt after a missed tilted align (0: none)"),
+    "search_drop": ContextParam(2.5e-4, "m", "tilted: sink below its resting height = a drop"),
+    "search_reach": ContextParam(0.01, "m", "tilted: reach of the slide after a drop"),
+    "search_lead": ContextParam(0.0, "m", "tilted: how far the low rim leads the axis"),
+    "search_friction": ContextParam(0.3, "", "tilted: friction of the rim on the far wall"),
 }
 
 LEARNED: dict[str, LearnedParam] = {
@@ -99,19 +105,21 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
     gave_up = (TimeAbove("t_switch") & TimeAbove("t_reach")) | LateralAbove("roi") | stopped
     search = Node(
         "search",
-        LearnedSearch(model),
+        LearnedTiltSearch(model),
         TimeAbove("t_search") | Done(),
-        "learned search (TSHIX + GMR feed-forward) from where the skill is",
+        "learned search (TSHIX + GMR feed-forward) from where the skill is, tilted or not",
     )
+    phases, tilted = tilt_nodes(TimeAbove("t_search"), dropped, "align")
     transitions = base.transitions + (
         *(Transition(lateral, "search", gave_up) for lateral in LATERALS),
         Transition(LATERALS[-1], "search", XBelow("-pass_end")),
         Transition("insert", "search", TimeAbove("t_stuck") & ~dropped),
         Transition("search", "align", dropped),
+        *tilted,
     )
     return Skill(
         name=NAME,
-        nodes=nodes + (search,),
+        nodes=nodes + (search, *phases),
         transitions=transitions,
         start=base.start,
         params=params,

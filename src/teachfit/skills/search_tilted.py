@@ -1,0 +1,209 @@
+"""The joined skill's learned search, tilted for a sharp-edged part: nodes of its graph.
+
+Upright, a sharp-edged part drops into its hole only when its axis passes within the
+clearance of the hole's (0.1 mm per side on the parts suite), which the learned tours rarely
+pass (:mod:`teachfit.skills.tilt`). Tilted by ``search_tilt`` (rad, 0: upright, the default),
+its low rim dips over the hole from millimetres. :class:`LearnedTiltSearch` is the joined
+skill's ``search`` node (:mod:`teachfit.skills.peg_in_hole_search`): upright it is
+:class:`~teachfit.skills.search.LearnedSearch` unchanged; tilted it plans the same TSHIX tour
+from where the skill is and follows it as the first phase of a tilted search
+(:class:`~teachfit.skills.tilt_phases.TiltedSearch`). The tilted search's next phases are
+nodes of the joined graph too (:func:`tilt_nodes`)::
+
+    search --drop felt--> search_slide --at the wall--> search_align --missed--> search
+       ^                       |
+       +------rode out---------+
+
+and each of the three ends in the skill's ``align`` once the part is ``drop_depth`` in.
+A tour that ends without a catch is followed by a fresh one from where it ended
+(``search_repeat``), with a fresh tilted search.
+
+The part is pressed by the push alone along z in every phase (the set-point's height follows
+the TCP, as the upright search does: the adaptive controller's learned feed-forward would
+otherwise cancel the push). The tilt's settings are the skill's context, which a task that
+knows its fit sets (:mod:`teachfit.skills.fit_context`): ``search_retry_tilt`` (rad, 0: none)
+after each missed align, alternating; ``search_drop`` (m) the sink below the tilted resting
+height that is felt as a drop; ``search_reach`` (m) the slide's reach (a hole's width);
+``search_lead`` (m) how far the low rim leads the axis (the tour is planned for the rim);
+``search_friction``: the stall lag at the far wall is :func:`~teachfit.skills.tilt.wedge_lag`
+of the tilt, this friction, the push and the follower's stiffness along the motion.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
+
+from teachfit.core.errors import SkillError
+from teachfit.models.search_model import SearchModel
+from teachfit.skills.conditions import Check, Condition
+from teachfit.skills.graph import Node, Transition
+from teachfit.skills.params import Value, resolve
+from teachfit.skills.percept import MPCommand, Percept
+from teachfit.skills.primitive import Primitive, PrimitiveRun
+from teachfit.skills.search import LearnedSearch, Tour, plan_tour
+from teachfit.skills.tilt import TiltConfig, wedge_lag
+from teachfit.skills.tilt_conditions import AtWall, DropFelt, Missed, RodeOut
+from teachfit.skills.tilt_context import KEY, TiltContext
+from teachfit.skills.tilt_phases import TiltedSearch, TiltPhase
+
+#: the tilted search's phases after the search node: node name -> phase
+PHASE_NODES = {"search_slide": "slide_to_wall", "search_align": "align_upright"}
+
+
+def _pressed(pc: Percept, out: MPCommand) -> None:
+    """Along z only the push presses: the set-point's height follows the TCP."""
+    pc.p_d[2] = pc.p[2]
+    out.twist[2] = 0.0
+
+
+@dataclass(frozen=True)
+class LearnedTiltSearch(LearnedSearch):
+    """The learned search, tilted by ``tilt`` (rad; 0: upright, :class:`LearnedSearch`);
+    see the module docstring for the other settings."""
+
+    tilt: Value = "search_tilt"
+    retry_tilt: Value = "search_retry_tilt"
+    drop: Value = "search_drop"
+    reach: Value = "search_reach"
+    lead: Value = "search_lead"
+    friction: Value = "search_friction"
+    kind: ClassVar[str] = "learned_tilt_search"
+
+    def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
+        angle = resolve(self.tilt, values)
+        if angle <= 0.0:
+            return super().compile(values)
+        tour = self.tour(values)
+        retry = resolve(self.retry_tilt, values)
+        cfg = tour.cfg
+        friction = resolve(self.friction, values)
+        stall = wedge_lag(angle, friction, cfg.push_force, cfg.stiffness_along)
+        tilt = TiltConfig(
+            angle=angle,
+            retry_angle=retry if 0.0 < retry < angle else None,
+            drop_depth=resolve(self.drop, values),
+            lateral_reach=resolve(self.reach, values),
+            stall_lag=stall,
+            lead=resolve(self.lead, values),
+        )
+        return _TiltedTourRun(self.model, replace(tour, cfg=replace(cfg, tilt=tilt)))
+
+    def describe(self) -> str:
+        return f"{super().describe()}, tilted {self.tilt} rad"
+
+
+class _TiltedTourRun(PrimitiveRun):
+    """The search node's run, tilted: a tour planned from here followed as a tilted
+    search's first phase; re-entered after a missed align it goes on with the same tour."""
+
+    def __init__(self, model: SearchModel, tour: Tour) -> None:
+        self.model, self.tour = model, tour
+        self.inner: PrimitiveRun | None = None
+
+    def _plan(self, pc: Percept) -> None:
+        t = self.tour
+        traj = plan_tour(self.model, t.planner, t.n, t.rng, pc, blend=False)
+        pc.shared.pop(KEY, None)  # a fresh tilted search: its context is made on entry
+        self.inner = TiltedSearch(traj, t.cfg).compile({})
+        self.inner.enter(pc)
+
+    def enter(self, pc: Percept) -> None:
+        if self.inner is None or not isinstance(pc.shared.get(KEY), TiltContext):
+            self._plan(pc)
+        else:
+            self.inner.enter(pc)
+
+    def command(self, pc: Percept, out: MPCommand) -> None:
+        assert self.inner is not None, "enter() first"
+        self.inner.command(pc, out)
+        _pressed(pc, out)
+        if pc.done and self.tour.repeat:  # a tour without a catch: another one from here
+            self._plan(pc)
+
+    def leave(self, pc: Percept) -> None:
+        assert self.inner is not None, "enter() first"
+        self.inner.leave(pc)
+
+
+@dataclass(frozen=True)
+class PressedPhase(Primitive):
+    """A tilted search's ``phase`` (:class:`~teachfit.skills.tilt_phases.TiltPhase`) with
+    the part pressed by the push alone along z (see the module docstring)."""
+
+    phase: str
+    kind: ClassVar[str] = "pressed_tilt_phase"
+
+    def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
+        return _PressedRun(TiltPhase(self.phase).compile(values))
+
+    def describe(self) -> str:
+        return f"{TiltPhase(self.phase).describe()}, pressed along z"
+
+    def refs(self) -> set[str]:
+        return set()
+
+    def to_toml(self) -> dict[str, Any]:
+        raise SkillError("a tilted search's phase runs inside its graph only: no TOML form")
+
+
+class _PressedRun(PrimitiveRun):
+    def __init__(self, inner: PrimitiveRun) -> None:
+        self.inner = inner
+
+    def enter(self, pc: Percept) -> None:
+        self.inner.enter(pc)
+
+    def command(self, pc: Percept, out: MPCommand) -> None:
+        self.inner.command(pc, out)
+        _pressed(pc, out)
+
+    def leave(self, pc: Percept) -> None:
+        self.inner.leave(pc)
+
+
+@dataclass(frozen=True)
+class Tilted(Condition):
+    """A tilted search runs (its context is published) and ``part`` holds; never upright
+    (where a tilted search's own conditions have no context to read)."""
+
+    part: Condition
+    kind: ClassVar[str] = "tilted"
+
+    def compile(self, values: Mapping[str, float]) -> Check:
+        inner = self.part.compile(values)
+        return lambda pc: isinstance(pc.shared.get(KEY), TiltContext) and inner(pc)
+
+    def describe(self) -> str:
+        return f"tilted: {self.part.describe()}"
+
+    def to_toml(self) -> dict[str, Any]:
+        raise SkillError("a tilted search's condition runs inside its graph only: no TOML form")
+
+
+def tilt_nodes(
+    error: Condition, dropped: Condition, caught: str
+) -> tuple[tuple[Node, ...], tuple[Transition, ...]]:
+    """The nodes after the joined skill's ``search`` (:data:`PHASE_NODES`, ``error`` their
+    error exit) and the transitions among them and from ``search``; ``dropped``: the part is
+    in, on to the skill's node ``caught``."""
+    nodes = tuple(
+        Node(
+            name,
+            PressedPhase(phase),
+            error=error,
+            doc=phase,
+            reset_setpoint=False,
+            chain=name == "search_slide",
+        )  # fmt: skip
+        for name, phase in PHASE_NODES.items()
+    )
+    transitions = (
+        Transition("search", "search_slide", Tilted(DropFelt())),
+        *(Transition(name, caught, dropped) for name in PHASE_NODES),
+        Transition("search_slide", "search", RodeOut()),
+        Transition("search_slide", "search_align", AtWall()),
+        Transition("search_align", "search", Missed()),
+    )
+    return nodes, transitions
