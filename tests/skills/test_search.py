@@ -192,6 +192,11 @@ def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
     pc.p[2] = ctx.z_top - 3e-4  # 0.3 mm below the resting height, past the tilt's settling
     pc.t = 0.5
     assert felt(pc)
+    # still tilting: a part that sinks below where the tour started (its edge) has dropped
+    ctx.z_top, ctx.t0, pc.t, pc.p[2] = 0.0, 0.0, 0.1, 0.0007
+    assert felt(pc)
+    pc.p[2] = 0.0009
+    assert not felt(pc)
     # a tour without a catch: a fresh tilted search from here
     pc.t = ctx.traj.duration + 0.1
     run.command(pc, MPCommand())

@@ -16,7 +16,11 @@ nodes of the joined graph too (:func:`tilt_nodes`)::
 
 and each of the three ends in the skill's ``align`` once the part is ``drop_depth`` in.
 A tour that ends without a catch is followed by a fresh one from where it ended
-(``search_repeat``), with a fresh tilted search.
+(``search_repeat``), with a fresh tilted search. While the part tilts at the start of a tour,
+its height where the tour started counts as the reference height a drop is felt below (as
+after a missed align): a part that stopped at the hole's edge (the far wall, where the skill's
+lateral move gave up) drops in while it tilts, before a resting height could be measured
+(round16-sharp-blind: 0.9 mm in, tilted, and the tour dragged it to the force limit).
 
 The part is pressed by the push alone along z in every phase (the set-point's height follows
 the TCP, as the upright search does: the adaptive controller's learned feed-forward would
@@ -108,6 +112,9 @@ class _TiltedTourRun(PrimitiveRun):
         pc.shared.pop(KEY, None)  # a fresh tilted search: its context is made on entry
         self.inner = TiltedSearch(traj, t.cfg).compile({})
         self.inner.enter(pc)
+        ctx = pc.shared[KEY]
+        assert isinstance(ctx, TiltContext)
+        ctx.z_floor = float(pc.p[2])  # a part that drops in as it tilts has dropped
 
     def enter(self, pc: Percept) -> None:
         if self.inner is None or not isinstance(pc.shared.get(KEY), TiltContext):
