@@ -181,6 +181,7 @@ def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
         ("search_align", "search"),
         ("search_align", "align"),
     } <= edges
+    assert ("search_slide", "align") not in edges  # a tilted corner dips deep while sliding
     ctx = pc.shared[KEY]
     assert isinstance(ctx, TiltContext) and ctx.cfg.angle == 0.25
     assert ctx.cfg.retry_angle is None  # search_retry_tilt 0: none

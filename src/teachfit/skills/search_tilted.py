@@ -14,7 +14,11 @@ nodes of the joined graph too (:func:`tilt_nodes`)::
        ^                       |
        +------rode out---------+
 
-and each of the three ends in the skill's ``align`` once the part is ``drop_depth`` in.
+and the search and the tilted align end in the skill's ``align`` once the part is
+``drop_depth`` in. The slide does not: a tilted part's low corner dips that deep while it
+slides (rect12x8-sharp-through), and turned upright there, short of the far wall, it stood
+on the edge, was pushed, searched again and slid in again, 17 times until ``t_max`` (2 of
+10 trials).
 A tour that ends without a catch is followed by a fresh one from where it ended
 (``search_repeat``), with a fresh tilted search. While the part tilts at the start of a tour,
 its height where the tour started counts as the reference height a drop is felt below (as
@@ -208,7 +212,7 @@ def tilt_nodes(
     )
     transitions = (
         Transition("search", "search_slide", Tilted(DropFelt())),
-        *(Transition(name, caught, dropped) for name in PHASE_NODES),
+        Transition("search_align", caught, dropped),
         Transition("search_slide", "search", RodeOut()),
         Transition("search_slide", "search_align", AtWall()),
         Transition("search_align", "search", Missed()),
