@@ -13,6 +13,7 @@ from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
+from teachfit.skills.search_tilted import TILT_BLEND
 from teachfit.skills.tilt_context import KEY, TiltContext
 from teachfit.tasks import get_task
 
@@ -156,23 +157,27 @@ def test_a_search_without_a_catch_tours_again_from_where_it_ended(peg):
 
 
 def _tilted_search(model, tilt: float):
-    """The joined skill's search node entered at the origin with ``search_tilt`` ``tilt``,
-    one command given."""
+    """The joined skill's search node entered 4 mm along +x from the taught hole with
+    ``search_tilt`` ``tilt``; its first command's orientation set-point and the percept after
+    one command once the tilt is in (``TILT_BLEND``)."""
     sk = peg_in_hole_search.build(model, "impedance")
     values = sk.resolve({"search_points": 10.0}) | {"search_tilt": tilt, "search_lead": 0.001}
     run = sk.node("search").primitive.compile(values)
-    pc, out = Percept(Pose(np.zeros(3)), 0.01), MPCommand()
-    pc.p[2] = 0.001
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    pc.p[:] = (0.004, 0.0, 0.001)
     run.enter(pc)
     pc.t = pc.t_node = 0.01
+    run.command(pc, MPCommand())
+    first = (pc.q_d.copy(), pc.p_d[:2].copy())
+    pc.t = pc.t_node = TILT_BLEND + 0.01
     pc.p[2] = 0.0008  # the TCP sinks: the set-point's height follows it
-    run.command(pc, out)
-    return sk, values, run, pc, out
+    run.command(pc, MPCommand())
+    return sk, values, run, pc, first
 
 
 def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
     _, model = peg
-    sk, values, run, pc, _ = _tilted_search(model, 0.25)
+    sk, values, run, pc, first = _tilted_search(model, 0.25)
     edges = {(t.source, t.target) for t in sk.transitions}
     assert {
         ("search", "search_slide"),
@@ -185,13 +190,18 @@ def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
     ctx = pc.shared[KEY]
     assert isinstance(ctx, TiltContext) and ctx.cfg.angle == 0.25
     assert ctx.cfg.retry_angle is None  # search_retry_tilt 0: none
-    assert 2.0 * np.degrees(np.arccos(abs(pc.q_d[0]))) == pytest.approx(np.degrees(0.25))
+    tilt = 2.0 * np.degrees(np.arccos(np.clip(abs(pc.q_d[0]), 0, 1)))
+    assert tilt == pytest.approx(np.degrees(0.25))
+    assert 2.0 * np.degrees(np.arccos(abs(first[0][0]))) < 0.05 * tilt  # turned in, blended
     assert pc.p_d[2] == pytest.approx(0.0008)  # only the push presses along z
+    # leaning toward the taught hole (-x), the tour starts at the low rim, the axis stays
+    assert np.allclose(ctx.d, [-1.0, 0.0])
+    assert np.allclose(ctx.traj.pos[0, :2], [0.003, 0.0], atol=1e-9)
+    assert np.allclose(first[1], [0.004, 0.0], atol=2e-4)
     felt = next(
         t.condition for t in sk.transitions if (t.source, t.target) == ("search", "search_slide")
     ).compile(values)
     pc.p[2] = ctx.z_top - 3e-4  # 0.3 mm below the resting height, past the tilt's settling
-    pc.t = 0.5
     assert felt(pc)
     # still tilting: a part that sinks below where the tour started (its edge) has dropped
     ctx.z_top, ctx.t0, pc.t, pc.p[2] = 0.0, 0.0, 0.1, 0.0007

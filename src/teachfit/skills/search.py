@@ -123,11 +123,13 @@ def plan_tour(
     rng: np.random.Generator,
     pc: Percept,
     blend: bool = True,
+    shift: tuple[float, float] = (0.0, 0.0),
 ) -> SetpointTrajectory:
-    """A TSHIX tour of ``n`` points from the measured pose in ``pc`` as task-frame set-points
-    at the set-point's height (:func:`states_to_setpoints`; ``blend``: the orientation from
-    the measured one, else the planned one from the start)."""
-    here = {"x": pc.p[0], "y": pc.p[1], "z": pc.p[2], "rz": yaw_of(pc.q)}
+    """A TSHIX tour of ``n`` points from the measured pose in ``pc`` (moved by ``shift``, m,
+    x-y) as task-frame set-points at the set-point's height (:func:`states_to_setpoints`;
+    ``blend``: the orientation from the measured one, else the planned one from the start)."""
+    x, y = pc.p[0] + shift[0], pc.p[1] + shift[1]
+    here = {"x": x, "y": y, "z": pc.p[2], "rz": yaw_of(pc.q)}
     start = np.array([here[d] for d in model.dims])
     try:
         traj = planner.plan(n, rng, start)
