@@ -13,7 +13,7 @@ from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
-from teachfit.skills.search_tilted import TILT_BLEND
+from teachfit.skills.search_tilted import TILT_BLEND, lean_of
 from teachfit.skills.tilt_context import KEY, TiltContext
 from teachfit.tasks import get_task
 
@@ -216,3 +216,16 @@ def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
     _, _, upright, pc_up, _ = _tilted_search(model, 0.0)
     assert KEY not in pc_up.shared and np.allclose(np.abs(pc_up.q_d), [1, 0, 0, 0], atol=1e-6)
     assert not felt(pc_up)
+
+
+def test_a_tilted_part_leans_a_corner_ahead_toward_the_taught_hole():
+    """Upright: toward the taught hole; tilted by the skill's lateral move: 45 degrees from
+    its lean toward the taught hole's side (no roll over the tip; a corner leads)."""
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    pc.p[:] = (0.004, 0.0, 0.0)
+    assert np.allclose(lean_of(pc), [-1.0, 0.0])
+    pc.q[:] = (np.cos(0.05), 0.0, np.sin(0.05), 0.0)  # 0.1 rad about y: leans along +x
+    pc.p[:] = (0.004, 0.001, 0.0)  # the taught hole ahead along -x, a little along -y
+    assert np.allclose(lean_of(pc), [np.sqrt(0.5), -np.sqrt(0.5)])
+    pc.p[:] = (0.004, -0.001, 0.0)
+    assert np.allclose(lean_of(pc), [np.sqrt(0.5), np.sqrt(0.5)])

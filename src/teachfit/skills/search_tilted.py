@@ -30,11 +30,16 @@ orientation where the tour starts (the skill's own lateral tilt leans the other 
 the FR3 the step to the tilt at once threw the part 5-10 mm sideways and 5 mm up, off the
 top and into the force limit (rect12x8-sharp-through, 6 of 10 trials).
 
-The part leans toward the taught hole (the task frame's origin) from where the tour starts,
-and the tour starts at its low rim, which the tilted search makes follow the tour (its
-``lead``): started at the part's axis, the lead pulled the part back by up to 6 mm first,
-away from the hole and over the edge of the top (rect12x8-sharp-through on the FR3, where
-the skill's last pass ended 6 mm beyond the taught hole).
+The part leans toward the taught hole, or, tilted already (the skill's lateral move), 45
+degrees from the way it leans, toward the taught hole's side (:func:`lean_of`); the tour
+starts at its low rim, which the tilted search makes follow the tour (its ``lead``). On
+the FR3 (rect12x8-sharp-through, where the skill's last pass ended 6 mm beyond the taught
+hole) a tour started at the part's axis first pulled the part back by the lead, 6 mm, and a
+lean toward the taught hole rolled the part from the lateral move's low rim over its tip
+onto the other; either threw it 5-10 mm sideways and up to 10 mm up, off the top, into the
+force limit. Leaning the lateral move's way (along x) kept a rectangular part's whole short
+side lowest, which drops only where it fits the hole within the clearance (a tour without
+a drop); turned 45 degrees, a corner leads and the tilt turns in without a roll.
 
 The part is pressed by the push alone along z in every phase (the set-point's height follows
 the TCP, as the upright search does: the adaptive controller's learned feed-forward would
@@ -73,6 +78,9 @@ from teachfit.skills.tilt_phases import TiltedSearch, TiltPhase
 #: time (s) over which a tour's orientation set-point turns from the measured orientation
 #: where it started to its tilt (see the module docstring)
 TILT_BLEND = 0.5
+#: tilt (rad) above which a tour's part leans near the way it leans (:func:`lean_of`), and
+#: how far (rad) the lean turns from it
+LEAN_MIN, LEAN_TURN = 0.05, np.pi / 4
 #: the tilted search's phases after the search node: node name -> phase
 PHASE_NODES = {"search_slide": "slide_to_wall", "search_align": "align_upright"}
 
@@ -119,6 +127,24 @@ class LearnedTiltSearch(LearnedSearch):
         return f"{super().describe()}, tilted {self.tilt} rad"
 
 
+def lean_of(pc: Percept) -> np.ndarray:
+    """The side (2,), task frame, a tour's tilted part leans to (its low rim): toward the
+    taught hole (the task frame's origin; +x right over it); where the part is tilted by more
+    than :data:`LEAN_MIN` already (the skill's lateral move), the side it leans to turned by
+    :data:`LEAN_TURN` toward the taught hole's side of it."""
+    toward = -pc.p[:2]
+    n = float(np.hypot(toward[0], toward[1]))
+    toward = toward / n if n > 1e-6 else np.array([1.0, 0.0])
+    axis = wxyz_to_rotation(pc.q).as_matrix()[:2, 2]  # the tilt about z x d moves it along d
+    n = float(np.hypot(axis[0], axis[1]))
+    if n <= np.sin(LEAN_MIN):
+        return toward
+    lean = axis / n
+    turn = LEAN_TURN if lean[0] * toward[1] - lean[1] * toward[0] >= 0.0 else -LEAN_TURN
+    c, s = np.cos(turn), np.sin(turn)
+    return np.array([c * lean[0] - s * lean[1], s * lean[0] + c * lean[1]])
+
+
 class _TiltedTourRun(PrimitiveRun):
     """The search node's run, tilted: a tour planned from here followed as a tilted
     search's first phase; re-entered after a missed align it goes on with the same tour."""
@@ -131,9 +157,7 @@ class _TiltedTourRun(PrimitiveRun):
     def _plan(self, pc: Percept) -> None:
         t, tilt = self.tour, self.tour.cfg.tilt
         assert tilt is not None
-        d = -pc.p[:2] / max(1e-9, float(np.hypot(pc.p[0], pc.p[1])))  # toward the taught hole
-        if not np.any(d):
-            d = np.array([1.0, 0.0])
+        d = lean_of(pc)
         shift = (tilt.lead * float(d[0]), tilt.lead * float(d[1]))  # the low rim: the start
         traj = plan_tour(self.model, t.planner, t.n, t.rng, pc, blend=False, shift=shift)
         pc.shared.pop(KEY, None)  # a fresh tilted search: its context is made on entry
