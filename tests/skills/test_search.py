@@ -212,6 +212,13 @@ def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
     pc.t = ctx.traj.duration + 0.1
     run.command(pc, MPCommand())
     assert pc.shared[KEY] is not ctx and not pc.done
+    # entered again (a missed align stood upright): the tilt turns in again, not at once
+    pc.q[:] = (1.0, 0.0, 0.0, 0.0)
+    pc.t += 1.0  # past the fresh tour's own turn-in
+    run.enter(pc)
+    pc.t += 0.01
+    run.command(pc, MPCommand())
+    assert 2.0 * np.degrees(np.arccos(abs(pc.q_d[0]))) < 0.05 * tilt
     # upright (the default, every built-in task): no tilted context, the drop never felt
     _, _, upright, pc_up, _ = _tilted_search(model, 0.0)
     assert KEY not in pc_up.shared and np.allclose(np.abs(pc_up.q_d), [1, 0, 0, 0], atol=1e-6)

@@ -26,7 +26,8 @@ after a missed align): a part that stopped at the hole's edge (the far wall, whe
 lateral move gave up) drops in while it tilts, before a resting height could be measured
 (round16-sharp-blind: 0.9 mm in, tilted, and the tour dragged it to the force limit). The
 orientation set-point turns to the tilt over :data:`TILT_BLEND` from the measured
-orientation where the tour starts (the skill's own lateral tilt leans the other way): on
+orientation where the tour starts, and where the search goes on after a missed align (the
+skill's own lateral tilt leans another way; the missed align stands upright): on
 the FR3 the step to the tilt at once threw the part 5-10 mm sideways and 5 mm up, off the
 top and into the force limit (rect12x8-sharp-through, 6 of 10 trials).
 
@@ -37,7 +38,9 @@ the FR3 (rect12x8-sharp-through, where the skill's last pass ended 6 mm beyond t
 hole) a tour started at the part's axis first pulled the part back by the lead, 6 mm, and a
 lean toward the taught hole rolled the part from the lateral move's low rim over its tip
 onto the other; either threw it 5-10 mm sideways and up to 10 mm up, off the top, into the
-force limit. Leaning the lateral move's way (along x) kept a rectangular part's whole short
+force limit; tilted again at once after a missed align, the part jumped 5-7 mm and felt
+false drops (round16-sharp-blind on the FR3: slides of 16 mm, and off the top). Leaning the
+lateral move's way (along x) kept a rectangular part's whole short
 side lowest, which drops only where it fits the hole within the clearance (a tour without
 a drop); turned 45 degrees, a corner leads and the tilt turns in without a roll.
 
@@ -173,8 +176,9 @@ class _TiltedTourRun(PrimitiveRun):
     def enter(self, pc: Percept) -> None:
         if self.inner is None or not isinstance(pc.shared.get(KEY), TiltContext):
             self._plan(pc)
-        else:
+        else:  # after a missed align (upright on the edge): tilted again, blended too
             self.inner.enter(pc)
+            self.q_entry, self.t_entry = pc.q.copy(), pc.t
 
     def command(self, pc: Percept, out: MPCommand) -> None:
         assert self.inner is not None, "enter() first"
