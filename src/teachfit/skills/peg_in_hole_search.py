@@ -25,6 +25,11 @@ is followed by a fresh one from where it ended, ``search_repeat``: a tight sharp
 caught only within about its clearance of the hole's axis, and one tour of the default points
 took 7-8 s of the 15 s on the parts suite's 8 mm round part; 0: the tour done ends it).
 
+With ``search_tilt`` > 0 (a sharp-edged part whose fit the task knows,
+:mod:`teachfit.skills.fit_context`) the search follows its tours tilted, with two more
+nodes, ``search_slide`` and ``search_align`` (:mod:`teachfit.skills.search_tilted`); 0 (the
+default): upright, as above.
+
 Learned, besides Johannsmeier et al.'s: ``t_switch``, ``t_stuck`` (when to switch to search) and the
 search's ``search_points``, ``search_scale``, ``search_speed``, ``search_push``; the meta
 learners tune them with the rest. Context adds ``t_search``, ``search_seed``,
