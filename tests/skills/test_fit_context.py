@@ -11,6 +11,7 @@ from teachfit.core.errors import SkillError
 from teachfit.core.params import ParamDomain
 from teachfit.skills import peg_in_hole
 from teachfit.skills.fit_context import NEVER, FitGeometry, fit_context
+from teachfit.skills.tilt import rim_lead
 from teachfit.tasks.registry import get_task
 
 DEFAULTS = {n: p.value for n, p in peg_in_hole.CONTEXT.items()}
@@ -36,11 +37,18 @@ def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_li
     assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + extra)
     assert values["t_reach"] == pytest.approx(start / (DEFAULTS["v_lateral"] * 0.25))
     assert domains["tilt"].high == pytest.approx(math.acos(0.004 / 0.0041))  # 0.22 rad
+    # the joined skill's search of a sharp edge is tilted, retried at the jam-free tilt
+    assert values["search_tilt"] == 0.25
+    assert values["search_retry_tilt"] == pytest.approx(math.acos(0.004 / 0.0041))
+    assert values["search_reach"] == pytest.approx(0.0082)
+    assert values["search_lead"] == pytest.approx(rim_lead(0.25, 0.008))
+    assert values["search_drop"] == pytest.approx(2.5e-4) and values["search_friction"] == 0.3
 
 
 def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() -> None:
     values, domains = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4), DEFAULTS, 0.25, TILT)
     assert values["f_push"] == DEFAULTS["f_push"]
+    assert "search_tilt" not in values  # a chamfer catches an upright search
     assert values["lateral_offset"] == pytest.approx(-(0.005 + 0.0055 + 6e-4))
     assert math.acos(0.0045 / 0.0055) > 0.3  # the fit allows more than the skill's own
     assert domains["tilt"].high == 0.3
@@ -86,6 +94,7 @@ def test_the_round_peg_example_gives_its_fit(mesh_examples: dict[str, str]) -> N
     ctx = peg_in_hole.hole_context(task, np.random.default_rng(0))
     assert ctx.values["lateral_dir"] == -1.0
     assert ctx.values["lateral_offset"] == pytest.approx(-(0.004 + 0.0041 + 0.0015), abs=1e-6)
+    assert ctx.values["search_friction"] == pytest.approx(task.params.friction)
 
 
 def test_a_fit_extends_the_skill_s_own_time_limit(mesh_examples: dict[str, str]) -> None:

@@ -13,6 +13,8 @@ from teachfit.skills.controllers import controller_spec
 from teachfit.skills.library import get_skill
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.search import recentred, states_to_setpoints, surface_radius
+from teachfit.skills.search_tilted import TILT_BLEND, lean_of
+from teachfit.skills.tilt_context import KEY, TiltContext
 from teachfit.tasks import get_task
 
 
@@ -152,3 +154,85 @@ def test_a_search_without_a_catch_tours_again_from_where_it_ended(peg):
     assert np.allclose(run.trajectory.pos[0, :2], pc.p[:2], atol=1e-9)
     _, _, pc_once = _tour(model, 0.0)  # Ehlers et al.'s: one tour, done
     assert pc_once.done
+
+
+def _tilted_search(model, tilt: float):
+    """The joined skill's search node entered 4 mm along +x from the taught hole with
+    ``search_tilt`` ``tilt``; its first command's orientation set-point and the percept after
+    one command once the tilt is in (``TILT_BLEND``)."""
+    sk = peg_in_hole_search.build(model, "impedance")
+    values = sk.resolve({"search_points": 10.0}) | {"search_tilt": tilt, "search_lead": 0.001}
+    run = sk.node("search").primitive.compile(values)
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    pc.p[:] = (0.004, 0.0, 0.001)
+    run.enter(pc)
+    pc.t = pc.t_node = 0.01
+    run.command(pc, MPCommand())
+    first = (pc.q_d.copy(), pc.p_d[:2].copy())
+    pc.t = pc.t_node = TILT_BLEND + 0.01
+    pc.p[2] = 0.0008  # the TCP sinks: the set-point's height follows it
+    run.command(pc, MPCommand())
+    return sk, values, run, pc, first
+
+
+def test_a_sharp_edged_part_searches_tilted_in_nodes_of_the_joined_graph(peg):
+    _, model = peg
+    sk, values, run, pc, first = _tilted_search(model, 0.25)
+    edges = {(t.source, t.target) for t in sk.transitions}
+    assert {
+        ("search", "search_slide"),
+        ("search_slide", "search_align"),
+        ("search_slide", "search"),
+        ("search_align", "search"),
+        ("search_align", "align"),
+    } <= edges
+    assert ("search_slide", "align") not in edges  # a tilted corner dips deep while sliding
+    ctx = pc.shared[KEY]
+    assert isinstance(ctx, TiltContext) and ctx.cfg.angle == 0.25
+    assert ctx.cfg.retry_angle is None  # search_retry_tilt 0: none
+    tilt = 2.0 * np.degrees(np.arccos(np.clip(abs(pc.q_d[0]), 0, 1)))
+    assert tilt == pytest.approx(np.degrees(0.25))
+    assert 2.0 * np.degrees(np.arccos(abs(first[0][0]))) < 0.05 * tilt  # turned in, blended
+    assert pc.p_d[2] == pytest.approx(0.0008)  # only the push presses along z
+    # leaning toward the taught hole (-x), the tour starts at the low rim, the axis stays
+    assert np.allclose(ctx.d, [-1.0, 0.0])
+    assert np.allclose(ctx.traj.pos[0, :2], [0.003, 0.0], atol=1e-9)
+    assert np.allclose(first[1], [0.004, 0.0], atol=2e-4)
+    felt = next(
+        t.condition for t in sk.transitions if (t.source, t.target) == ("search", "search_slide")
+    ).compile(values)
+    pc.p[2] = ctx.z_top - 3e-4  # 0.3 mm below the resting height, past the tilt's settling
+    assert felt(pc)
+    # still tilting: a part that sinks below where the tour started (its edge) has dropped
+    ctx.z_top, ctx.t0, pc.t, pc.p[2] = 0.0, 0.0, 0.1, 0.0007
+    assert felt(pc)
+    pc.p[2] = 0.0009
+    assert not felt(pc)
+    # a tour without a catch: a fresh tilted search from here
+    pc.t = ctx.traj.duration + 0.1
+    run.command(pc, MPCommand())
+    assert pc.shared[KEY] is not ctx and not pc.done
+    # entered again (a missed align stood upright): the tilt turns in again, not at once
+    pc.q[:] = (1.0, 0.0, 0.0, 0.0)
+    pc.t += 1.0  # past the fresh tour's own turn-in
+    run.enter(pc)
+    pc.t += 0.01
+    run.command(pc, MPCommand())
+    assert 2.0 * np.degrees(np.arccos(abs(pc.q_d[0]))) < 0.05 * tilt
+    # upright (the default, every built-in task): no tilted context, the drop never felt
+    _, _, upright, pc_up, _ = _tilted_search(model, 0.0)
+    assert KEY not in pc_up.shared and np.allclose(np.abs(pc_up.q_d), [1, 0, 0, 0], atol=1e-6)
+    assert not felt(pc_up)
+
+
+def test_a_tilted_part_leans_a_corner_ahead_toward_the_taught_hole():
+    """Upright: toward the taught hole; tilted by the skill's lateral move: 45 degrees from
+    its lean toward the taught hole's side (no roll over the tip; a corner leads)."""
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    pc.p[:] = (0.004, 0.0, 0.0)
+    assert np.allclose(lean_of(pc), [-1.0, 0.0])
+    pc.q[:] = (np.cos(0.05), 0.0, np.sin(0.05), 0.0)  # 0.1 rad about y: leans along +x
+    pc.p[:] = (0.004, 0.001, 0.0)  # the taught hole ahead along -x, a little along -y
+    assert np.allclose(lean_of(pc), [np.sqrt(0.5), -np.sqrt(0.5)])
+    pc.p[:] = (0.004, -0.001, 0.0)
+    assert np.allclose(lean_of(pc), [np.sqrt(0.5), np.sqrt(0.5)])

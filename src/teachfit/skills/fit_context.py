@@ -61,6 +61,7 @@ from dataclasses import dataclass
 
 from teachfit.core.errors import SkillError
 from teachfit.core.params import ParamDomain
+from teachfit.skills.tilt import rim_lead
 
 #: the roi beyond the start of the lateral move (m)
 ROI_MARGIN = 0.001
@@ -72,6 +73,9 @@ WALL_SHARE = 2.0
 PASS_TIME = 1.0
 #: share of the default press a sharp leading rim gets (see the module docstring)
 SHARP_PUSH = 0.5
+#: the joined skill's search tilt for a sharp-edged part (rad) and the sink felt as a drop
+#: (m): those of the tilted search on the sharp-edged task variants (``peg2d``)
+SEARCH_TILT, SEARCH_DROP = 0.25, 2.5e-4
 
 
 @dataclass(frozen=True)
@@ -86,6 +90,7 @@ class FitGeometry:
     tip_chamfer: float
     sigma: float
     reach: float = math.inf
+    friction: float = 0.3
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.half_width) and self.half_width > 0):
@@ -117,10 +122,19 @@ def fit_of(task: object) -> FitGeometry | None:
     vals = [getattr(task, n, None) for n in ("part_half_width", "clearance", "tip_chamfer")]
     if not all(isinstance(v, int | float) for v in vals):
         return None
-    sigma = float(getattr(getattr(task, "params", None), "hole_pos_sigma", 0.0) or 0.0)
+    params = getattr(task, "params", None)
+    sigma = float(getattr(params, "hole_pos_sigma", 0.0) or 0.0)
+    friction = getattr(params, "friction", None)
     reach = getattr(task, "detection_radius", None)
     r, c, e = (float(v) for v in vals if isinstance(v, int | float))
-    return FitGeometry(r, c, e, sigma, float(reach) if isinstance(reach, int | float) else math.inf)
+    return FitGeometry(
+        r,
+        c,
+        e,
+        sigma,
+        float(reach) if isinstance(reach, int | float) else math.inf,
+        float(friction) if isinstance(friction, int | float) else FitGeometry.friction,
+    )
 
 
 def fit_context(
@@ -154,4 +168,23 @@ def fit_context(
         - defaults["t_lateral"]
         + 2.0 * (t_lateral + PASS_TIME),
     }
+    if fit.tip_chamfer < fit.clearance:
+        values |= search_tilt_context(fit)
     return values, {"tilt": ParamDomain(tilt.low, min(tilt.high, fit.max_tilt))}
+
+
+def search_tilt_context(fit: FitGeometry) -> dict[str, float]:
+    """The joined skill's tilted search for a sharp-edged part
+    (:mod:`teachfit.skills.search_tilted`): tilted :data:`SEARCH_TILT`, after a missed
+    align alternately at the jam-free :attr:`FitGeometry.max_tilt` where that is smaller; a
+    drop felt at :data:`SEARCH_DROP`; the slide reaching the hole's width; the rim's lead for
+    a part ``2 r`` wide; the fit's friction."""
+    retry = fit.max_tilt if fit.max_tilt < SEARCH_TILT else 0.0
+    return {
+        "search_tilt": SEARCH_TILT,
+        "search_retry_tilt": retry,
+        "search_drop": SEARCH_DROP,
+        "search_reach": 2.0 * fit.hole_half_width,
+        "search_lead": rim_lead(SEARCH_TILT, 2.0 * fit.half_width),
+        "search_friction": fit.friction,
+    }

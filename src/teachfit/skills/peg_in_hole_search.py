@@ -25,6 +25,11 @@ is followed by a fresh one from where it ended, ``search_repeat``: a tight sharp
 caught only within about its clearance of the hole's axis, and one tour of the default points
 took 7-8 s of the 15 s on the parts suite's 8 mm round part; 0: the tour done ends it).
 
+With ``search_tilt`` > 0 (a sharp-edged part whose fit the task knows,
+:mod:`teachfit.skills.fit_context`) the search follows its tours tilted, with two more
+nodes, ``search_slide`` and ``search_align`` (:mod:`teachfit.skills.search_tilted`); 0 (the
+default): upright, as above.
+
 Learned, besides Johannsmeier et al.'s: ``t_switch``, ``t_stuck`` (when to switch to search) and the
 search's ``search_points``, ``search_scale``, ``search_speed``, ``search_push``; the meta
 learners tune them with the rest. Context adds ``t_search``, ``search_seed``,
@@ -51,7 +56,7 @@ from teachfit.skills.conditions import (
 )
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
-from teachfit.skills.search import LearnedSearch
+from teachfit.skills.search_tilted import LearnedTiltSearch, tilt_nodes
 
 NAME = "peg-in-hole+search"
 
@@ -67,6 +72,12 @@ CONTEXT: dict[str, ContextParam] = {
     "search_radius": ContextParam(
         0.0, "m", "least RMS radius of the search's spread: the taught hole's error (0: none)"
     ),
+    "search_tilt": ContextParam(0.0, "rad", "tilt of the searching part (0: upright)"),
+    "search_retry_tilt": ContextParam(0.0, "rad", "tilt after a missed tilted align (0: none)"),
+    "search_drop": ContextParam(2.5e-4, "m", "tilted: sink below its resting height = a drop"),
+    "search_reach": ContextParam(0.01, "m", "tilted: reach of the slide after a drop"),
+    "search_lead": ContextParam(0.0, "m", "tilted: how far the low rim leads the axis"),
+    "search_friction": ContextParam(0.3, "", "tilted: friction of the rim on the far wall"),
 }
 
 LEARNED: dict[str, LearnedParam] = {
@@ -99,19 +110,21 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
     gave_up = (TimeAbove("t_switch") & TimeAbove("t_reach")) | LateralAbove("roi") | stopped
     search = Node(
         "search",
-        LearnedSearch(model),
+        LearnedTiltSearch(model),
         TimeAbove("t_search") | Done(),
-        "learned search (TSHIX + GMR feed-forward) from where the skill is",
+        "learned search (TSHIX + GMR feed-forward) from where the skill is, tilted or not",
     )
+    phases, tilted = tilt_nodes(TimeAbove("t_search"), dropped, "align")
     transitions = base.transitions + (
         *(Transition(lateral, "search", gave_up) for lateral in LATERALS),
         Transition(LATERALS[-1], "search", XBelow("-pass_end")),
         Transition("insert", "search", TimeAbove("t_stuck") & ~dropped),
         Transition("search", "align", dropped),
+        *tilted,
     )
     return Skill(
         name=NAME,
-        nodes=nodes + (search,),
+        nodes=nodes + (search, *phases),
         transitions=transitions,
         start=base.start,
         params=params,

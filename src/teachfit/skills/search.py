@@ -116,6 +116,42 @@ def states_to_setpoints(
     return SetpointTrajectory(t, pos, rotation_to_wxyz(planned), ff, name=name)
 
 
+def plan_tour(
+    model: SearchModel,
+    planner: TshixPlanner,
+    n: int,
+    rng: np.random.Generator,
+    pc: Percept,
+    blend: bool = True,
+    shift: tuple[float, float] = (0.0, 0.0),
+) -> SetpointTrajectory:
+    """A TSHIX tour of ``n`` points from the measured pose in ``pc`` (moved by ``shift``, m,
+    x-y) as task-frame set-points at the set-point's height (:func:`states_to_setpoints`;
+    ``blend``: the orientation from the measured one, else the planned one from the start)."""
+    x, y = pc.p[0] + shift[0], pc.p[1] + shift[1]
+    here = {"x": x, "y": y, "z": pc.p[2], "rz": yaw_of(pc.q)}
+    start = np.array([here[d] for d in model.dims])
+    try:
+        traj = planner.plan(n, rng, start)
+    except (PlanningError, ModelError) as exc:
+        raise SkillError(f"search planning failed: {exc}") from exc
+    entry = pc.q.copy() if blend else None
+    return states_to_setpoints(traj.t, traj.states, model.dims, float(pc.p_d[2]), model, entry)
+
+
+@dataclass(frozen=True)
+class Tour:
+    """How a learned search tours (:meth:`LearnedSearch.tour`): ``n`` points per tour,
+    the ``planner``, the follow config ``cfg``, the sampler ``rng``, ``repeat``: a tour
+    without a catch is followed by another from where it ended."""
+
+    n: int
+    planner: TshixPlanner
+    cfg: FollowConfig
+    rng: np.random.Generator
+    repeat: bool
+
+
 @dataclass(frozen=True)
 class LearnedSearch(Primitive):
     """Search with a learned model from where the skill is; see the module docstring.
@@ -141,6 +177,16 @@ class LearnedSearch(Primitive):
     kind: ClassVar[str] = "learned_search"
 
     def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
+        if self.follow.tilt is not None:
+            raise SkillError(
+                "learned_search follows upright: a tilted search is a graph of its own"
+            )
+        tour = self.tour(values)
+        return _SearchRun(self.model, tour.planner, tour.n, tour.cfg, tour.rng, tour.repeat)
+
+    def tour(self, values: Mapping[str, float]) -> Tour:
+        """The tours' settings with ``values``: points, planner, follow config (the push
+        set), the sampler and whether a tour without a catch is followed by another."""
         n = int(round(resolve(self.n_points, values)))
         if n < 2:
             raise SkillError(f"search needs at least 2 points, got {n}")
@@ -153,13 +199,9 @@ class LearnedSearch(Primitive):
         )
         ang = None if self.model.angular_speed is None else self.model.angular_speed * speed
         planner = TshixPlanner(ex, self.model.speed * speed, ang)
-        if self.follow.tilt is not None:
-            raise SkillError(
-                "learned_search follows upright: a tilted search is a graph of its own"
-            )
         cfg = FollowConfig(**{**self.follow.__dict__, "push_force": push, "anchor": "frame"})
         rng = np.random.default_rng(int(resolve(self.seed, values)))
-        return _SearchRun(self.model, planner, n, cfg, rng, resolve(self.repeat, values) > 0)
+        return Tour(n, planner, cfg, rng, resolve(self.repeat, values) > 0)
 
     def describe(self) -> str:
         return (
@@ -194,15 +236,7 @@ class _SearchRun(PrimitiveRun):
 
     def _plan(self, pc: Percept) -> None:
         """A tour from the measured pose, followed from node time ``t0`` on."""
-        here = {"x": pc.p[0], "y": pc.p[1], "z": pc.p[2], "rz": yaw_of(pc.q)}
-        start = np.array([here[d] for d in self.dims])
-        try:
-            traj = self.planner.plan(self.n, self.rng, start)
-        except (PlanningError, ModelError) as exc:
-            raise SkillError(f"search planning failed: {exc}") from exc
-        self.trajectory = states_to_setpoints(
-            traj.t, traj.states, self.dims, float(pc.p_d[2]), self.model, pc.q.copy()
-        )
+        self.trajectory = plan_tour(self.model, self.planner, self.n, self.rng, pc)
         self.follow = _FollowRun(self.trajectory, self.cfg)
         self.follow.enter(pc)
 
