@@ -43,6 +43,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+# numba's on-disk cache (``cache=True``) keys each compiled function on its own file only: the
+# functions of tsp_moves are compiled into this file's kernels, so an edit there alone leaves
+# this file's cached kernels stale; touch this file too (or clear __pycache__) after one.
 from teachfit.trajectories.tsp_moves import _d, _lk_node, _move_segment, _or_segment, _reverse
 
 
