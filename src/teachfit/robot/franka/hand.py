@@ -2,19 +2,21 @@
 
 A *guide* is a CSV file with the header ``t,x,y,press`` and one row per waypoint: ``t`` the
 time (s, strictly increasing), ``x``, ``y`` where the hand wants the held part's tip (the TCP)
-in the task's hole frame (m), ``press`` the hand's downward push (N, >= 0). Rows with ``t < 0``
-are the lead-in: the hand brings the arm to where the demonstration starts before anything is
-recorded; ``demo record --hand`` records from ``t = 0`` to the last row.
+in the task's hole frame (m), ``press`` the hand's downward push (N; negative lifts). Rows with
+``t < 0`` are the lead-in: the hand brings the arm to where the demonstration starts before
+anything is recorded; ``demo record --hand`` records from ``t = 0`` to the last row.
 
 The hand is a person's, not a servo: it pulls the TCP towards the (linearly interpolated)
 target with a spring-damper (:class:`HandParams`: 2500 N/m, 100 N·s/m on the speed relative to
-the target's, capped at 15 N: a hand stiff enough that the joints' and the surface's friction
-under a 6 N press leave it about 1 mm short at rest, inside a chamfered hole's capture), pushes down with ``press`` (a force, undamped), and holds the tool
-upright (a rotational spring-damper to the orientation it found). The twin applies it as an
-external force inside the physics (:class:`teachfit.robot.franka.twin_hand.TwinHand`), so
+the target's, capped at 15 N: stiff enough that the joints' and the surface's friction under a
+6 N press leave it about 1 mm short at rest, inside a chamfered hole's capture), pushes down
+with ``press`` while damping vertical motion as a hand does (``press_damping``), and holds the
+tool upright (a rotational spring-damper to the orientation it found). The twin applies it as
+an external force inside the physics (:class:`teachfit.robot.franka.twin_hand.TwinHand`), so
 libfranka's ``O_F_ext_hat_K`` sees it as it would see a person's push: in free air the
-recording reads the press as ``fz = -press`` (the environment's force on the tool); pressed on
-the fixture, the fixture's reaction cancels it in the joint-torque estimate, as on a real arm
+recording reads the hand's vertical force, ``fz = -press - press_damping * vz`` (the
+environment's force on the tool; ``-press`` where the hand holds still); pressed on the
+fixture, the fixture's reaction cancels it in the joint-torque estimate, as on a real arm
 (no wrist sensor). After the last row the hand lets go.
 
 :func:`sweep_guide` draws a blind search like the simulated teacher's sweep
@@ -54,12 +56,13 @@ class GuideError(TeachfitError):
 @dataclass(frozen=True)
 class HandParams:
     """The hand's spring-damper: ``stiffness`` N/m and ``damping`` N·s/m across (x, y),
-    ``max_force`` N its cap; ``rot_stiffness``
+    ``max_force`` N its cap; ``press_damping`` N·s/m on vertical speed; ``rot_stiffness``
     N·m/rad, ``rot_damping`` N·m·s/rad and ``max_torque`` N·m holding the tool upright."""
 
     stiffness: float = 2500.0
     damping: float = 100.0
     max_force: float = 15.0
+    press_damping: float = 40.0
     rot_stiffness: float = 10.0
     rot_damping: float = 1.0
     max_torque: float = 3.0
@@ -134,8 +137,8 @@ def _checked(rows: np.ndarray, name: str) -> Guide:
         bad = f"t must end after 0 s and span at most {MAX_DURATION:g} s"
     elif np.any(np.abs(xy) > MAX_REACH):
         bad = f"x, y must stay within {MAX_REACH} m of the hole (hole frame, m)"
-    elif np.any(press < 0) or np.any(press > MAX_PRESS):
-        bad = f"press must be 0 to {MAX_PRESS:g} N (the hand's downward push)"
+    elif np.any(np.abs(press) > MAX_PRESS):
+        bad = f"press must be within +-{MAX_PRESS:g} N (the hand's downward push; < 0 lifts)"
     if bad is not None:
         raise GuideError(f"{name}: {bad}: {FIX}")
     return Guide(t.copy(), xy.copy(), press.copy())
@@ -165,7 +168,8 @@ def sweep_guide(
     seed: int = 0,
 ) -> Guide:
     """A blind search from ``start`` (hole frame, m) drawn like the teacher's sweep: the lead-in
-    (t < 0) moves the tool there over the hole's surface and lowers it with a growing press;
+    (t < 0) lifts the part (out of the hole, if it is in), carries it over ``start`` and
+    lowers it;
     then passes ``2 halfwidth`` wide across the direction to the hole, ``pitch`` apart, at
     ``speed`` m/s, the last one ending over the hole, held there 3 s. ``seed`` draws the
     side the passes start on and a slow wander of the hand (0.3 mm)."""
@@ -193,11 +197,14 @@ def sweep_guide(
     path = (
         path + rng.normal(0.0, 3e-4, path.shape) * (np.arange(len(path)) < len(path) - 1)[:, None]
     )
-    lead_t = np.array([-4.0, -3.0, -1.0])  # over there, then lowered at ~5 cm/s
-    lead_xy = np.array([[0.0, 0.0], p0, p0])
+    # the lead-in: lift (out of the hole, where the last demonstration left the part), carry
+    # the part over the start, lower it, press
+    lead_t = np.array([-7.0, -5.8, -5.7, -4.7, -4.6, -0.5])
+    lead_xy = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], p0, p0, p0])
+    lead_press = [-4.0, -4.0, 0.0, 0.0, 3.0, 3.0]
     t = np.concatenate([lead_t, t, [t[-1] + 3.0]])
     xy = np.concatenate([lead_xy, path, path[-1:]])
-    pr = np.concatenate([[0.0, 1.5, 1.5], np.full(len(path) + 1, press)])
+    pr = np.concatenate([lead_press, np.full(len(path) + 1, press)])
     return Guide(t, xy, pr)
 
 

@@ -72,7 +72,7 @@ class TwinHand:
         norm = float(np.linalg.norm(across))
         if norm > p.max_force:
             across *= p.max_force / norm
-        force = across + np.array([0.0, 0.0, -press])
+        force = across + np.array([0.0, 0.0, -press - p.press_damping * twist[2]])
         err = self._rot0 @ d.site_xmat[self._site].reshape(3, 3).T
         angle = 0.5 * np.array(
             [err[2, 1] - err[1, 2], err[0, 2] - err[2, 0], err[1, 0] - err[0, 1]]
