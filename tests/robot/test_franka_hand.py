@@ -12,6 +12,7 @@ import pytest
 from typer.testing import CliRunner
 
 from teachfit.cli import app
+from teachfit.core.errors import TeachfitError
 from teachfit.robot.franka import hand_channel
 from teachfit.robot.franka.hand import (
     Guide,
@@ -94,8 +95,8 @@ def test_send_guide_to_no_twin_says_a_scripted_hand_guides_only_the_twin(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     monkeypatch.setattr(hand_channel, "HAND_PORT", _free_port())
-    with pytest.raises(Exception, match="guides only the twin"):
-        hand_channel.send_guide("127.0.0.1", parse_guide(GOOD, "g"))
+    with pytest.raises(TeachfitError, match="^--hand g.csv: nothing answers.*guides only the twin"):
+        hand_channel.send_guide("127.0.0.1", parse_guide(GOOD, "g"), "--hand g.csv")
 
 
 @pytest.mark.parametrize(

@@ -141,7 +141,7 @@ def _scripted_hand(
             "twin (teachfit robot twin); on a real arm a person guides it, drop --hand"
         ) from None
     guide = read_guide(hand)
-    return guide, lambda g: send_guide(host, g), str(hand)
+    return guide, lambda g: send_guide(host, g, f"--hand {hand}"), str(hand)
 
 
 def _check_target(out: Path, append: bool, overwrite: bool) -> None:

@@ -21,9 +21,9 @@ HAND_PORT = 1339
 MAGIC = "TEACHFIT-HAND 1"
 
 
-def send_guide(host: str, guide: Guide, timeout: float = 10.0) -> None:
-    """Hand ``guide`` to the twin on ``host`` (loopback); :class:`TeachfitError` if no twin's
-    hand channel answers there or the twin refuses it."""
+def send_guide(host: str, guide: Guide, what: str = "--hand", timeout: float = 10.0) -> None:
+    """Hand ``guide`` (named ``what`` in errors) to the twin on ``host`` (loopback);
+    :class:`TeachfitError` if no twin's hand channel answers there or the twin refuses it."""
     body = f"{MAGIC}\n{guide.to_csv()}END\n".encode()
     try:
         with socket.create_connection((host, HAND_PORT), timeout=timeout) as conn:
@@ -31,12 +31,12 @@ def send_guide(host: str, guide: Guide, timeout: float = 10.0) -> None:
             reply = conn.makefile("r", encoding="utf-8").readline().strip()
     except OSError as exc:
         raise TeachfitError(
-            f"--hand: nothing answers on {host}:{HAND_PORT} ({exc.strerror or exc}): a scripted "
+            f"{what}: nothing answers on {host}:{HAND_PORT} ({exc.strerror or exc}): a scripted "
             "hand guides only the twin (teachfit robot twin --no-realtime); on a real arm a "
             "person guides it, record without --hand"
         ) from None
     if reply != "OK":
-        raise TeachfitError(f"--hand: the twin refused the guide: {reply or 'no answer'}")
+        raise TeachfitError(f"{what}: the twin refused the guide: {reply or 'no answer'}")
 
 
 class HandChannel:
