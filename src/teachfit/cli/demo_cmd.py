@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, TypeVar
 
 import typer
 from rich.markup import escape
@@ -43,6 +43,9 @@ from teachfit.execution.recording import is_run_log
 from teachfit.execution.teacher import PATTERNS, BlindTeacher, TeacherStyle
 from teachfit.tasks.registry import TASKS, load_task
 
+if TYPE_CHECKING:
+    from teachfit.robot.franka.hand import Guide
+
 T = TypeVar("T")
 app = typer.Typer(help="Record, import and inspect demonstrations.", no_args_is_help=True)
 
@@ -65,24 +68,38 @@ def record(
         float | None,
         typer.Option(min=0, help="real robot: seconds to record (default: until Ctrl-C)"),
     ] = None,
+    hand: Annotated[
+        Path | None,
+        typer.Option(
+            help="the Franka twin only: a scripted hand guides the arm (CSV t,x,y,press: s, m "
+            "in the hole frame, N; python -m teachfit.robot.franka.hand writes one)"
+        ),
+    ] = None,
     n: o.CountOld = None,
 ) -> None:
     """Record demonstrations: the simulated blind teacher on a simulated robot, or a person
-    guiding a real robot (--robot franka --host ADDRESS; Ctrl-C ends it, every sample kept)."""
+    guiding a real robot (--robot franka --host ADDRESS; Ctrl-C ends it, every sample kept),
+    or on the Franka twin a scripted hand (--hand guide.csv)."""
     from teachfit.robot.registry import ROBOTS, make_robot
 
     count = o.pick(count, n)
     the_task = load_task(task)
     _check_target(out, append, overwrite)
-    if robot in ROBOTS and not ROBOTS[robot].simulated:
+    real = robot in ROBOTS and not ROBOTS[robot].simulated
+    scripted = _scripted_hand(hand, real, host, duration)
+    if real:
         from teachfit.demonstrations.kinesthetic import record_demonstration
 
         arm = make_robot(
             robot, the_task, **robot_options(host, realtime, reflex_force=reflex_force)
         )
         try:
-            console.print("guide the arm; Ctrl-C ends the recording")
-            demos = [record_demonstration(arm, the_task.name, duration)]
+            console.print(
+                "guide the arm; Ctrl-C ends the recording"
+                if hand is None
+                else f"the scripted hand {hand} guides the arm"
+            )
+            demos = [record_demonstration(arm, the_task.name, duration, hand=scripted)]
             discarded: list[str] = []
         finally:
             arm.close()
@@ -94,6 +111,37 @@ def record(
         f"recorded {len(demos)} demonstration(s) of [bold]{the_task.name}[/] -> {out}"
         + (f" (discarded {len(discarded)}: {'; '.join(discarded)})" if discarded else "")
     )
+
+
+def _scripted_hand(
+    hand: Path | None, real: bool, host: str | None, duration: float | None
+) -> tuple[Guide, Callable[[Guide], None], str] | None:
+    """``--hand``'s guide, read and checked before anything connects, with the function that
+    hands it to the twin on ``host``; ``None`` without --hand."""
+    if hand is None:
+        return None
+    from teachfit.robot.franka.hand import read_guide
+    from teachfit.robot.franka.hand_channel import send_guide
+    from teachfit.robot.franka.twin import check_host
+
+    if not real or host is None:
+        raise TeachfitError(
+            f"--hand {hand}: a scripted hand guides the Franka twin only: give --robot franka "
+            "--host 127.0.0.1 with teachfit robot twin running"
+        )
+    if duration is not None:
+        raise TeachfitError(
+            f"--hand {hand}: the guide sets the recording's length: drop --duration"
+        )
+    try:
+        check_host(host)
+    except TeachfitError:
+        raise TeachfitError(
+            f"--hand {hand}: --host {host} is not loopback: a scripted hand guides only the "
+            "twin (teachfit robot twin); on a real arm a person guides it, drop --hand"
+        ) from None
+    guide = read_guide(hand)
+    return guide, lambda g: send_guide(host, g, f"--hand {hand}"), str(hand)
 
 
 def _check_target(out: Path, append: bool, overwrite: bool) -> None:

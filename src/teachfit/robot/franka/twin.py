@@ -18,6 +18,10 @@ and the Franka Hand (and reports it in the state's ``m_load``); the teachfit dri
 held part (:mod:`teachfit.robot.franka.load`), so the part no longer hangs on the law's
 stiffness.
 
+A scripted hand (a person guiding the arm, as a force profile: :mod:`teachfit.robot.franka.hand`)
+comes over a second loopback port, 1339 (:mod:`teachfit.robot.franka.hand_channel`); the twin
+applies it inside the physics, so the wrench estimate sees it as a person's push.
+
 Loopback only, as the franky-sim launcher (:mod:`teachfit.robot.franka.sim`): every socket of
 the process is confined to 127.0.0.1. ``python -m teachfit.robot.franka.twin --task NAME`` is
 the process :class:`TwinProcess` starts for the tests (its own process group, a READY line,
@@ -63,6 +67,7 @@ def serve(
     """Serve ``task``'s cell on ``host`` (loopback) until Ctrl-C (``KeyboardInterrupt``) or
     ``SystemExit``; calls ``ready(address)`` once it listens. :class:`TeachfitError` for a
     non-loopback host or a port already taken."""
+    from teachfit.robot.franka.hand_channel import HandChannel
     from teachfit.robot.franka.sim import confine_to_loopback
     from teachfit.robot.franka.twin_cell import TwinSimulator
     from teachfit.robot.franka.twin_firmware import TwinSimulationServer
@@ -73,7 +78,7 @@ def serve(
         raise TeachfitError(why)
     confine_to_loopback()
     sim = TwinSimulator(task, params)
-    with sim, TwinSimulationServer(sim, host, realtime=realtime) as server:
+    with HandChannel(host, sim.hand.take), sim, TwinSimulationServer(sim, host, realtime) as server:
         ready(host)
         server.run_forever()
 

@@ -25,7 +25,9 @@ estimates ``tau_ext_hat_filtered``. A fixed per-joint offset (``TwinParams.torqu
 once from the seed; 0.2 N·m std reads 0.5-2 N at the hand at rest) stands for the sensors'
 calibration and the model's errors: a real arm reads a few newtons at rest without contact
 (franka_ros issue #404). :meth:`TwinSimulator.external_wrench` turns the estimate into
-libfranka's ``O_F_ext_hat_K`` (see there for the sign).
+libfranka's ``O_F_ext_hat_K`` (see there for the sign). A scripted hand
+(:attr:`TwinSimulator.hand`, :mod:`teachfit.robot.franka.twin_hand`) pushes the held part as a
+person guiding the arm would, as an external force inside the physics.
 """
 
 from __future__ import annotations
@@ -46,6 +48,8 @@ from teachfit.robot.fr3.ik import solve_ik
 from teachfit.robot.fr3.params import READY_Q, FR3Params
 from teachfit.robot.fr3.sensing import JointTorqueObserver
 from teachfit.robot.franka.frames import DEFAULT_BASE2WORLD
+from teachfit.robot.franka.hand import HandParams
+from teachfit.robot.franka.twin_hand import TwinHand
 from teachfit.tasks.base import Task
 
 #: libfranka's F_T_EE translation for the Franka Hand (m along the flange axis)
@@ -146,6 +150,8 @@ class TwinSimulator(BaseSimulator):
         # the fr3 robot's joint constants, for the Stribeck term of each step (no limit checks)
         self._joints = (np.zeros(0), np.zeros(0), np.zeros(0), *cell.stribeck())
         self._jac = np.zeros((6, self.model.nv))
+        #: a scripted hand (:mod:`teachfit.robot.franka.twin_hand`), idle until a guide comes
+        self.hand = TwinHand(self.model, self.data, task, HandParams())
 
     def start_q(self) -> np.ndarray:
         """Joint angles (rad) placing the TCP at ``params.start`` from the hole's contact pose."""
@@ -172,6 +178,7 @@ class TwinSimulator(BaseSimulator):
         d.qpos[self.robot._qpos_addrs] = self.robot.initial_q
         mujoco.mj_forward(m, d)
         self.observer.reset()
+        self.hand.guide = None
 
     def _get_robots(self) -> list[Any]:
         return [self.robot]
@@ -185,6 +192,7 @@ class TwinSimulator(BaseSimulator):
             self.observer.draw_noise()
             sc[kernel.NOISE_I] = 0.0
         bufs[0][:] = self.data.qvel  # dq before the step
+        self.hand.apply()  # a person's push: external, so the observer sees it
         kernel.step_physics(fns, m_ptr, d_ptr, dat, self._joints)
         kernel.observe(fns, m_ptr, d_ptr, dat, bufs, sc)
 
