@@ -1,6 +1,5 @@
 import functools
 import os
-import re
 import shutil
 import tempfile
 import uuid
@@ -90,19 +89,6 @@ from franka_fixtures import (  # noqa: E402, F401
     robot_port,
 )
 
-#: the fixtures that take 127.0.0.1:1337 and with it the machine-wide lock, which a pytest-xdist
-#: worker holds to the end of its run once it has them
-_PORT_FIXTURES = re.compile(r"\b(franka_port|franka_sim|robot_port|franka_twin|listener)\b")
-
-
-@functools.cache
-def _uses_the_port(path: str) -> bool:
-    """Whether the test file ``path`` (relative to the root) asks for a port fixture."""
-    try:
-        return _PORT_FIXTURES.search((ROOT / path).read_text()) is not None
-    except OSError:
-        return False
-
 
 @pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
@@ -110,11 +96,12 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
     one wherever a worker is free: a second worker would otherwise wait at its first such test
     for the lock until the first worker's run ends (pytest-xdist's ``xdist_group`` marks do not
     reach its scheduler under this pytest)."""
+    from port_schedule import uses_the_port
     from xdist.scheduler import LoadScopeScheduling
 
     class PortScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
             path = nodeid.split("::", 1)[0]
-            return "robot-port" if _uses_the_port(path) else nodeid
+            return "robot-port" if uses_the_port(ROOT / path) else nodeid
 
     return PortScheduling(config, log)
