@@ -141,3 +141,22 @@ def test_feedforward_never_below_the_sliding_friction_while_moving():
     push = FollowConfig().push_force
     assert friction_floor(get_task("peg2d"), FollowConfig()) == pytest.approx(0.3 * (push + 0.981))
     assert friction_floor(get_task("socket3d"), FollowConfig()) == 0.0  # no hint: no floor
+
+
+def test_a_fit_task_s_sharp_part_is_searched_as_the_joined_skill_searches_it():
+    from types import SimpleNamespace
+
+    from teachfit.execution.search import FIT_TILT_RAMP, task_follow_config
+    from teachfit.skills.fit_context import FitGeometry, search_tilt_context
+
+    params = SimpleNamespace(hole_pos_sigma=5e-4, friction=0.3)
+    sharp = SimpleNamespace(part_half_width=0.008, clearance=1e-4, tip_chamfer=0.0, params=params)
+    tilt = task_follow_config(sharp).tilt  # type: ignore[arg-type]
+    want = search_tilt_context(FitGeometry(0.008, 1e-4, 0.0, 5e-4))
+    assert tilt is not None and tilt.angle == want["search_tilt"]
+    assert tilt.lead == pytest.approx(want["search_lead"])
+    assert tilt.lateral_reach == pytest.approx(want["search_reach"])
+    assert tilt.drop_depth == want["search_drop"] and tilt.ramp_time == FIT_TILT_RAMP
+    assert tilt.retry_angle == pytest.approx(want["search_retry_tilt"])  # acos(8/8.1) < 0.25
+    chamfered = SimpleNamespace(**{**vars(sharp), "tip_chamfer": 5e-4})
+    assert task_follow_config(chamfered).tilt is None  # type: ignore[arg-type]

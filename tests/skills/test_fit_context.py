@@ -36,7 +36,9 @@ def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_li
     extra = t_lateral - DEFAULTS["t_lateral"] + 2 * (t_lateral + 1.0)
     assert values["t_max"] == pytest.approx(DEFAULTS["t_max"] + extra)
     assert values["t_reach"] == pytest.approx(start / (DEFAULTS["v_lateral"] * 0.25))
-    assert domains["tilt"].high == pytest.approx(math.acos(0.004 / 0.0041))  # 0.22 rad
+    # the jam-free tilt is 0.22 rad; turned upright about the TCP the low rim rises <= 0.45 mm
+    assert math.acos(0.004 / 0.0041) > math.asin(4.5e-4 / 0.004)
+    assert domains["tilt"].high == pytest.approx(math.asin(4.5e-4 / 0.004))  # 0.11 rad
     # the joined skill's search of a sharp edge is tilted, retried at the jam-free tilt
     assert values["search_tilt"] == 0.25
     assert values["search_retry_tilt"] == pytest.approx(math.acos(0.004 / 0.0041))
@@ -50,8 +52,10 @@ def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() ->
     assert values["f_push"] == DEFAULTS["f_push"]
     assert "search_tilt" not in values  # a chamfer catches an upright search
     assert values["lateral_offset"] == pytest.approx(-(0.005 + 0.0055 + 6e-4))
-    assert math.acos(0.0045 / 0.0055) > 0.3  # the fit allows more than the skill's own
-    assert domains["tilt"].high == 0.3
+    assert math.acos(0.0045 / 0.0055) > 0.3  # the fit allows more than the skill's own,
+    assert domains["tilt"].high == pytest.approx(math.asin(4.5e-4 / 0.005))  # the turn less
+    _, wide_domains = fit_context(FitGeometry(0.001, 5e-4, 5e-4, 2e-4), DEFAULTS, 0.25, TILT)
+    assert wide_domains["tilt"].high == 0.3  # a part 2 mm wide: the skill's own domain
     # a top that ends nearer: the start stays over it
     near, _ = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4, 0.008), DEFAULTS, 0.25, TILT)
     assert near["lateral_offset"] == -0.008

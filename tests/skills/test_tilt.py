@@ -276,3 +276,9 @@ def test_a_tilted_pass_drops_in_where_an_upright_one_slides_over(sharp_pass):
     assert logged == ["search", "lateral", "align"]  # the run log shows the active phase
     upright = run_trajectory(robot, task, traj, start, dataclasses.replace(cfg, tilt=None))
     assert not upright.success and not upright.ground_truth_inserted
+
+
+def test_a_negative_ramp_time_is_an_error() -> None:
+    assert TiltConfig(ramp_time=0.5).ramp_time == 0.5
+    with pytest.raises(SkillError, match="ramp_time"):
+        TiltConfig(ramp_time=-0.1)

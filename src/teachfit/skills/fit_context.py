@@ -39,14 +39,22 @@ upright about that rim into the hole. With ``R = r + c`` the hole's half width:
   entry, and the part turned upright there stood on the top; a part centred on the hole's
   line may stop at the far edge without dipping (TCP 0.4 mm above the entry, 0.1 mm past
   the axis);
-* the tilt domain ``(0, min(0.3, acos((r - e) / R)))``: turning upright about the far wall,
-  the high rim clears the near edge for any depth (*Jams* in :mod:`teachfit.skills.tilt`);
+* the tilt domain ``(0, min(0.3, acos((r - e) / R), align_tilt))``: turning upright about
+  the far wall, the high rim clears the near edge for any depth (*Jams* in
+  :mod:`teachfit.skills.tilt`);
 * ``t_lateral = (|lateral_offset| + R) / (v_lateral s_low)`` with ``s_low`` the lowest learned
   ``speed_factor``: the slowest move still reaches the far wall; ``t_max`` grows by as much as
   ``t_lateral`` does over its default, plus two passes of ``t_lateral + 1 s``; a skill that
   gives the lateral move up early (the joined skill's switch to a search,
   :mod:`teachfit.skills.peg_in_hole_search`) waits ``t_reach = |lateral_offset| / (v_lateral
   s_low)``, the slowest move's time to the taught axis;
+* the tilt at most :attr:`FitGeometry.align_tilt`, ``r sin(tilt) <= 0.45 mm``: ``align``
+  turns the part upright about the TCP, which lifts the low rim, caught at the far wall, by
+  ``r sin(tilt)`` and lowers the high one as much onto the near edge. With the skill's 0.1
+  rad a part 16 mm wide (``r`` 8 mm, 0.8 mm) stood on the top after the turn, 1.1 mm off the
+  axis (round16-sharp-blind and rect16x10-chamfer-blind on the floating tool, 10 held-out
+  set-ups: 0/10 each); at 0.075 rad (0.6 mm) 11/20 and 4/20, at 0.06 and 0.05 rad 20/20
+  each on both robots; a part 8 mm wide keeps 0.1 rad (0.4 mm; the round-peg example 20/20);
 * a sharp leading rim (``e < c``) is pressed with half the default ``f_push``: pressed with
   4 N it caught on the seam between the plate's convex pieces (a resistance of 4.2 N along
   +x with the TCP still on the top, 4 of 10 executions); with 2 N it slid over it (10/10).
@@ -73,6 +81,9 @@ WALL_SHARE = 2.0
 PASS_TIME = 1.0
 #: share of the default press a sharp leading rim gets (see the module docstring)
 SHARP_PUSH = 0.5
+#: the most the low rim may rise (m) when ``align`` turns the part upright about the TCP
+#: (see the module docstring)
+ALIGN_RISE = 4.5e-4
 #: the joined skill's search tilt for a sharp-edged part (rad) and the sink felt as a drop
 #: (m): those of the tilted search on the sharp-edged task variants (``peg2d``)
 SEARCH_TILT, SEARCH_DROP = 0.25, 2.5e-4
@@ -109,6 +120,12 @@ class FitGeometry:
     def hole_half_width(self) -> float:
         """``R = r + c`` (m)."""
         return self.half_width + self.clearance
+
+    @property
+    def align_tilt(self) -> float:
+        """``asin(ALIGN_RISE / r)`` (rad): the largest tilt whose turn upright about the TCP
+        lifts the low rim by at most :data:`ALIGN_RISE` (``r sin(tilt)``)."""
+        return math.asin(min(1.0, ALIGN_RISE / self.half_width))
 
     @property
     def max_tilt(self) -> float:
@@ -170,7 +187,7 @@ def fit_context(
     }
     if fit.tip_chamfer < fit.clearance:
         values |= search_tilt_context(fit)
-    return values, {"tilt": ParamDomain(tilt.low, min(tilt.high, fit.max_tilt))}
+    return values, {"tilt": ParamDomain(tilt.low, min(tilt.high, fit.max_tilt, fit.align_tilt))}
 
 
 def search_tilt_context(fit: FitGeometry) -> dict[str, float]:

@@ -45,8 +45,12 @@ conditions that move it on in :mod:`teachfit.skills.tilt_conditions`, what the p
 Lead. The point that feels the hole is the low rim, ``r cos(angle)`` ahead of the axis along
 ``d``; a trajectory planned for where the hole may be is planned for that point, so the
 follower moves its set-points back by ``lead`` along ``d`` (:func:`rim_lead`; ramped in over
-``LEAD_TIME`` at the start). Without it the rim swept the planned region shifted a radius
-ahead, and a wide part's tour passed with the rim 10-14 mm from the hole's centre (Ø 30 mm,
+``LEAD_TIME`` at the start). The tilt itself turns in from upright over ``ramp_time`` (s,
+0: at once) where a config asks: the parts suite's sharp round parts, searched alone on the
+floating tool (10 starts), found their holes 8/10 and 7/10 (round8, round16) with the tilt at
+once and 9/10 and 10/10 with it turned in over 0.5 s. Without the lead the rim swept the
+planned region shifted a radius ahead, and a wide part's tour passed with the rim 10-14 mm
+from the hole's centre (Ø 30 mm,
 0.5 mm, μ 0.5, 5 of 20 starts): the part sinks deep enough to feel only where the rim is
 near the hole's line along ``d`` (offset across it, its neighbours on the rim rest on the top
 beside the hole and it sinks a fraction of a millimetre).
@@ -110,6 +114,7 @@ class TiltConfig:
     retry_angle: float | None = None
     off_depth: float | None = None
     lead: float = 0.0
+    ramp_time: float = 0.0
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.angle) and 0.0 < self.angle < 0.6):
@@ -124,6 +129,8 @@ class TiltConfig:
             raise SkillError(
                 f"tilt: off_depth must exceed drop_depth ({self.drop_depth}), got {self.off_depth}"
             )
+        if not (math.isfinite(self.ramp_time) and self.ramp_time >= 0.0):
+            raise SkillError(f"tilt: ramp_time must be >= 0 s, got {self.ramp_time}")
         if not (math.isfinite(self.lead) and self.lead >= 0.0):
             raise SkillError(f"tilt: lead must be >= 0 m, got {self.lead}")
         if self.direction is not None and not math.isfinite(self.direction):

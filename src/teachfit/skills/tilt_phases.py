@@ -81,7 +81,9 @@ class _SearchRun(_PhaseRun):
 
     def steer(self, ctx: TiltContext, pc: Percept, out: MPCommand, quat: np.ndarray) -> None:
         ctx.z_top = ctx.reference(pc)
-        ctx.orient(pc, quat, ctx.full)
+        ramp = ctx.cfg.ramp_time  # from upright to the tilt over the search's first ramp_time
+        share = ctx.time(pc) / ramp if ramp > 0.0 else 1.0
+        ctx.orient(pc, quat, ctx.full * min(1.0, share))
 
     def leave(self, pc: Percept) -> None:  # a drop felt: the reference with this tick
         assert self.ctx is not None
