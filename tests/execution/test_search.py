@@ -3,7 +3,7 @@ import pytest
 
 from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
-from teachfit.execution.search import plan_search, run_search, search_setpoints
+from teachfit.execution.search import TRACK_FEEL, plan_search, run_search, search_setpoints
 from teachfit.execution.teacher import BlindTeacher
 from teachfit.models.search_model import SearchModel
 from teachfit.robot.floating import FloatingToolRobot
@@ -104,8 +104,8 @@ def test_follower_config_from_the_task():
     slick = task_follow_config(get_task("peg2d", friction=0.8))  # same lag as at 0.3
     assert slick.stiffness_along * 0.3 == pytest.approx(base.stiffness_along * 0.8)
     assert slick.hold_stiffness == slick.stiffness_across == pytest.approx(400.0)
-    socket = task_follow_config(get_task("socket3d"))  # no hints: the defaults
-    assert socket == base
+    socket = task_follow_config(get_task("socket3d"))  # no hints: the defaults, lag closed
+    assert socket == FollowConfig(track_feel=TRACK_FEEL) and base.track_feel == 0.0
 
 
 def test_sharp_edged_holes_are_searched_tilted_chamfered_ones_upright():
@@ -114,7 +114,9 @@ def test_sharp_edged_holes_are_searched_tilted_chamfered_ones_upright():
     from teachfit.tasks.variants import grid
 
     default = task_follow_config(get_task("peg2d"))  # the default cell's follower as before
-    assert default == FollowConfig(hold_depth=default.hold_depth, hold_stiffness=150.0)
+    assert default == FollowConfig(
+        hold_depth=default.hold_depth, hold_stiffness=150.0, track_feel=TRACK_FEEL
+    )
     assert default.tilt is None
     for v in grid("peg2d"):
         task = v.make()

@@ -1,4 +1,4 @@
-"""The follow primitive's felt-press loop (``press_feel``)."""
+"""The follow primitive's felt-press loop (``press_feel``) and lag loop (``track_feel``)."""
 
 import numpy as np
 import pytest
@@ -57,3 +57,33 @@ def test_once_held_the_lateral_stiffness_is_the_hold_stiffness_every_way():
     assert np.allclose(cmd.stiffness_full[:2, :2], 200.0 * np.eye(2))
     with pytest.raises(Exception, match="hold_stiffness"):
         FollowConfig(hold_stiffness=-1.0)
+
+
+def _drags(cfg, pressed, ticks=200):
+    """The x force the follower adds along a +x trajectory at 10 mm/s, the TCP held at 0."""
+    t = np.array([0.0, 10.0])
+    pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    traj = SetpointTrajectory.from_path(t, pos, np.tile([1.0, 0, 0, 0], (2, 1)))
+    run = FollowSetpoints(traj, cfg).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    run.enter(pc)
+    out = []
+    for k in range(ticks):
+        pc.f[2] = pressed
+        pc.t_node = pc.t = 0.01 * k
+        pc.p[:] = 0.0  # stuck: the set-point runs ahead
+        cmd = MPCommand()
+        run.command(pc, cmd)
+        out.append((cmd.wrench[0], cmd.wrench[1]))
+    return np.array(out)
+
+
+def test_a_lagging_part_is_pushed_along_the_motion_slowly_and_bounded():
+    f = _drags(FollowConfig(track_feel=0.1), pressed=6.0)
+    assert np.all(f[:, 1] == 0.0) and np.all(np.diff(f[:, 0]) >= 0.0)  # along x only, growing
+    # the integral of k_along x lag over 0.1 s: at tick k the set-point leads by 1e-4 k m
+    lags = 1e-4 * np.arange(10)
+    assert f[9, 0] == pytest.approx(1500.0 * 0.01 / 0.1 * lags.sum())
+    assert f[-1, 0] == 6.0  # clipped at the push force
+    assert np.all(_drags(FollowConfig(track_feel=0.1), pressed=1.0) == 0.0)  # not pressed
+    assert np.all(_drags(FollowConfig(), pressed=6.0) == 0.0)  # off by default

@@ -39,7 +39,12 @@ class FollowConfig:
     part (a hand that felt the drop also relaxes sideways). ``tilt`` (None: upright): search
     with the part tilted, and on the drop slide it to the hole's wall and align it upright
     (:mod:`teachfit.skills.tilt`: a skill graph of its own; its align node is a hold, with
-    ``hold_stiffness``).
+    ``hold_stiffness``). ``track_feel`` (s), when positive and upright, closes a slow loop on
+    the lag along the motion, as a person who feels the part drag pushes harder: while the
+    part is pressed on a surface, a force along the motion grows by ``stiffness_along`` times
+    the set-point's lead over the TCP along it, integrated over ``track_feel`` (clipped to
+    ``[0, push_force]``: at most the friction of a coefficient 1); 0 (the default) follows
+    with the feed-forward alone.
     """
 
     stiffness_along: float = 1500.0
@@ -55,9 +60,11 @@ class FollowConfig:
     hold_depth: float | None = None
     hold_stiffness: float | None = None
     tilt: TiltConfig | None = None
+    track_feel: float = 0.0
 
     def __post_init__(self) -> None:
         for name in (
+            "track_feel",
             "stiffness_along",
             "stiffness_across",
             "stiffness_z",
@@ -100,6 +107,7 @@ class Follower:
         self.direction = np.array([1.0, 0.0])
         self.offset = np.zeros(3)
         self.press_correction = 0.0
+        self.track_correction = 0.0
         self.hold: np.ndarray | None = None
         self.z0 = 0.0
 
@@ -108,7 +116,7 @@ class Follower:
         self.direction[:] = (1.0, 0.0)
         self.offset[:] = pc.p_d - self.traj.pos[0] if self.cfg.anchor == "entry" else 0.0
         pc.done = False
-        self.press_correction = 0.0
+        self.press_correction = self.track_correction = 0.0
         self.z0, self.hold = float(pc.p[2]), None
 
     def track(self, pc: Percept, out: MPCommand, t_traj: float) -> np.ndarray:
@@ -131,7 +139,19 @@ class Follower:
                 lim = 0.5 * cfg.push_force
                 self.press_correction = min(lim, max(-lim, self.press_correction + step))
             out.wrench[2] -= self.press_correction
+        if cfg.track_feel > 0.0 and cfg.tilt is None:
+            self._track_loop(pc, out)
         return quat
+
+    def _track_loop(self, pc: Percept, out: MPCommand) -> None:
+        """``track_feel``'s loop (see :class:`FollowConfig`): the force along the motion."""
+        cfg = self.cfg
+        u = self.direction / max(1e-12, math.hypot(self.direction[0], self.direction[1]))
+        if pc.f[2] > 0.5 * cfg.push_force:  # pressed on a surface: the lag is its friction
+            lag = float((pc.p_d[0] - pc.p[0]) * u[0] + (pc.p_d[1] - pc.p[1]) * u[1])
+            step = cfg.stiffness_along * lag * pc.dt / cfg.track_feel
+            self.track_correction = min(cfg.push_force, max(0.0, self.track_correction + step))
+        out.wrench[:2] += self.track_correction * u
 
     def hold_still(self, pc: Percept, out: MPCommand) -> None:
         """Where the part is held: the x-y set-point stays there, only the push goes on."""
