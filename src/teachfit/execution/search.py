@@ -24,6 +24,7 @@ from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.skills.fit_context import fit_of, search_tilt_context
 from teachfit.skills.follow import FollowConfig
+from teachfit.skills.follower import TRACK_FEEL
 from teachfit.skills.tilt import TiltConfig, rim_lead, tilted_drop, wedge_lag
 from teachfit.tasks.base import Task
 from teachfit.trajectories import SearchTrajectory, TshixPlanner
@@ -35,13 +36,6 @@ _WRENCH_INDEX = {"x": 0, "y": 1, "z": 2, "rz": 5}
 #: m past the deepest a tilted part sinks into the hole that means it left the top instead
 #: (the tilt gives under the contact torque; the set-point leads the sinking part)
 OFF_MARGIN = 0.002
-#: s, the follower's loop on its lag along the motion (:class:`FollowConfig` ``track_feel``).
-#: Without it the FR3's part trailed its set-point by 0.5-1.5 mm (median per start; the arm's
-#: joint friction, which the demonstration's feed-forward does not cover everywhere) and the
-#: tour passed the hole 1.1-1.5 mm off where it was planned within 0.2 mm: arm Table I
-#: (30 starts, the same run) TSHIX 24 -> 27/30, TSHIX-iid 25 -> 28/30, ergodic 18 -> 24/30 with
-#: 0.1 s (0.3 s: 27, 28, 23); on the floating tool 30, 28, 26 -> 30, 27, 27
-TRACK_FEEL = 0.1
 #: s over which a fit task's tilted search turns from upright to its tilt (see
 #: :class:`~teachfit.skills.tilt.TiltConfig`; the joined skill's blend, ``TILT_BLEND``)
 FIT_TILT_RAMP = 0.5

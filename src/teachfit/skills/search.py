@@ -47,6 +47,7 @@ from teachfit.core.setpoints import SetpointTrajectory
 from teachfit.models.exploration import ExplorationDistribution
 from teachfit.models.search_model import SearchModel
 from teachfit.skills.follow import FollowConfig, _FollowRun
+from teachfit.skills.follower import TRACK_FEEL
 from teachfit.skills.params import Value, resolve
 from teachfit.skills.percept import MPCommand, Percept
 from teachfit.skills.primitive import Primitive, PrimitiveRun
@@ -173,7 +174,7 @@ class LearnedSearch(Primitive):
     seed: Value = "search_seed"
     radius: Value = "search_radius"
     repeat: Value = "search_repeat"
-    follow: FollowConfig = FollowConfig(settle_time=0.0)
+    follow: FollowConfig = FollowConfig(settle_time=0.0, track_feel=TRACK_FEEL)
     kind: ClassVar[str] = "learned_search"
 
     def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
