@@ -116,3 +116,38 @@ def test_a_fit_extends_the_skill_s_own_time_limit(mesh_examples: dict[str, str])
     extra = t_lateral - own["t_lateral"] + 2 * (t_lateral + 1.0)
     assert ctx.values["t_max"] == pytest.approx(own["t_max"] + extra)
     assert ctx.values["t_max"] > plain.values["t_max"] + 10.0  # the search's time kept
+
+
+def test_a_sharp_rectangle_goes_corner_first_and_a_chamfered_one_does_not() -> None:
+    from teachfit.skills.fit_context import CORNER_K, CORNER_ROLL, CORNER_SLOPE
+
+    # rect12x8-sharp-through: r = 6 mm along the move, w = 4 mm across, c = 0.1 mm
+    rect = FitGeometry(0.006, 1e-4, 0.0, 5e-4, corner=0.004)
+    values, domains = fit_context(rect, DEFAULTS, 0.25, TILT)
+    plain, _ = fit_context(FitGeometry(0.006, 1e-4, 0.0, 5e-4), DEFAULTS, 0.25, TILT)
+    start = -values["lateral_offset"]
+    assert values["lateral_dir_y"] == -CORNER_SLOPE and values["lateral_dir"] == -1.0
+    assert values["start_y"] == pytest.approx(CORNER_SLOPE * start)  # through the taught axis
+    assert values["roll"] == CORNER_ROLL and values["k_across"] == CORNER_K
+    assert values["roi"] > math.hypot(start, CORNER_SLOPE * start)  # the start is inside
+    assert values["t_lateral"] == pytest.approx(plain["t_lateral"] * math.hypot(1, CORNER_SLOPE))
+    assert values["t_max"] > plain["t_max"]
+    # the roll lifts the low corner by w sin(roll) as it turns upright: the tilt is left less
+    rise = 4.5e-4 - 0.004 * math.sin(CORNER_ROLL)
+    assert domains["tilt"].high == pytest.approx(math.asin(rise / 0.006))
+    chamfered, _ = fit_context(
+        FitGeometry(0.006, 1e-4, 5e-4, 5e-4, corner=0.004), DEFAULTS, 0.25, TILT
+    )
+    assert "roll" not in chamfered and "lateral_dir_y" not in chamfered  # a chamfer catches
+
+
+def test_fit_of_gives_a_non_round_part_its_corner() -> None:
+    from types import SimpleNamespace
+
+    from teachfit.skills.fit_context import fit_of
+
+    base = {"part_half_width": 0.006, "clearance": 1e-4, "tip_chamfer": 0.0}
+    rect = SimpleNamespace(**base, part_half_depth=0.004, rz_period=math.pi)
+    round_ = SimpleNamespace(**base, part_half_depth=0.006, rz_period=0.0)
+    assert fit_of(rect).corner == 0.004  # type: ignore[union-attr]
+    assert fit_of(round_).corner == 0.0  # type: ignore[union-attr]

@@ -323,3 +323,25 @@ def test_with_domains_bounds_a_learned_parameter_and_clips_its_default():
         sk.with_domains({"stiffness_z": ParamDomain(0.0, 1.0)})
     fixed = peg_in_hole.build("impedance").with_fixed({"tilt": 0.05})
     assert "tilt" not in fixed.with_domains({"tilt": ParamDomain(0.0, 0.1)}).space.names
+
+
+def test_move_to_turns_to_rz_ry_rx_of_yaw_tilt_and_roll() -> None:
+    from scipy.spatial.transform import Rotation
+
+    from teachfit.core.geometry import Pose, wxyz_to_rotation
+    from teachfit.skills.percept import MPCommand, Percept
+
+    run = MoveTo(yaw=0.2, tilt=-0.1, roll=0.05, w_max=10.0, dw_max=100.0).compile({})
+    pc = Percept(Pose(np.zeros(3)), 0.001)
+    run.enter(pc)
+    turn = np.zeros(3)
+    while not pc.done:
+        out = MPCommand()
+        run.command(pc, out)
+        turn += out.twist[3:] * pc.dt
+        pc.t_node += pc.dt
+    want = Rotation.from_euler("ZYX", [0.2, -0.1, 0.05])
+    got = Rotation.from_rotvec(turn) * wxyz_to_rotation(pc.q_d)
+    assert (got.inv() * want).magnitude() < 1e-3
+    low = want.apply([[0.0, -0.004, 0.0], [0.0, 0.004, 0.0]])[:, 2]
+    assert low[0] < low[1]  # a positive roll lowers the -y side

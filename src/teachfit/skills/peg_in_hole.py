@@ -20,7 +20,8 @@ surface); the lateral move runs along its +x. Five primitives:
    approach pose ``pass_y`` to one side (``approach_2``, ``contact_2``, ``lateral_2``), then
    to the other (``_3``); with the defaults (``pass_end`` 1 m) never (a task's fit sets
    them: :mod:`teachfit.skills.fit_context`, as ``wall_depth`` and ``wall_x``, where along
-   -x a resistance ``f_lateral_rev`` or a stop counts).
+   -x a resistance ``f_lateral_rev`` or a stop counts; a sharp rectangle's fit moves it corner
+   first: rolled by ``roll``, from ``y = start_y``, along ``(lateral_dir, lateral_dir_y)``).
 4. ``align``     rotate upright into the estimated hole orientation (the nearest yaw modulo
    the part's symmetry ``rz_period``) keeping contact with ``f_push``.
 5. ``insert``    push with the learned ``force`` while the set-point sinks to ``depth``,
@@ -77,6 +78,11 @@ CONTEXT: dict[str, ContextParam] = {
         0.003, "m", "approach pose at x = -lateral_offset (before the hole for lateral_dir 1)"
     ),
     "lateral_dir": ContextParam(1.0, "", "lateral move along +x (1) or -x (-1: low rim first)"),
+    "lateral_dir_y": ContextParam(0.0, "", "the lateral move's y component (0: along x)"),
+    "start_y": ContextParam(0.0, "m", "y of the first approach pose"),
+    "roll": ContextParam(
+        0.0, "rad", "approach: the part rolled about x, its -y side lower (a corner first)"
+    ),
     "roi": ContextParam(0.012, "m", "region of interest: radius around the hole axis"),
     "rz_period": ContextParam(0.0, "rad", "symmetry of the part about z (0: none)"),
     "v_max": ContextParam(0.1, "m/s", "translational speed limit"),
@@ -177,7 +183,7 @@ def _reach_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
     """``approach``, ``contact`` and ``lateral`` (see :func:`_pass_nodes`), and the same for
     the extra passes ``pass_y`` to either side (``_2``: +y, ``_3``: -y)."""
     return (
-        _pass_nodes("", 0.0, fast, roi)
+        _pass_nodes("", "start_y", fast, roi)
         + _pass_nodes("_2", "pass_y", fast, roi)
         + _pass_nodes("_3", "-pass_y", fast, roi)
     )
@@ -194,6 +200,7 @@ def _pass_nodes(suffix: str, y: Value, fast: _Speeds, roi: LateralAbove) -> tupl
                 goal=("-lateral_offset", y, "approach_height"),
                 yaw=0.0,
                 tilt="-tilt",
+                roll="roll",
                 rz_period="rz_period",
                 stiffness=_STIFF_FREE,
                 **fast,
@@ -215,7 +222,7 @@ def _pass_nodes(suffix: str, y: Value, fast: _Speeds, roi: LateralAbove) -> tupl
         Node(
             "lateral" + suffix,
             Move(
-                direction=("lateral_dir", 0.0, 0.0),
+                direction=("lateral_dir", "lateral_dir_y", 0.0),
                 speed="v_lateral",
                 speed_factor="speed_factor",
                 push="f_push",

@@ -123,9 +123,9 @@ def _stiffness(values: Mapping[str, float], vec: Vec6V) -> np.ndarray:
     return k
 
 
-def _quat_rz_ry(yaw: float, tilt: float) -> np.ndarray:
-    """``Rz(yaw) Ry(tilt)`` (rad, intrinsic z then y) as a quaternion (w, x, y, z)."""
-    return rotation_to_wxyz(Rotation.from_euler("ZY", [yaw, tilt]), canonical=False)
+def _quat_rz_ry(yaw: float, tilt: float, roll: float = 0.0) -> np.ndarray:
+    """``Rz(yaw) Ry(tilt) Rx(roll)`` (rad, intrinsic z, y, x) as a quaternion (w, x, y, z)."""
+    return rotation_to_wxyz(Rotation.from_euler("ZYX", [yaw, tilt, roll]), canonical=False)
 
 
 def _check_len(name: str, vec: tuple[Value, ...] | None, n: int) -> None:
@@ -138,18 +138,19 @@ class MoveTo(Primitive):
     """Move the set-point to a goal pose along a synchronised trapezoidal profile.
 
     ``goal`` (m, task frame; ``relative=True``: an offset from the entry set-point; ``None``:
-    keep the position). The goal orientation is ``Rz(yaw) Ry(tilt)`` in the task frame
-    (``None``: keep the orientation); with ``rz_period > 0`` the yaw goal is shifted by whole
-    periods to the one nearest the entry yaw (symmetric parts). Translation and rotation share
-    one time scaling within ``v_max``, ``a_max`` (m/s, m/s²) and ``w_max``, ``dw_max``
-    (rad/s, rad/s²); ``speed_factor`` scales time, i.e. speeds by it and accelerations by its
-    square. ``push`` (N) is a feed-forward force along the task -z.
+    keep the position). The goal orientation is ``Rz(yaw) Ry(tilt) Rx(roll)`` in the
+    task frame (``None``: keep the orientation); with ``rz_period > 0`` the yaw goal is
+    shifted by whole periods to the one nearest the entry yaw (symmetric parts). Translation
+    and rotation share one time scaling within ``v_max``, ``a_max`` (m/s, m/s²) and
+    ``w_max``, ``dw_max`` (rad/s, rad/s²); ``speed_factor`` scales time, i.e. speeds by it
+    and accelerations by its square. ``push`` (N) is a feed-forward force along the task -z.
     """
 
     goal: Vec3V | None = None
     relative: bool = False
     yaw: Value | None = None
     tilt: Value | None = None
+    roll: Value = 0.0
     rz_period: Value = 0.0
     v_max: Value = 0.05
     a_max: Value = 0.5
@@ -173,7 +174,9 @@ class MoveTo(Primitive):
             relative=self.relative,
             q_goal=None
             if self.yaw is None or self.tilt is None
-            else _quat_rz_ry(resolve(self.yaw, values), resolve(self.tilt, values)),
+            else _quat_rz_ry(
+                resolve(self.yaw, values), resolve(self.tilt, values), resolve(self.roll, values)
+            ),
             rz_period=_nonneg("rz_period", resolve(self.rz_period, values)),
             v=_positive("v_max", resolve(self.v_max, values)) * sf,
             a=_positive("a_max", resolve(self.a_max, values)) * sf * sf,

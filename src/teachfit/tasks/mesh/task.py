@@ -186,6 +186,14 @@ class MeshTask(SkillTask):
         return float(np.abs(body[:, 0]).max())
 
     @property
+    def part_half_depth(self) -> float:
+        """The held part's half width across the task x (m): its largest ``|y|`` (TCP frame)
+        over the length that enters the hole."""
+        verts = self.cell.held.vertices
+        body = verts[verts[:, 2] <= verts[:, 2].min() + self.hole_depth]
+        return float(np.abs(body[:, 1]).max())
+
+    @property
     def tip_chamfer(self) -> float:
         """How much narrower along x (m) the held part's tip face is than its body (0: a sharp
         edge)."""
