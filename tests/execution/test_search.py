@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 
@@ -150,6 +152,7 @@ def test_a_fit_task_s_sharp_part_is_searched_as_the_joined_skill_searches_it():
 
     from teachfit.execution.search import FIT_TILT_RAMP, task_follow_config
     from teachfit.skills.fit_context import FitGeometry, search_tilt_context
+    from teachfit.skills.tilt import rim_lead
 
     params = SimpleNamespace(hole_pos_sigma=5e-4, friction=0.3)
     sharp = SimpleNamespace(part_half_width=0.008, clearance=1e-4, tip_chamfer=0.0, params=params)
@@ -162,3 +165,9 @@ def test_a_fit_task_s_sharp_part_is_searched_as_the_joined_skill_searches_it():
     assert tilt.retry_angle == pytest.approx(want["search_retry_tilt"])  # acos(8/8.1) < 0.25
     chamfered = SimpleNamespace(**{**vars(sharp), "tip_chamfer": 5e-4})
     assert task_follow_config(chamfered).tilt is None  # type: ignore[arg-type]
+    assert tilt.corner is None  # round: the tilt follows the path
+    rect = SimpleNamespace(**{**vars(sharp), "part_half_width": 0.006})
+    rect.part_half_depth, rect.rz_period = 0.004, math.pi
+    corner = task_follow_config(rect).tilt  # type: ignore[arg-type]
+    assert corner is not None and corner.corner == pytest.approx(math.atan2(0.004, 0.006))
+    assert corner.lead == pytest.approx(rim_lead(corner.angle, 2 * math.hypot(0.006, 0.004)))

@@ -2,6 +2,7 @@
 sequence of one execution, and a pass over a sharp hole that an upright peg misses."""
 
 import dataclasses
+import math
 from typing import Any
 
 import numpy as np
@@ -282,3 +283,14 @@ def test_a_negative_ramp_time_is_an_error() -> None:
     assert TiltConfig(ramp_time=0.5).ramp_time == 0.5
     with pytest.raises(SkillError, match="ramp_time"):
         TiltConfig(ramp_time=-0.1)
+
+
+def test_a_non_round_part_leans_toward_its_corner_nearest_the_path() -> None:
+    corner = math.atan2(0.004, 0.006)  # a 12 x 8 mm rectangle
+    path = np.array([[0.0, 0.0], [0.01, 0.001], [0.02, -0.001]])  # toward +x, a little +y
+    assert np.allclose(TiltConfig().unit(path), [1.0, 0.0])  # round: along the path
+    d = TiltConfig(corner=corner).unit(path)
+    assert np.allclose(d, [math.cos(corner), math.sin(corner)])
+    down = np.array([[0.0, 0.0], [-0.001, -0.01], [-0.002, -0.02]])  # -y, a little -x
+    back = TiltConfig(corner=corner).unit(down)
+    assert np.allclose(back, [-math.cos(corner), -math.sin(corner)])

@@ -8,6 +8,7 @@ demonstration is translated so that its first pose is the origin.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
@@ -292,14 +293,20 @@ def _fit_tilt(task: Task, stiffness: float, load: float) -> TiltConfig | None:
         return None
     ctx = search_tilt_context(fit)
     retry = ctx["search_retry_tilt"]
+    lead, reach, corner = ctx["search_lead"], ctx["search_reach"], None
+    if fit.corner > 0.0:  # corner first: the corner leads, the slide reaches the diagonal
+        corner = math.atan2(fit.corner, fit.half_width)
+        lead = rim_lead(ctx["search_tilt"], 2.0 * math.hypot(fit.half_width, fit.corner))
+        reach = 2.0 * math.hypot(fit.hole_half_width, fit.corner + fit.clearance)
     return TiltConfig(
         angle=ctx["search_tilt"],
         retry_angle=retry if 0.0 < retry < ctx["search_tilt"] else None,
         drop_depth=ctx["search_drop"],
-        lateral_reach=ctx["search_reach"],
+        lateral_reach=reach,
         stall_lag=wedge_lag(ctx["search_tilt"], ctx["search_friction"], load, stiffness),
-        lead=ctx["search_lead"],
+        lead=lead,
         ramp_time=FIT_TILT_RAMP,
+        corner=corner,
     )
 
 
