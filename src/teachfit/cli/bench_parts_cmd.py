@@ -49,7 +49,7 @@ def bench_parts(
     starts: Annotated[int, o.starts("of the search, and assemble's trials")] = 20,
     train_setups: Annotated[
         int, typer.Option(min=1, help="training set-ups per learning trial")
-    ] = 4,
+    ] = 8,
     clearance: o.SuiteClearance = 0.2,
     seed: Annotated[int, o.seed("set-ups, starts, demonstrations and trials")] = 0,
     workers: o.Workers = None,
