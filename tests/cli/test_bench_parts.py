@@ -33,9 +33,16 @@ def test_bench_parts_prints_a_row_per_method_with_its_interval(
     res = CliRunner().invoke(app, args, env={"COLUMNS": "200"})
     assert res.exit_code == 0, res.output
     assert seen == [("round8-sharp-through", True, "floating", bp.Sizes(2, 3, 4, 1, workers=None))]
-    rows = [line for line in md.read_text().splitlines() if line.startswith("| round8")]
-    assert [r.split(" | ")[2] for r in rows] == list(bp.METHODS)
-    assert all("1/2 = 50 % [9, 91] | 1.5 s | 1x error-condition: stuck |" in r for r in rows)
+    text = md.read_text()
+    head = next(line for line in text.splitlines() if line.startswith("| part"))
+    assert head == "| part | robot | " + " | ".join(bp.METHODS) + " |"
+    rows = [line for line in text.splitlines() if line.startswith("| round8")]
+    assert rows == ["| round8-sharp-through | floating" + " | 1/2 [9, 91] ✗" * 4 + " |"]
+    misses = [line for line in text.splitlines() if line.startswith("- round8")]
+    assert misses[0] == (
+        "- round8-sharp-through / floating / skill / 1/2 = 50 % [9, 91]: 1x error-condition: stuck"
+    )
+    assert len(misses) == 4
     assert "missed on round8-sharp-through/floating/skill" in res.output
     assert png.is_file()
 

@@ -209,3 +209,17 @@ def rate_cell(s: SuccessSummary) -> str:
     return (
         f"{s.successes}/{s.trials} = {100 * s.rate:.0f} % [{100 * s.low:.0f}, {100 * s.high:.0f}]"
     )
+
+
+def pivot(rows: Sequence[PartRow]) -> tuple[list[str], list[list[str]]]:
+    """The rows as one line per part and robot, a column per method (``k/n [low, high]``,
+    Wilson 95 %; the results page's compact table): ``(columns, lines)``."""
+    methods = list(dict.fromkeys(r.method for r in rows))
+    cells: dict[tuple[str, str], dict[str, str]] = {}
+    for r in rows:
+        s = r.summary
+        mark = "" if s.rate >= GOAL else " ✗"
+        cell = f"{s.successes}/{s.trials} [{100 * s.low:.0f}, {100 * s.high:.0f}]{mark}"
+        cells.setdefault((r.part, r.robot), {})[r.method] = cell
+    lines = [[p, rb, *(got.get(m, "") for m in methods)] for (p, rb), got in cells.items()]
+    return ["part", "robot", *methods], lines

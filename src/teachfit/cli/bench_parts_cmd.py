@@ -112,16 +112,24 @@ def _run(
 
 
 def _report(rows: Sequence[PartRow], title: str, markdown: Path | None, plot: Path | None) -> None:
-    """The table, the goal's misses, the markdown and the figure."""
-    from teachfit.bench.parts import GOAL, goal_misses
+    """The table, the goal's misses, the markdown (one line per part and robot, then each
+    miss with its commonest failure) and the figure."""
+    from teachfit.bench.parts import GOAL, goal_misses, pivot
+    from teachfit.cli.common import append_markdown
 
-    emit_table(title, _COLS, [_cells(r) for r in rows], markdown)
+    emit_table(title, _COLS, [_cells(r) for r in rows], None)
     misses = goal_misses(rows)
     miss = ", ".join(f"{r.part}/{r.robot}/{r.method}" for r in misses)
-    console.print(
-        f"goal >= {100 * GOAL:.0f} % on every row: " + (f"missed on {miss}" if miss else "met")
-    )
+    goal = f"goal >= {100 * GOAL:.0f} % on every row: " + (f"missed on {miss}" if miss else "met")
+    console.print(goal)
     if markdown is not None:
+        cols, lines = pivot(rows)
+        text = [f"**{title}**", "", "| " + " | ".join(cols) + " |", "|" + " --- |" * len(cols)]
+        text += ["| " + " | ".join(c) + " |" for c in lines]
+        text += ["", f"{goal}."] + [
+            f"- {' / '.join(_cells(r)[:4])}: {_cells(r)[5]}" for r in misses
+        ]
+        append_markdown(markdown, "\n".join(text))
         console.print(f"markdown appended to {markdown}")
     if plot is not None:
         from teachfit.viz.parts_figures import save_parts_figure
