@@ -181,17 +181,20 @@ class MeshTask(SkillTask):
     def part_half_width(self) -> float:
         """The held part's half width along the task x (m): its largest ``|x|`` (TCP frame)
         over the length that enters the hole."""
-        verts = self.cell.held.vertices
-        body = verts[verts[:, 2] <= verts[:, 2].min() + self.hole_depth]
-        return float(np.abs(body[:, 0]).max())
+        return self._body_extent(0)
 
     @property
     def part_half_depth(self) -> float:
         """The held part's half width across the task x (m): its largest ``|y|`` (TCP frame)
         over the length that enters the hole."""
+        return self._body_extent(1)
+
+    def _body_extent(self, axis: int) -> float:
+        """The held part's largest ``|coordinate|`` along TCP ``axis`` (m) over the length
+        that enters the hole."""
         verts = self.cell.held.vertices
         body = verts[verts[:, 2] <= verts[:, 2].min() + self.hole_depth]
-        return float(np.abs(body[:, 1]).max())
+        return float(np.abs(body[:, axis]).max())
 
     @property
     def tip_chamfer(self) -> float:
