@@ -118,10 +118,11 @@ def bench_plan_task(
     max_error: float = 0.003,
 ) -> tuple[Rows, dict[str, int]]:
     """(c) the plan open loop vs (d) joined (compliant tracking + seating skill) on the
-    L-groove or tenon cell, the same capture errors (0.5 mm-``max_error``, 0.5-2 deg) for
-    both; rows keyed by ``max_error`` count the simulator's ground truth (the open loop has no
-    success test of its own) with the execution's end time (s); also the *measured* successes
-    per method (the joined skill's own verdict)."""
+    L-groove or tenon cell, on the robot of :func:`~teachfit.bench.search.use_robot`, the
+    same capture errors (0.5 mm-``max_error``, 0.5-2 deg) for both; rows keyed by
+    ``max_error`` count the simulator's ground truth (the open loop has no success test of its
+    own) with the execution's end time (s); also the *measured* successes per method (the
+    joined skill's own verdict)."""
     from teachfit.execution.plan_contact import plan_path, run_plan_trials, timed_path
 
     plan = plan_path(part, seed=seed)
@@ -133,7 +134,7 @@ def bench_plan_task(
     for method in ("open-loop", "joined"):
         out = run_plan_trials(
             part, path, trials, seed, method, lambda _t: progress() if progress else None,
-            translation=(0.0005, max_error),
+            robot_name=ROBOT[0], translation=(0.0005, max_error),
         )  # fmt: skip
         truth = [bool(t.ground_truth) for t in out]
         rows[method] = [(max_error, summarize(truth, [t.result.t_end for t in out]))]

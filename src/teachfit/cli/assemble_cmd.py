@@ -241,11 +241,19 @@ def bench_assembly(
         ),
     ] = "skill,search,open-loop,joined",
     markdown: o.Markdown = None,
+    robot: Annotated[
+        str, typer.Option(help="simulated robot of every trial and demonstration: floating, fr3")
+    ] = "floating",
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
     from teachfit.bench.assembly import bench_inputs, bench_task
+    from teachfit.bench.search import use_robot
     from teachfit.execution.assembly import METHODS
 
+    if robot not in ("floating", "fr3"):
+        raise TeachfitError(f"--robot: choose floating or fr3 (got {robot!r})")
+    use_robot(robot)
+    on = "" if robot == "floating" else f" on {robot}"
     errs = [parse_quantity(e) for e in errors.split(",") if e.strip()]
     names = [t.strip() for t in tasks.split(",") if t.strip()]
     model, learned = bench_inputs(names, search, params, seed)
@@ -255,7 +263,7 @@ def bench_assembly(
     md: list[str] = []
     for name in names:
         if name in ("l-groove", "tenon"):
-            md += _bench_planned(name, trials, seed)
+            md += _bench_planned(name, trials, seed, on)
             continue
         with progress_bar() as bar:
             job = bar.add_task(f"{name}: demonstrations, then trials")
@@ -264,7 +272,7 @@ def bench_assembly(
                 model=model, learned=learned, methods=chosen,
             )  # fmt: skip
         _print_bench(name, rows, errs, bool(learned))
-        md += ["", *_bench_markdown(name, rows, errs, trials)]
+        md += ["", *_bench_markdown(name + on, rows, errs, trials)]
         if plot is not None:
             from teachfit.viz.assembly_figures import plot_success_by_error
 
@@ -291,7 +299,7 @@ def _bench_markdown(name: str, rows: Rows, errs: list[float], trials: int) -> li
     return out
 
 
-def _bench_planned(name: str, trials: int, seed: int) -> list[str]:
+def _bench_planned(name: str, trials: int, seed: int, on: str = "") -> list[str]:
     """``bench assembly`` on a planned part: open loop vs joined, one line each (returned
     as markdown list items too)."""
     from teachfit.bench.assembly import bench_plan_task, losses
@@ -300,7 +308,7 @@ def _bench_planned(name: str, trials: int, seed: int) -> list[str]:
         job = bar.add_task(f"{name}: plan, then trials", total=2 * trials)
         rows, meas = bench_plan_task(name, trials, seed, partial(bar.advance, job))
     lines = [
-        f"{name} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
+        f"{name}{on} {m}: capture error 0.5-{pts[0][0] * 1e3:g} mm, 0.5-2 deg: truly "
         f"inserted {pts[0][1]} (end time); measured success {meas[m]}/{trials}"
         for m, pts in rows.items()
     ]

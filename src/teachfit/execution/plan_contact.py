@@ -264,6 +264,7 @@ def run_plan_trials(
     seed: int = 0,
     method: str = "joined",
     on_trial: Callable[[PlanTrial], None] | None = None,
+    robot_name: str = "floating",
     **error_ranges: tuple[float, float],
 ) -> list[PlanTrial]:
     """``trials`` executions of ``path`` in cells with capture errors from
@@ -273,7 +274,7 @@ def run_plan_trials(
     for i in range(trials):
         cell = trial_cell(part, seed, i, **error_ranges)
         err = cell.params
-        robot = make_robot("floating", cell, seed=i)
+        robot = make_robot(robot_name, cell, seed=i)
         task2world = G_NOMINAL.compose(T2G)
         start = task2world.compose(Pose(path.pos[0], path.quat[0]))
         res = execute(
