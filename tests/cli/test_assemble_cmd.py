@@ -103,3 +103,24 @@ def test_bench_assembly_appends_its_table_as_markdown(tmp_path, monkeypatch):
     assert text.startswith("<!-- teachfit-run source=command")
     assert "| peg2d (10 trials), e (mm) | skill | joined |" in text
     assert "| 3 | 2/3 [21,94] 2.00 | 0/1 [0,79] |" in text
+
+
+def test_bench_assembly_on_the_arm_names_it_and_refuses_a_real_robot(tmp_path, monkeypatch):
+    from teachfit.bench import assembly, search
+    from teachfit.metrics.stats import summarize
+
+    seen = []
+
+    def bench_task(name, errors, trials, *args, **kwargs):
+        seen.append(search.ROBOT[0])
+        return {"skill": [(e, summarize([True], [1.0])) for e in errors]}
+
+    monkeypatch.setattr(assembly, "bench_task", bench_task)
+    monkeypatch.setattr(search, "ROBOT", ["floating"])
+    out = tmp_path / "assembly.md"
+    res = invoke("bench", "assembly", "--robot", "fr3", "--errors", "0", "--markdown", out)
+    assert res.exit_code == 0, res.output
+    assert seen == ["fr3", "fr3"]
+    assert "| socket3d on fr3 (10 trials), e (mm) | skill |" in out.read_text(encoding="utf-8")
+    res = invoke("bench", "assembly", "--robot", "franka", "--errors", "0")
+    assert res.exit_code == 2 and "choose floating or fr3" in res.output

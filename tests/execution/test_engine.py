@@ -229,3 +229,59 @@ def test_a_chain_node_checks_its_transitions_on_entry_and_a_left_node_hears_of_i
     assert b.t_enter == b.t_exit == c.t_enter  # the chain node was left as it was entered
     assert d.t_enter == pytest.approx(c.t_enter + 0.01)  # one command later
     assert still.left == [a.t_exit, b.t_exit, c.t_exit]  # each node left by a transition was told
+
+
+@dataclass(frozen=True)
+class _Turning(Primitive):
+    """Sets the orientation set-point to ``yaw`` (rad, about the task z; 0: leaves it), free in
+    rotation; notes (q_d, q) whenever its node is entered, after the engine set the set-point."""
+
+    yaw: float = 0.0
+    entered: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    kind: ClassVar[str] = "turning"
+
+    def compile(self, values: Mapping[str, float]) -> PrimitiveRun:
+        return _TurningRun(self.yaw, self.entered)
+
+    def describe(self) -> str:
+        return "turn, note entering"
+
+
+class _TurningRun(PrimitiveRun):
+    def __init__(self, yaw: float, entered: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        self.yaw, self.entered = yaw, entered
+
+    def enter(self, pc: Percept) -> None:
+        self.entered.append((pc.q_d.copy(), pc.q.copy()))
+        pc.done = False
+
+    def command(self, pc: Percept, out: MPCommand) -> None:
+        if self.yaw:
+            pc.q_d[:] = (math.cos(self.yaw / 2), 0.0, 0.0, math.sin(self.yaw / 2))
+        out.twist[:] = 0.0
+        out.stiffness[:] = (2000.0, 2000.0, 2000.0, 0.0, 0.0, 0.0)
+
+
+def test_a_node_that_keeps_its_orientation_starts_from_the_commanded_one(task):
+    noted: list[tuple[np.ndarray, np.ndarray]] = []
+    err = TimeAbove(2.0)
+    nodes = (
+        Node("turn", _Turning(0.3), err),
+        Node("keep", _Turning(0.0, noted), err, keep_orientation=True),
+        Node("reset", _Turning(0.0, noted), err),
+    )
+    skill = Skill(
+        "keep",
+        nodes,
+        (Transition("turn", "keep", TimeAbove(0.3)), Transition("keep", "reset", TimeAbove(0.0))),
+        "turn",
+        SkillParams(),
+        success=TimeAbove(0.4, scope="skill"),
+        error=TimeAbove(1.0, scope="skill"),
+    )
+    start = task.contact_pose(np.array([0.02, 0.0])).compose(Pose.from_xyz_rz(0, 0, 0.01, 0))
+    execute(skill, FloatingToolRobot(task), start, Pose(np.zeros(3)), config=ExecConfig())
+    (qd_keep, q_keep), (qd_reset, q_reset) = noted
+    assert 2 * math.atan2(q_keep[3], q_keep[0]) == pytest.approx(0.0, abs=0.01)  # not turned
+    np.testing.assert_allclose(qd_keep, (math.cos(0.15), 0.0, 0.0, math.sin(0.15)), atol=1e-9)
+    np.testing.assert_allclose(qd_reset, q_reset)  # the default: from the measured pose

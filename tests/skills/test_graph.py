@@ -271,6 +271,13 @@ def test_toml_round_trip_and_example_file():
     back = skill_from_dict(tomllib.loads(skill_to_toml(sk)))
     assert back == sk
     assert load_skill(EXAMPLE) == sk
+    kept = sk.node("insert")
+    sk2 = dataclasses.replace(
+        sk, nodes=tuple(dataclasses.replace(n, keep_orientation=n is kept) for n in sk.nodes)
+    )
+    text = skill_to_toml(sk2)
+    assert text.count("keep_orientation = true") == 1
+    assert skill_from_dict(tomllib.loads(text)) == sk2 != sk
 
 
 def test_toml_errors_name_the_node(tmp_path):

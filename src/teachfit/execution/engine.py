@@ -125,11 +125,11 @@ def execute(
 
 def _enter(node: CompiledNode, pc: Percept) -> None:
     """Enter ``node``: its clock at 0, no goal yet, the set-point held where the part is
-    (unless the node keeps the previous one), its primitive told."""
+    (unless the node keeps the previous one, or its orientation), its primitive told."""
     pc.t_node = 0.0
     pc.goal[:] = math.nan
     if node.reset_setpoint:
-        pc.hold_here()
+        pc.hold_here(position_only=node.keep_orientation)
     node.run.enter(pc)
 
 

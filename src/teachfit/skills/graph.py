@@ -32,8 +32,11 @@ class Node:
 
     ``reset_setpoint``: the node starts from the measured pose (the set-point of the previous
     node may have run ahead of a constrained part); ``False`` continues from the commanded
-    set-point. ``chain``: entered by a transition, its own transitions are checked at once,
-    in the same command period (a phase that may end as soon as it begins).
+    set-point. ``keep_orientation`` (with ``reset_setpoint``): the position starts from the
+    measured one, the orientation from the commanded one -- a part that sags under gravity,
+    friction or contact does not ratchet the commanded orientation over repeated entries.
+    ``chain``: entered by a transition, its own transitions are checked at once, in the same
+    command period (a phase that may end as soon as it begins).
     """
 
     name: str
@@ -42,6 +45,7 @@ class Node:
     doc: str = ""
     reset_setpoint: bool = True
     chain: bool = False
+    keep_orientation: bool = False
 
     def refs(self) -> set[str]:
         return self.primitive.refs() | (self.error.refs() if self.error else set())
@@ -66,6 +70,7 @@ class CompiledNode:
     reset_setpoint: bool
     transitions: tuple[tuple[Check, int, str], ...]  # (check, target index, description)
     chain: bool = False
+    keep_orientation: bool = False
 
 
 @dataclass(frozen=True)
@@ -214,7 +219,9 @@ class Skill:
                 if exc.node is not None:
                     raise
                 raise SkillError(str(exc), node=node.name) from exc
-            return CompiledNode(node.name, run, err, node.reset_setpoint, trs, node.chain)
+            return CompiledNode(
+                node.name, run, err, node.reset_setpoint, trs, node.chain, node.keep_orientation
+            )
 
         nodes = [build(n) for n in self.nodes]
         rec = build(self.recovery) if self.recovery is not None else None

@@ -49,7 +49,7 @@ from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.params import ContextParam, LearnedParam, SkillParams
 from teachfit.skills.primitive import primitive_from_toml
 
-_NODE_KEYS = {"error", "doc", "reset_setpoint"}
+_NODE_KEYS = {"error", "doc", "reset_setpoint", "keep_orientation"}
 
 
 def _table(data: Mapping[str, Any], key: str, where: str) -> dict[str, Any]:
@@ -65,7 +65,8 @@ def _node(name: str, data: Mapping[str, Any]) -> Node:
         err = condition_from_toml(data["error"]) if "error" in data else None
     except SkillError as exc:
         raise SkillError(str(exc), node=name) from exc
-    return Node(name, prim, err, str(data.get("doc", "")), bool(data.get("reset_setpoint", True)))
+    reset, keep = bool(data.get("reset_setpoint", True)), bool(data.get("keep_orientation", False))
+    return Node(name, prim, err, str(data.get("doc", "")), reset, keep_orientation=keep)
 
 
 def skill_from_dict(data: Mapping[str, Any], where: str = "skill") -> Skill:
@@ -165,6 +166,8 @@ def skill_to_dict(skill: Skill) -> dict[str, Any]:
         table["error"] = node.error.to_toml()
         table["doc"] = node.doc
         table["reset_setpoint"] = node.reset_setpoint
+        if node.keep_orientation:
+            table["keep_orientation"] = True
         nodes[node.name] = table
     transitions = [
         {"from": t.source, "to": t.target, "when": t.condition.to_toml()} for t in skill.transitions

@@ -78,10 +78,12 @@ class Percept:
         np.dot(rt, state.wrench[3:], out=self.f[3:])
         quat_mul_into(self.q, self._q_task_inv, state.quat)
 
-    def hold_here(self) -> None:
-        """Set the set-point to the measured pose (a primitive starting from where it is)."""
+    def hold_here(self, position_only: bool = False) -> None:
+        """Set the set-point to the measured pose (a primitive starting from where it is);
+        ``position_only``: the commanded orientation is kept."""
         self.p_d[:] = self.p
-        self.q_d[:] = self.q
+        if not position_only:
+            self.q_d[:] = self.q
 
     # ------------------------------------------------------------------ derived values
     @property
