@@ -48,6 +48,11 @@ def test_every_method_has_its_graph_and_search_needs_a_model(peg):
         "open-loop": "open-loop",
         "joined": "peg-in-hole+search",
     }
+    task = get_task("peg2d")
+    follow = method_skill("search", model, "peg-in-hole", "adaptive", task).nodes[0].primitive
+    assert follow.follow.hold_depth == task.search_hold_depth  # the search executor's hold
+    plain = method_skill("search", model, "peg-in-hole", "adaptive").nodes[0].primitive
+    assert plain.follow.hold_depth is None
     with pytest.raises(TeachfitError, match="search model"):
         assembly_jobs("peg2d", ["joined"], [0.0], 1, None)
     with pytest.raises(TeachfitError, match="unknown assembly method"):

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache, partial
 from typing import Any
 
@@ -37,6 +37,7 @@ from teachfit.core.errors import TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.execution.batch import episode_rng, episode_seed, run_batch
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
+from teachfit.execution.search import task_follow_config
 from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
@@ -47,6 +48,7 @@ from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.library import get_skill
 from teachfit.skills.params import SkillParams
 from teachfit.skills.primitive import MoveTo
+from teachfit.skills.search import LearnedSearch
 from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task
 
@@ -105,15 +107,23 @@ def open_loop_skill(controller: str = "adaptive") -> Skill:
     )
 
 
-def search_skill(model: SearchModel, controller: str = "adaptive") -> Skill:
+def search_skill(
+    model: SearchModel, controller: str = "adaptive", task: Task | None = None
+) -> Skill:
     """Ehlers et al. 2019 alone: the joined skill's search node from the start pose until the task's
     success detector fires (as Ehlers et al.'s runner,
-    :func:`~teachfit.skills.follow.follow_skill`)."""
+    :func:`~teachfit.skills.follow.follow_skill`), with the task's follower settings where
+    ``task`` is given (:func:`~teachfit.execution.search.task_follow_config`: the hold once the
+    part sank into the hole -- dragged on, a dropped part wedges on the arm)."""
     joined = peg_in_hole_search.build(model, controller)
     node = joined.node("search")
+    prim = node.primitive
+    if task is not None and isinstance(prim, LearnedSearch):
+        follow = replace(task_follow_config(task), tilt=None, settle_time=0.0)
+        prim = replace(prim, follow=follow)
     return Skill(
         "search",
-        (Node("search", node.primitive, TimeAbove("t_search") | Done()),),
+        (Node("search", prim, TimeAbove("t_search") | Done()),),
         (),
         "search",
         SkillParams(dict(joined.params.context), dict(joined.params.learned)),
@@ -123,8 +133,11 @@ def search_skill(model: SearchModel, controller: str = "adaptive") -> Skill:
     )
 
 
-def method_skill(method: str, model: SearchModel | None, skill: str, controller: str) -> Skill:
-    """The skill graph a method runs (``skill``: the base skill spec for ``"skill"``)."""
+def method_skill(
+    method: str, model: SearchModel | None, skill: str, controller: str, task: Task | None = None
+) -> Skill:
+    """The skill graph a method runs (``skill``: the base skill spec for ``"skill"``; ``task``:
+    the search's follower settings, see :func:`search_skill`)."""
     if method == "skill":
         return get_skill(skill, controller)
     if method == "open-loop":
@@ -132,7 +145,7 @@ def method_skill(method: str, model: SearchModel | None, skill: str, controller:
     if model is None:
         raise TeachfitError(f"method {method!r} needs a search model (--search MODEL)")
     if method == "search":
-        return search_skill(model, controller)
+        return search_skill(model, controller, task)
     if method in ("joined", JOINED_LEARNED):
         return peg_in_hole_search.build(model, controller)
     known = (*METHODS, JOINED_LEARNED)
@@ -229,7 +242,7 @@ def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
     robot = _robot(job.task, job.overrides, job.robot, job.robot_options)
     rng = episode_rng(job.seed, job.index)
     taught = taught_hole(task, job.hole_error, job.yaw_error, rng)
-    base = method_skill(job.method, _model(job.model_json), job.skill, job.controller)
+    base = method_skill(job.method, _model(job.model_json), job.skill, job.controller, task)
     ctx = peg_in_hole.hole_context(task, rng, base.params.context)
     values = dict(ctx.values)
     if job.method == "search":  # start on the surface at the taught pose
