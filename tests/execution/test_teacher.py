@@ -98,6 +98,7 @@ def test_unchamfered_yaw_task_gets_a_fine_spiral_inside_its_yaw_tolerance():
     assert style.pattern == "spiral"
     assert style.spiral_pitch == pytest.approx(puzzle.params.clearance)
     assert style.rz_wiggle < puzzle.rz_tolerance and style.rz_belief_sigma < puzzle.rz_tolerance
+    assert style.arm_stiffness > TeacherStyle().arm_stiffness  # a firm hand: a straight spiral
     # an asked-for pattern and asked-for fields stay; chamfered or yaw-free tasks are unchanged
     zigzag = style_for(puzzle, TeacherStyle(pattern="zigzag", rz_wiggle=0.3))
     assert zigzag.pattern == "zigzag" and zigzag.rz_wiggle == 0.3
