@@ -17,7 +17,15 @@ from teachfit.robot.registry import make_robot
 from teachfit.skills.follow import FollowConfig, FollowSetpoints, follow_skill
 from teachfit.skills.library import get_skill
 from teachfit.skills.percept import MPCommand, Percept
-from teachfit.skills.tilt import LEAD_TIME, LIFT_SPEED, TiltConfig, rim_lead, tilted_drop, wedge_lag
+from teachfit.skills.tilt import (
+    LEAD_TIME,
+    LIFT_SPEED,
+    MISSES,
+    TiltConfig,
+    rim_lead,
+    tilted_drop,
+    wedge_lag,
+)
 from teachfit.skills.tilt_context import TiltContext, context_of
 from teachfit.skills.tilt_graph import NODES
 from teachfit.tasks import get_task
@@ -249,6 +257,11 @@ def test_the_phases_are_the_graph_s_nodes_and_a_tilted_follow_node_is_refused():
     assert tuple(n.name for n in get_skill("tilted-search").nodes) == NODES  # skill show
     plain = follow_skill(traj, FollowConfig(tilt=TiltConfig()))  # no off_depth: no lift
     assert [n.name for n in plain.nodes] == ["search", "lateral", "align"]
+    cfg = TiltConfig()  # the budget: the tour (10 s) and MISSES drops' lateral and align phases
+    rounds = cfg.lateral_time + cfg.align_time
+    assert cfg.extra_time == pytest.approx(MISSES * rounds) and MISSES >= 2
+    budget = 10.0 + FollowConfig().settle_time + MISSES * rounds
+    assert plain.error.value == pytest.approx(budget + 1.0)  # the skill's own time limit
     with pytest.raises(SkillError, match="follow_skill"):
         FollowSetpoints(traj, FollowConfig(tilt=TiltConfig())).compile({})
     with pytest.raises(SkillError, match="inside its graph"):
