@@ -242,7 +242,7 @@ def bench_assembly(
     ] = "skill,search,open-loop,joined",
     markdown: o.Markdown = None,
     robot: Annotated[
-        str, typer.Option(help="simulated robot of every trial and demonstration: floating, fr3")
+        str, typer.Option(help="robot to run on, simulated: floating or fr3 (trials and demos)")
     ] = "floating",
 ) -> None:
     """Each seed alone vs joined: same trials, same taught-hole errors, Wilson intervals."""
