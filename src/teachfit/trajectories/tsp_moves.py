@@ -285,8 +285,9 @@ def _or_segment(
     """Or-opt of a segment of any length: the segment ``S = tour[i+1..j-1]`` between ``a =
     tour[i]`` and a candidate ``c = tour[j]`` of ``a`` is cut out (``a`` joined to ``c``) and
     put, either way round, next to a candidate of its first or last node that is nearer to it
-    than the cut gains (positive partial gain: a third of the CPU of trying all candidates,
-    which paid for more kicks). Applies the first improving one; returns (gain, lo, hi) like
+    than the cut gains (positive partial gain: about 40 % of the CPU of trying all candidates,
+    which saves about a quarter of the kernel's CPU at 300 points and pays for the other
+    moves). Applies the first improving one; returns (gain, lo, hi) like
     :func:`_move_segment` (gain 0: none)."""
     m = tour.shape[0]
     dummy = m - 1
