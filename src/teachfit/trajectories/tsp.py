@@ -5,11 +5,11 @@ zero distance from every node and the edge ``(dummy, start)`` may never be remov
 tour ``start → p_1 → … → p_N → dummy → start`` then costs exactly the open path.
 
 ``solver="fast"`` (default): nearest-neighbour construction, then the compiled local search
-of :mod:`teachfit.trajectories.tsp_kernel` (2-opt, Or-opt (of any segment up to 300 points)
-and Lin-Kernighan chains over the
+of :mod:`teachfit.trajectories.tsp_kernel` (2-opt, Or-opt (of any segment and a new free end
+up to 300 points) and Lin-Kernighan chains over the
 nearest and Delaunay neighbours from ``scipy.spatial``, then a fixed number of seeded
-segment-swap kicks; up to 300 points it reads a distance matrix; why it is written here is said
-there). ``solver="lkh"`` calls LKH-3
+segment-swap kicks (every second one at long edges up to 300 points); up to 300 points it reads
+a distance matrix; why it is written here is said there). ``solver="lkh"`` calls LKH-3
 through ``elkai`` (slow, the reference quality of the benchmark).
 
 Distances are Euclidean after scaling each coordinate by ``weights`` (e.g. ``(1, 1, ℓ)`` to
@@ -108,16 +108,22 @@ def _candidates(x: np.ndarray, k: int, width: int = 10) -> np.ndarray:
 # benchmarks/search_speed.py: larger windows and a little threshold accepting win)
 _WINDOW = 1 << 30  # segments of any length (clusters move as a whole)
 _THRESHOLD = 0.1  # of the mean nearest-neighbour edge
+#: up to _LK_FROM points: every second kick cuts at long edges, each cut the longest of this
+#: many drawn tour edges (the kick where the tour is poor: whole clusters and the free end
+#: move; instances over 1.01 x LKH among 180 sets of 300 points, per kick seed: 2: 2-7, 3: 1-2,
+#: 4: 2-6, none: 20-27), and in the plane a higher threshold (0.1: 8-9, 0.2: 2-5, 0.45: 1-2,
+#: 0.8: 5-10); 3-D points keep 0.1 (15 Gaussian sets: mean 1.0032 x LKH, 0.45: 1.0067)
+_LONG_CUTS, _THRESHOLD_PLANE = 3, 0.45
 _DEPTH, _BREADTH = 3, 1  # Lin-Kernighan chain: flips at most, alternatives at its first step
-# up to this many points the chain is off and the kicks are 5.5 N (5 N were as close to LKH
+# up to this many points the chain is off and the kicks are 5 N (5 N were as close to LKH
 # as 3 N kicks with chains, in half the time: 300 points, benchmarks/search_speed.py)
 _LK_FROM = 300
 #: at least this many kicks (small sets: 1500 kicks of 100 points take about 15 ms)
 _MIN_KICKS = 1500
-#: kicks per point up to _LK_FROM points: 5.5 N since the distance matrix made each kick ~15 %
-#: cheaper (5 N before): less CPU than before, and as the kicks' draws begin with the former
-#: 5 N ones and the shortest tour seen is kept, no tour longer than before
-_KICKS_PER_POINT = 5.5
+#: kicks per point up to _LK_FROM points: 5 N (5.5 N with the distance matrix, 2026-12-05,
+#: then 5 N again with the long-edge kicks and the new-end move: 4-7 % less CPU than 5.5 N
+#: before, as close to LKH as 5.5 N with them: 7 against 4 of 540 runs over 1.01 x LKH)
+_KICKS_PER_POINT = 5.0
 #: up to this many nodes (the start and 300 points) the kernel reads a distance matrix: 15-19 %
 #: less CPU at 100 and 300 points, the same tours; slower at 600 and 1000 points (the matrix
 #: leaves the cache), so coordinates there (benchmarks/search_speed.py point sets)
@@ -149,6 +155,7 @@ def _compiled(
     draws = rng.integers(0, 1 << 30, size=(n_kicks, 3), dtype=np.int64)
     scale = float(np.ptp(x, axis=0).max()) or 1.0
     d0 = np.linalg.norm(np.diff(x[tour[:-1]], axis=0), axis=1).mean()
+    small = n - 1 <= _LK_FROM
     out = improve_tour(
         _distances(x),
         neigh,
@@ -156,16 +163,17 @@ def _compiled(
         draws,
         _WINDOW,
         1e-12 * scale,
-        _THRESHOLD * d0,
-        _DEPTH if x.shape[0] - 1 > _LK_FROM else 0,
+        (_THRESHOLD_PLANE if small and x.shape[1] == 2 else _THRESHOLD) * d0,
+        0 if small else _DEPTH,
         _BREADTH,
-        x.shape[0] - 1 <= _LK_FROM,
+        small,
+        _LONG_CUTS if small else 0,
     )
     return [int(v) for v in out]
 
 
 def _default_kicks(n: int) -> int:
-    """Kicks of the iterated local search: max(5.5 N, 1500) up to 300 points (≈ 20-30 ms, no LK
+    """Kicks of the iterated local search: max(5 N, 1500) up to 300 points (≈ 15-25 ms, no LK
     chains, Or-opt of any segment, distance matrix), then 3 N (N / 300)^0.75 (measured in
     benchmarks/search_speed.py: larger sets need more kicks per point to stay within 1 % of
     LKH; with (N / 300)^0.5 uniform 2000 points gave 1.011)."""
@@ -218,7 +226,7 @@ def open_tour(
     n_neighbours : int
         Candidate-list size K of the local search.
     n_kicks : int, optional
-        Iterated-local-search kicks; default ``max(5.5 N, 1500)`` up to 300 points (≈ 20-30 ms
+        Iterated-local-search kicks; default ``max(5 N, 1500)`` up to 300 points (≈ 15-25 ms
         CPU), ``3 N (N / 300)^0.75`` beyond. A fixed count,
         not a time budget: the same input gives the same tour on every machine.
     lkh_runs : int

@@ -20,8 +20,13 @@ points costs exactly the open tour. Moves (all in O(segment) time on arrays):
   (done by two or three reversals);
 - **Or-opt of any segment** (up to 300 points): cut the segment between a node and one of its
   candidates out (the two joined) and put it, either way round, next to a candidate of its
-  first or last node — the 3-opt "segment insertion" that no sequence of improving 2-opt
-  moves reaches (it took the worst 100-point sets from 1.02 to <= 1.01 x LKH);
+  first or last node nearer than the cut gains — the 3-opt "segment insertion" that no
+  sequence of improving 2-opt moves reaches (it took the worst 100-point sets from 1.02 to
+  <= 1.01 x LKH);
+- **a new free end** (up to 300 points): cut the tour at an edge ``(u, b)``, ``u`` the new
+  last point, and put the tail ``b .. z`` between two nodes before ``u``, one of them a
+  candidate of ``b`` (a segment insertion across the dummy's edge, which no move above
+  breaks unless the last point is a candidate);
 - **Lin-Kernighan chain** (when neither improves): a sequence of up to ``depth`` 2-opt flips
   that keep ``t1`` fixed, each adding an edge from the last free end to a candidate
   neighbour, the partial gain kept positive; the chain is cut at its best closed gain. At the
@@ -32,7 +37,8 @@ all restricted to candidate lists (nearest and Delaunay neighbours) with don't-l
 segments of any length (``A B C D -> A C B D``; whole clusters of points move; with both path
 ends fixed this changes three edges, a random segment insertion, not the 4-opt double bridge
 ``A B C D E -> A D C B E``, which was tried and came out further from LKH-3 at the same number
-of kicks, whether its segments were of any length, short or chosen along candidate edges),
+of kicks, whether its segments were of any length, short or chosen along candidate edges;
+up to 300 points every second kick cuts at three long edges, each the longest of three drawn),
 local search from its six end nodes, kept when at most ``threshold`` longer (threshold
 accepting); the shortest tour seen is returned. Distances are read from a matrix when one is
 given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`).
@@ -46,7 +52,14 @@ from numba import njit
 # numba's on-disk cache (``cache=True``) keys each compiled function on its own file only: the
 # functions of tsp_moves are compiled into this file's kernels, so an edit there alone leaves
 # this file's cached kernels stale; touch this file too (or clear __pycache__) after one.
-from teachfit.trajectories.tsp_moves import _d, _lk_node, _move_segment, _or_segment, _reverse
+from teachfit.trajectories.tsp_moves import (
+    _d,
+    _lk_node,
+    _move_segment,
+    _or_segment,
+    _reverse,
+    _tail_move,
+)
 
 
 @njit(cache=True)
@@ -163,11 +176,11 @@ def _local_search(
     inq: np.ndarray,
     flips: np.ndarray,
     breadth: int,
-    or_any: bool,
+    segments: bool,
 ) -> float:
     """Local search from the nodes ``seeds`` until no move improves (2-opt and Or-opt of 1-3
-    nodes, then with ``or_any`` Or-opt of any segment, then Lin-Kernighan chains when
-    ``flips`` has rows); returns the total gain."""
+    nodes, then with ``segments`` a new free end and Or-opt of any segment, then
+    Lin-Kernighan chains when ``flips`` has rows); returns the total gain."""
     head_tail = np.zeros(2, dtype=np.int64)
     inq[:] = False
     for v in seeds:
@@ -181,18 +194,15 @@ def _local_search(
         if a == dummy:
             continue
         delta, lo, hi = _improve_node(x, neigh, tour, pos, a, eps)
+        if delta <= 0.0 and segments:
+            delta, lo, hi = _tail_move(x, neigh, tour, pos, a, eps)
+            if delta <= 0.0:
+                delta, lo, hi = _or_segment(x, neigh, tour, pos, a, eps)
         if delta > 0.0:
             gain += delta
             _push_ends(queue, inq, head_tail, tour, lo, hi)
             _push(queue, inq, head_tail, a)
             continue
-        if or_any:
-            delta, lo, hi = _or_segment(x, neigh, tour, pos, a, eps)
-            if delta > 0.0:
-                gain += delta
-                _push_ends(queue, inq, head_tail, tour, lo, hi)
-                _push(queue, inq, head_tail, a)
-                continue
         if flips.shape[0] == 0:
             continue
         delta, n_flips = _lk_node(x, neigh, tour, pos, a, eps, flips, breadth)
@@ -204,9 +214,77 @@ def _local_search(
     return gain
 
 
-# Long on purpose (> 60 lines): the iterated local search's whole loop in one compiled
-# function (kick, local search from the kick's ends, acceptance, best tour kept), so that its
-# buffers are allocated once and nothing crosses into Python per kick.
+@njit(cache=True)
+def _long_edge_cuts(
+    x: np.ndarray, tour: np.ndarray, draw: np.ndarray, samples: int
+) -> tuple[int, int, int]:
+    """Cuts of a kick at long edges: three tour edges, each the longest of ``samples`` drawn
+    (xorshift seeded by the kick's ``draw``); returns ``(a, lb, lc)`` as
+    :func:`_kick_cuts`."""
+    m = tour.shape[0]
+    h = np.uint64(draw[0] * 1000003 + draw[1] * 7919 + draw[2])
+    cuts = np.empty(3, dtype=np.int64)
+    for k in range(3):
+        best_c, best_len = 1, -1.0
+        for _ in range(samples):
+            h ^= h << np.uint64(13)
+            h ^= h >> np.uint64(7)
+            h ^= h << np.uint64(17)
+            c = 1 + int(h % np.uint64(m - 1))  # the edge (tour[c-1], tour[c]), 1 <= c < m
+            length = _d(x, tour[c - 1], tour[c], m - 1)
+            if length > best_len:
+                best_c, best_len = c, length
+        cuts[k] = best_c
+    cuts.sort()
+    if cuts[0] == cuts[1] or cuts[1] == cuts[2]:
+        return 0, 0, 0
+    return cuts[0], cuts[1] - cuts[0], cuts[2] - cuts[1]
+
+
+@njit(cache=True)
+def _kick_cuts(
+    x: np.ndarray, tour: np.ndarray, draws: np.ndarray, r: int, window: int, long_cuts: int
+) -> tuple[int, int, int]:
+    """The segments of kick ``r``: ``B = tour[a..a+lb-1]`` and the ``lc`` nodes after it
+    (``lb = 0``: no kick). Random lengths up to ``window``; with ``long_cuts`` every second
+    kick cuts at long edges instead (:func:`_long_edge_cuts`)."""
+    inner = tour.shape[0] - 2  # movable positions 1..m-2
+    if long_cuts > 0 and r % 2 == 0:
+        return _long_edge_cuts(x, tour, draws[r], long_cuts)
+    lb = 1 + draws[r, 1] % (window - 1) if window > 1 else 1
+    lc = 1 + draws[r, 2] % max(1, window - lb)
+    if lb + lc > inner:
+        return 0, 0, 0
+    return 1 + draws[r, 0] % (inner - lb - lc + 1), lb, lc
+
+
+@njit(cache=True)
+def _kick(
+    x: np.ndarray, tour: np.ndarray, pos: np.ndarray, a: int, lb: int, lc: int, ends: np.ndarray
+) -> float:
+    """Swap ``B = tour[a..a+lb-1]`` and the ``lc`` nodes after it (``A B C D -> A C B D``);
+    the six nodes at the changed edges go to ``ends``. Returns the gain (negative: longer)."""
+    dummy = tour.shape[0] - 1
+    b_end, c_end = a + lb - 1, a + lb + lc - 1
+    pa, na = tour[a - 1], tour[c_end + 1]
+    b0, b1, c0, c1 = tour[a], tour[b_end], tour[b_end + 1], tour[c_end]
+    delta = (
+        _d(x, pa, b0, dummy)
+        + _d(x, b1, c0, dummy)
+        + _d(x, c1, na, dummy)
+        - _d(x, pa, c0, dummy)
+        - _d(x, c1, b0, dummy)
+        - _d(x, b1, na, dummy)
+    )
+    _move_segment(tour, pos, a, b_end, c_end, True)  # A B C D -> A C rev(B) D
+    _reverse(tour, pos, c_end - lb + 1, c_end)  # -> A C B D
+    ends[0], ends[1], ends[2], ends[3], ends[4], ends[5] = pa, na, b0, b1, c0, c1
+    return delta
+
+
+# Long on purpose (> 60 lines by its numpydoc docstring): the iterated local search's whole
+# loop in one compiled function (kick, local search from the kick's ends, acceptance, best tour
+# kept), so that its buffers are allocated once and nothing crosses into Python per kick.
 @njit(cache=True)
 def improve_tour(
     x: np.ndarray,
@@ -218,7 +296,8 @@ def improve_tour(
     threshold: float = 0.0,
     depth: int = 6,
     breadth: int = 3,
-    or_any: bool = True,
+    segments: bool = True,
+    long_cuts: int = 0,
 ) -> np.ndarray:
     """Local search, then one kick per row of ``draws`` (three non-negative ints each).
 
@@ -234,6 +313,10 @@ def improve_tour(
         K nearest other nodes of each node, nearest first.
     tour : ndarray of int, shape (M,)
         Initial path: ``tour[0] = 0``, ``tour[M-1] = M-1`` (the dummy).
+    segments : bool
+        Also the moves of a new free end and Or-opt of any segment.
+    long_cuts : int
+        With > 0, every second kick cuts at the longest of this many drawn edges.
     """
     m = tour.shape[0]
     tour = tour.copy()
@@ -244,42 +327,23 @@ def improve_tour(
     inq = np.zeros(m, dtype=np.bool_)
     flips = np.zeros((depth, 2), dtype=np.int64)
     all_nodes = np.arange(m - 1)
-    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq, flips, breadth, or_any)
-    inner = m - 2  # movable positions 1..m-2
-    if inner < 4:
+    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq, flips, breadth, segments)
+    if m - 2 < 4:
         return tour
-    window = min(window, inner - 1)
+    window = min(window, m - 3)
     saved_tour = tour.copy()
     saved_pos = pos.copy()
     ends = np.empty(6, dtype=np.int64)
-    dummy = m - 1
     best_tour = tour.copy()
     total, best = 0.0, 0.0  # gain of the current / best tour over the first local optimum
     for r in range(draws.shape[0]):
-        lb = 1 + draws[r, 1] % (window - 1) if window > 1 else 1
-        lc = 1 + draws[r, 2] % max(1, window - lb)
-        if lb + lc > inner:
+        a, lb, lc = _kick_cuts(x, tour, draws, r, window, long_cuts)
+        if lb == 0:
             continue
-        a = 1 + draws[r, 0] % (inner - lb - lc + 1)  # B = tour[a..a+lb-1], C follows
-        b_end, c_end = a + lb - 1, a + lb + lc - 1
-        pa, na = tour[a - 1], tour[c_end + 1]
-        b0, b1, c0, c1 = tour[a], tour[b_end], tour[b_end + 1], tour[c_end]
-        delta = (
-            _d(x, pa, b0, dummy)
-            + _d(x, b1, c0, dummy)
-            + _d(x, c1, na, dummy)
-            - _d(x, pa, c0, dummy)
-            - _d(x, c1, b0, dummy)
-            - _d(x, b1, na, dummy)
-        )
         saved_tour[:] = tour
         saved_pos[:] = pos
-        _move_segment(tour, pos, a, b_end, c_end, True)  # A B C D -> A C rev(B) D
-        _reverse(tour, pos, c_end - lb + 1, c_end)  # -> A C B D
-        ends[0], ends[1], ends[2], ends[3], ends[4], ends[5] = pa, na, b0, b1, c0, c1
-        gain = delta + _local_search(
-            x, neigh, tour, pos, ends, eps, queue, inq, flips, breadth, or_any
-        )
+        gain = _kick(x, tour, pos, a, lb, lc, ends)
+        gain += _local_search(x, neigh, tour, pos, ends, eps, queue, inq, flips, breadth, segments)
         if gain <= eps - threshold:  # longer than accepted: undo
             tour[:] = saved_tour
             pos[:] = saved_pos

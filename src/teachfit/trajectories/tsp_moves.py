@@ -1,7 +1,7 @@
 """Moves of the open-tour kernel (numba), used by :mod:`teachfit.trajectories.tsp_kernel`:
-distances with the dummy end, reversals, segment moves, the Lin-Kernighan chain, the start tour
-and the candidate lists. The tour layout and why this is written here are described in
-:mod:`teachfit.trajectories.tsp_kernel`.
+distances with the dummy end, reversals, segment moves, the Lin-Kernighan chain, a new free
+end, the start tour and the candidate lists. The tour layout and why this is written here are
+described in :mod:`teachfit.trajectories.tsp_kernel`.
 """
 
 from __future__ import annotations
@@ -284,8 +284,11 @@ def _or_segment(
 ) -> tuple[float, int, int]:
     """Or-opt of a segment of any length: the segment ``S = tour[i+1..j-1]`` between ``a =
     tour[i]`` and a candidate ``c = tour[j]`` of ``a`` is cut out (``a`` joined to ``c``) and
-    put, either way round, next to a candidate of its first or last node. Applies the first
-    improving one; returns (gain, lo, hi) like :func:`_move_segment` (gain 0: none)."""
+    put, either way round, next to a candidate of its first or last node that is nearer to it
+    than the cut gains (positive partial gain: about 40 % of the CPU of trying all candidates,
+    which saves about a quarter of the kernel's CPU at 300 points and pays for the other
+    moves). Applies the first improving one; returns (gain, lo, hi) like
+    :func:`_move_segment` (gain 0: none)."""
     m = tour.shape[0]
     dummy = m - 1
     i = pos[a]
@@ -305,6 +308,8 @@ def _or_segment(
         for end in range(2):
             v = b if end == 0 else p
             for e in neigh[v]:
+                if g1 - _d(x, v, e, dummy) <= eps:
+                    break
                 q0 = pos[e]
                 for q in (q0 - 1, q0):
                     if q < 0 or q > m - 2 or (i <= q <= j - 1):
@@ -314,3 +319,44 @@ def _or_segment(
                         lo, hi = _move_segment(tour, pos, i + 1, j - 1, q, flip)
                         return g1 + g2, lo, hi
     return 0.0, 0, 0
+
+
+@njit(cache=True)
+def _tail_move(
+    x: np.ndarray, neigh: np.ndarray, tour: np.ndarray, pos: np.ndarray, a: int, eps: float
+) -> tuple[float, int, int]:
+    """A new free end: the tour is cut at an edge of ``a``, ``(u, b) = (tour[i], tour[i+1])``,
+    ``u`` becomes the last point and the tail ``b .. z`` (``z`` the last point so far) goes,
+    either way round, between ``tour[q]`` and ``tour[q+1]`` before the cut, one of them a
+    candidate of ``b`` nearer than ``u`` (positive partial gain). With the dummy at
+    distance 0 this is a segment insertion whose gain starts with the whole edge ``(u, b)``;
+    the other moves break the dummy's edge only next to a candidate of the last point, so the
+    end moved mostly by kicks (19 of the 20 instances over 1.01 x LKH among 180 sets of 300
+    points ended elsewhere than LKH's tour).
+    Applies the first improving one; returns (gain, lo, hi) like :func:`_move_segment`."""
+    m = tour.shape[0]
+    dummy = m - 1
+    z = tour[m - 2]
+    for side in range(2):
+        i = pos[a] if side == 0 else pos[a] - 1
+        if i < 1 or i > m - 3:
+            continue
+        b = tour[i + 1]
+        g1 = _d(x, tour[i], b, dummy)
+        for e in neigh[b]:
+            de = _d(x, b, e, dummy)
+            if g1 - de <= eps:
+                break
+            q0 = pos[e]
+            if q0 >= i:
+                continue
+            for q in (q0, q0 - 1):  # e = tour[q]: e b .. z ...; e = tour[q+1]: ... z .. b e
+                if q < 0:
+                    continue
+                left, right = tour[q], tour[q + 1]
+                far = _d(x, z, right, dummy) if q == q0 else _d(x, left, z, dummy)
+                g = g1 - de + _d(x, left, right, dummy) - far
+                if g > eps:
+                    lo, hi = _move_segment(tour, pos, i + 1, m - 2, q, q != q0)
+                    return g, lo, hi
+    return 0.0, 0, -1
