@@ -249,9 +249,11 @@ def bench_assembly(
     from teachfit.bench.assembly import bench_inputs, bench_task
     from teachfit.bench.search import use_robot
     from teachfit.execution.assembly import METHODS
+    from teachfit.robot.registry import ROBOTS
 
-    if robot not in ("floating", "fr3"):
-        raise TeachfitError(f"--robot: choose floating or fr3 (got {robot!r})")
+    simulated = sorted(n for n, e in ROBOTS.items() if e.simulated)
+    if robot not in simulated:
+        raise TeachfitError(f"--robot: choose {' or '.join(simulated)} (got {robot!r})")
     use_robot(robot)
     on = "" if robot == "floating" else f" on {robot}"
     errs = [parse_quantity(e) for e in errors.split(",") if e.strip()]
