@@ -2,10 +2,14 @@
 seeds.
 
 Usage: ``python benchmarks/twin_vs_fr3.py [--trials 10] [--seed 0]
-[--cases peg,tshix-peg2d,assemble-peg2d] [--points 100] [--markdown FILE]``
+[--cases peg,tshix-peg2d,assemble-peg2d] [--points 100] [--fr3-cell twin|own] [--markdown FILE]``
 
 Each case runs ``--trials`` executions on ``--robot fr3`` (the task's FR3 cell in this process,
-its sensor noise seeded with ``--seed``) and then the same ones on ``--robot franka``: teachfit's
+its sensor noise seeded with ``--seed``; ``--fr3-cell twin``, the default, places its base and
+the held part where the twin's cell has them, :func:`~teachfit.robot.franka.twin_cell.cell_params`:
+the base 0.25 m below the world origin and the part at libfranka's flange-to-EE offset, 103.4 mm,
+so that the two sides differ in the protocol path only; ``own`` keeps the fr3 robot's defaults,
+base at the origin and part at 66 mm) and then the same ones on ``--robot franka``: teachfit's
 driver over pylibfranka against ``teachfit robot twin`` (the same cell behind libfranka's
 protocol), which this script starts on 127.0.0.1 in lock-step (``--no-realtime``, its seed
 ``--seed``) and stops by its PID. libfranka's port 1337 is fixed: the script waits for the
@@ -63,6 +67,8 @@ from teachfit.tasks.registry import load_task
 
 #: TSHIX's sample count (``--points``)
 POINTS = [100]
+#: the fr3 side's cell (``--fr3-cell``): the twin's base and part mount, or the fr3 robot's own
+FR3_CELL = ["twin"]
 #: a robot's options (``--robot franka``: host and realtime)
 Arm = dict[str, Any]
 
@@ -200,10 +206,21 @@ def _said(result: ExecutionResult) -> ExecutionResult:
     return result
 
 
+def fr3_cell() -> Arm:
+    """The fr3 robot's options of ``--fr3-cell``: the twin's base and part mount (``twin``) or
+    none (``own``)."""
+    if FR3_CELL[0] == "own":
+        return {}
+    from teachfit.robot.franka.twin_cell import TwinParams, cell_params
+
+    cell = cell_params(TwinParams())
+    return {"base_pos": cell.base_pos, "mount_offset": cell.mount_offset}
+
+
 def run_side(case: str, robot: str, seed: int, trials: int) -> Side:
     """``case``'s executions on ``robot`` (``franka``: the driver on 127.0.0.1)."""
     task_name, runs = CASES[case]
-    arm: Arm = {"host": "127.0.0.1", "realtime": False} if robot == "franka" else {}
+    arm: Arm = {"host": "127.0.0.1", "realtime": False} if robot == "franka" else fr3_cell()
     t0 = time.monotonic()
     print(f"{case} on {robot}", flush=True)
     traces = runs(robot, arm, load_task(task_name), seed, trials)
@@ -230,6 +247,12 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--points", type=int, default=100, help="TSHIX points (tshix-peg2d)")
+    ap.add_argument(
+        "--fr3-cell",
+        choices=("twin", "own"),
+        default="twin",
+        help="the fr3 side's base and part mount: the twin's (default) or the fr3 robot's own",
+    )
     add_markdown_option(ap)
     args = ap.parse_args(argv)
     if args.trials < 1:
@@ -241,6 +264,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.points < 1:
         ap.exit(2, f"error: --points {args.points}: give at least 1\n")
     POINTS[0] = args.points
+    FR3_CELL[0] = args.fr3_cell
     markdown = checked_markdown(ap, args.markdown)
     rows = []
     for case in cases:
@@ -253,9 +277,11 @@ def main(argv: list[str] | None = None) -> None:
         "tshix-peg2d": f"TSHIX (N = {args.points}) on peg2d",
         "assemble-peg2d": f"the joined skill on peg2d, hole {HOLE_ERROR * 1e3:g} mm off",
     }
+    cell = {"twin": "the twin's cell geometry", "own": "its own cell geometry"}
     title = (
         f"**fr3 in-process vs the franka driver on the twin**, the same {args.trials} starts "
-        f"per case (seed {args.seed}): " + "; ".join(what[c] for c in cases)
+        f"per case (seed {args.seed}), the fr3 robot in {cell[args.fr3_cell]}: "
+        + "; ".join(what[c] for c in cases)
     )
     append_table(ap, markdown, table(title, HEADER, rows))
 

@@ -183,3 +183,22 @@ def test_twin_vs_fr3_refuses_bad_input_before_starting_anything(
         _run(monkeypatch, "twin_vs_fr3", args)
     err = capsys.readouterr().err
     assert stop.value.code == 2 and said in err and err.count("\n") == 1, err
+
+
+def test_twin_vs_fr3_puts_the_fr3_side_where_the_twin_arm_stands() -> None:
+    """``--fr3-cell twin`` gives the fr3 robot the twin cell's base and part mount (the two
+    sides then differ in the protocol path only); ``own`` leaves the fr3 robot's defaults."""
+    import dataclasses
+
+    from teachfit.robot.fr3 import FR3Params
+    from teachfit.robot.franka.twin_cell import TwinParams, cell_params
+
+    script = _script("twin_vs_fr3")
+    script.FR3_CELL[0] = "twin"
+    opts = script.fr3_cell()
+    cell = cell_params(TwinParams())
+    placed = dataclasses.replace(FR3Params(), **opts)
+    assert placed.base_pos == cell.base_pos and placed.mount_offset == cell.mount_offset
+    assert placed.base_pos != FR3Params().base_pos  # the twin's base is not the fr3 robot's
+    script.FR3_CELL[0] = "own"
+    assert script.fr3_cell() == {}
