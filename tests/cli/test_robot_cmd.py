@@ -22,6 +22,8 @@ def test_list_names_every_registered_robot_and_its_kind() -> None:
 def test_check_needs_a_real_robot_and_its_address() -> None:
     res = runner.invoke(app, ["robot", "check", "--robot", "floating"])
     assert res.exit_code == 2 and "simulated" in res.output
+    res = runner.invoke(app, ["bench", "robot", "--robot", "fr3"])  # where its tick is timed
+    assert res.exit_code == 2 and "bench sim --robot fr3" in " ".join(res.output.split())
     res = runner.invoke(app, ["robot", "check"])
     assert res.exit_code == 2 and "--host" in res.output
     res = runner.invoke(app, ["bench", "robot", "--host", "127.0.0.1", "--seconds", "0"])

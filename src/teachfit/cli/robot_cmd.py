@@ -55,7 +55,10 @@ def list_robots() -> None:
 
 def _real(robot: str, host: str | None) -> str:
     if robot != "franka":
-        raise TeachfitError(f"robot {robot!r} is simulated: nothing to connect to (use franka)")
+        raise TeachfitError(
+            f"robot {robot!r} is simulated: nothing to connect to (use franka; a simulated "
+            f"robot's tick is timed by teachfit bench sim --robot {robot})"
+        )
     if not host:
         raise TeachfitError("--host ADDRESS is needed: the Franka's (or the simulator's) address")
     return host
