@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import mujoco
+import numba
 import numpy as np
 
 from teachfit.control import compiled
 from teachfit.control.adaptive import AdaptiveImpedance
 from teachfit.core.control import ImpedanceLimits
 from teachfit.core.state import ImpedanceCommand
+from teachfit.robot.fr3 import kernel
 
 MASS = np.array([1.0, 1.0, 1.0, 0.004, 0.004, 0.004])
 
@@ -47,3 +50,22 @@ def test_compiled_adaptation_follows_the_python_law():
     np.testing.assert_allclose(ad[9], law.stiffness_adapt, rtol=1e-9, atol=1e-15)
     assert law.stiffness_adapt[:3].min() > 0  # it did adapt
     assert clipped > 0  # and the force limit was reached
+
+
+@numba.njit
+def _sub_quat(fn, res, qa, qb):  # noqa: ANN001, ANN202
+    compiled.call(fn, (compiled.addr(res), compiled.addr(qa), compiled.addr(qb)))
+
+
+def test_a_routine_by_address_is_the_ctypes_routine():
+    """``call`` with an address (the floating kernel's) = with the ctypes routine (the FR3's)."""
+    routine = kernel.routines()[compiled.SUB_QUAT]
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        qa, qb = rng.normal(size=4), rng.normal(size=4)
+        qa, qb = qa / np.linalg.norm(qa), qb / np.linalg.norm(qb)
+        by_ctypes, by_address, reference = np.zeros(3), np.zeros(3), np.zeros(3)
+        _sub_quat(routine, by_ctypes, qa, qb)
+        _sub_quat(compiled.c_address(routine), by_address, qa, qb)
+        mujoco.mju_subQuat(reference, qa, qb)
+        assert by_address.tobytes() == by_ctypes.tobytes() == reference.tobytes()

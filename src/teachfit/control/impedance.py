@@ -17,6 +17,8 @@ quaternion routines for :mod:`teachfit.core.geometry`'s (tests check both agree)
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from teachfit.core.control import ImpedanceLimits
@@ -33,9 +35,10 @@ def clipped_twist(cmd: ImpedanceCommand, limits: ImpedanceLimits) -> np.ndarray:
     """The command's desired twist (6,) with speeds clipped to ``max_speed``/``max_ang_speed``."""
     out = np.concatenate([cmd.lin_vel, cmd.ang_vel])
     for sl, cap in ((slice(0, 3), limits.max_speed), (slice(3, 6), limits.max_ang_speed)):
-        norm = float(np.linalg.norm(out[sl]))
+        part = out[sl]
+        norm = math.sqrt(float(part.dot(part)))  # = np.linalg.norm, without its dispatch
         if norm > cap:
-            out[sl] *= cap / norm
+            part *= cap / norm
     return out
 
 
@@ -122,7 +125,7 @@ class SetpointError:
     def set(self, cmd: ImpedanceCommand, twist: np.ndarray, t: float) -> None:
         """Adopt ``cmd``'s set-point with the (already limited) desired ``twist`` (6,) at ``t``."""
         self._vd[:] = twist
-        self._spinning = bool(np.any(self._vd[3:] != 0.0))
+        self._spinning = bool(self._vd[3:].any())  # nonzero (NaN too), as np.any(!= 0)
         self._xd[:] = cmd.pos
         self._qd[:] = cmd.quat
         self._t0 = t

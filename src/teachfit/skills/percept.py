@@ -112,7 +112,8 @@ class Percept:
 
     def to_world_pose(self, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A task-frame pose as world ``(pos (3,), quat (4,))``."""
-        pos = self.rot @ p + self.origin
+        pos = np.dot(self.rot, p)  # the product ``@`` makes, with less dispatch
+        pos += self.origin
         quat = np.zeros(4)
         quat_mul_into(quat, self.q_task, q)
         return pos, quat
