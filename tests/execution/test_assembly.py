@@ -49,9 +49,12 @@ def test_every_method_has_its_graph_and_search_needs_a_model(peg):
         "joined": "peg-in-hole+search",
     }
     task = get_task("peg2d")
-    follow = method_skill("search", model, "peg-in-hole", "adaptive", task).nodes[0].primitive
+    alone = method_skill("search", model, "peg-in-hole", "adaptive", task)
+    # the part is put down at the taught pose before the search moves it
+    assert alone.start == "contact" and [n.name for n in alone.nodes] == ["contact", "search"]
+    follow = alone.node("search").primitive
     assert follow.follow.hold_depth == task.search_hold_depth  # the search executor's hold
-    plain = method_skill("search", model, "peg-in-hole", "adaptive").nodes[0].primitive
+    plain = method_skill("search", model, "peg-in-hole", "adaptive").node("search").primitive
     assert plain.follow.hold_depth is None
     with pytest.raises(TeachfitError, match="search model"):
         assembly_jobs("peg2d", ["joined"], [0.0], 1, None)

@@ -42,7 +42,7 @@ from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
-from teachfit.skills.conditions import DepthAbove, Detected, Done, TimeAbove
+from teachfit.skills.conditions import DepthAbove, Detected, Done, ForceAbove, TimeAbove
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.library import get_skill
@@ -121,11 +121,15 @@ def search_skill(
     if task is not None and isinstance(prim, LearnedSearch):
         follow = replace(task_follow_config(task), tilt=None, settle_time=0.0)
         prim = replace(prim, follow=follow)
+    # put the part down where it was taught first, as a person does before searching: a search
+    # that starts moving while the part still falls turns it on the way down (on the arm the
+    # socket's plug then lands in its recess turned and jams there)
+    contact = joined.node("contact")
     return Skill(
         "search",
-        (Node("search", prim, TimeAbove("t_search") | Done()),),
-        (),
-        "search",
+        (contact, Node("search", prim, TimeAbove("t_search") | Done())),
+        (Transition("contact", "search", ForceAbove("f_contact", axis="+z")),),
+        "contact",
         SkillParams(dict(joined.params.context), dict(joined.params.learned)),
         Detected(),
         joined.error,
