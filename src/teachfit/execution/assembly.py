@@ -10,8 +10,9 @@ not its direction: the search's spread is at least ``hole_error`` wide (``search
 Methods (:data:`METHODS`):
 
 - ``"skill"``: Johannsmeier et al.'s skill alone (its recovery only retracts);
-- ``"search"``: Ehlers et al.'s learned search alone, started on the surface at the taught pose (the
-  same :class:`~teachfit.skills.search.LearnedSearch` node as the joined skill's) until the
+- ``"search"``: Ehlers et al.'s learned search alone, started on the surface at the taught pose:
+  the part is put down there (the joined skill's ``contact`` node) and then searched with the
+  same :class:`~teachfit.skills.search.LearnedSearch` node as the joined skill's until the
   task's success detector fires;
 - ``"open-loop"``: the plan executed open loop: move above the taught hole, then straight down
   to the insertion depth, stiff, whatever the contact says;
