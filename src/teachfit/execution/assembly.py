@@ -43,7 +43,7 @@ from teachfit.models.search_model import SearchModel
 from teachfit.robot.interface import Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
-from teachfit.skills.conditions import DepthAbove, Detected, Done, ForceAbove, TimeAbove
+from teachfit.skills.conditions import DepthAbove, Detected, Done, TimeAbove
 from teachfit.skills.controllers import controller_spec
 from teachfit.skills.graph import Node, Skill, Transition
 from teachfit.skills.library import get_skill
@@ -125,11 +125,12 @@ def search_skill(
     # put the part down where it was taught first, as a person does before searching: a search
     # that starts moving while the part still falls turns it on the way down (on the arm the
     # socket's plug then lands in its recess turned and jams there)
-    contact = joined.node("contact")
+    # (the joined skill's own node and its own sign of contact)
+    touched = next(t.condition for t in joined.transitions if t.source == "contact")
     return Skill(
         "search",
-        (contact, Node("search", prim, TimeAbove("t_search") | Done())),
-        (Transition("contact", "search", ForceAbove("f_contact", axis="+z")),),
+        (joined.node("contact"), Node("search", prim, TimeAbove("t_search") | Done())),
+        (Transition("contact", "search", touched),),
         "contact",
         SkillParams(dict(joined.params.context), dict(joined.params.learned)),
         Detected(),
