@@ -90,3 +90,16 @@ def test_a_searching_method_is_told_the_error_s_size(peg):
         else:
             assert ctx["search_radius"] == pytest.approx(0.003)
             assert ctx["search_seed"] == float(episode_seed(4, 0))
+
+
+def test_a_trial_reads_the_same_whatever_ran_before_it_in_the_process(peg):
+    """The sensor noise is the trial's own (restarted from its seed), so a method's trial
+    does not move when another method's trials run before it in the same process."""
+    _, model = peg
+    learned = (("search_points", 10.0),)
+    jobs = assembly_jobs("peg2d", ["skill"], [0.001], 2, model, keep_log=True, learned=learned)
+    alone = run_assembly(jobs[1:], workers=0)[0]
+    after = run_assembly(jobs, workers=0)[1]
+    assert alone.index == after.index == 1 and alone.result is not None
+    assert after.result is not None
+    np.testing.assert_array_equal(alone.result.log.wrench, after.result.log.wrench)

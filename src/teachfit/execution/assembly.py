@@ -3,7 +3,9 @@
 Each trial draws, from :func:`~teachfit.execution.batch.episode_seed` ``(seed, i)`` only (so
 every method sees the same trials), a *taught* hole pose: the true hole moved by exactly
 ``hole_error`` (m) in a uniformly random direction of the surface plane, its yaw by a uniform
-``+-yaw_error`` (rad, tasks whose yaw matters), and a start 25 mm above it (1 mm jitter). The
+``+-yaw_error`` (rad, tasks whose yaw matters), a start 25 mm above it (1 mm jitter) and, on a
+simulated robot, its sensor noise (:class:`~teachfit.robot.interface.NoiseSeeded`: the same
+trial reads the same noise under every method, in any process, after any other trial). The
 skill's task frame is the taught hole; the true hole is known only to the simulator (ground
 truth, recorded beside the measured outcome). A searching method is told the error's size,
 not its direction: the search's spread is at least ``hole_error`` wide (``search_radius``).
@@ -40,7 +42,7 @@ from teachfit.execution.batch import episode_rng, episode_seed, run_batch
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
 from teachfit.execution.search import task_follow_config
 from teachfit.models.search_model import SearchModel
-from teachfit.robot.interface import Robot
+from teachfit.robot.interface import NoiseSeeded, Robot
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
 from teachfit.skills.conditions import DepthAbove, Detected, Done, TimeAbove
@@ -246,6 +248,8 @@ def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
     """Run one trial in this process (task, robot and model cached per process)."""
     task = _task(job.task, job.overrides)
     robot = _robot(job.task, job.overrides, job.robot, job.robot_options)
+    if isinstance(robot, NoiseSeeded):  # the trial's own noise, whatever ran before it here
+        robot.seed_noise(episode_seed(job.seed, job.index))
     rng = episode_rng(job.seed, job.index)
     taught = taught_hole(task, job.hole_error, job.yaw_error, rng)
     base = method_skill(job.method, _model(job.model_json), job.skill, job.controller, task)

@@ -24,7 +24,7 @@ from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
 from teachfit.robot.floating_kernel import FloatingKernel
-from teachfit.robot.interface import law_fault
+from teachfit.robot.interface import law_fault, reseed
 from teachfit.robot.sensor_filter import LowPass2
 from teachfit.tasks.base import Task
 from teachfit.tasks.scene.mjcf import ContactParams, SceneXml, fmt
@@ -322,6 +322,11 @@ class FloatingToolRobot:
         out[4] += lz * fx - lx * fz
         out[5] += lx * fy - ly * fx
         return out
+
+    def seed_noise(self, seed: int) -> None:
+        """Restart the gauge noise from ``seed``; the next :meth:`reset` on draws from it
+        (:class:`~teachfit.robot.interface.NoiseSeeded`)."""
+        reseed(self.rng, seed)
 
     def _noise(self, n: int) -> np.ndarray:
         """(n, 6) gauge noise of ``n`` ticks, before the filter (N, N·m)."""

@@ -89,6 +89,30 @@ class Robot(Protocol):
         ...
 
 
+@runtime_checkable
+class NoiseSeeded(Protocol):
+    """A simulated robot whose sensor noise comes from its own seeded stream.
+
+    A batch that runs many trials on one robot restarts that stream per trial (from the
+    trial's own seed), so that a trial's noise depends on the trial alone, not on the trials
+    that ran before it in the same process. A real arm's noise is its sensors' own: it does
+    not implement this.
+    """
+
+    def seed_noise(self, seed: int) -> None:
+        """Restart the sensor noise's stream from ``seed`` (integer >= 0); the readings from
+        the next :meth:`Robot.reset` on draw from it."""
+        ...
+
+
+def reseed(rng: np.random.Generator, seed: int) -> None:
+    """Restart ``rng`` in place (every holder of the generator sees it) on the noise stream of
+    ``seed``: the child ``(1,)`` of its :class:`numpy.random.SeedSequence`, apart from the draws
+    of ``default_rng(seed)`` that a trial makes from the same seed."""
+    child = np.random.SeedSequence(seed, spawn_key=(1,))
+    rng.bit_generator.state = np.random.PCG64(child).state
+
+
 def law_fault(law: object, t: float) -> ControlError | None:
     """A :class:`ControlError` if the control law's last wrench is not finite, else ``None``.
 

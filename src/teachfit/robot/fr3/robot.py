@@ -34,7 +34,7 @@ from teachfit.robot.fr3.control import TorqueImpedance, operational_inertia
 from teachfit.robot.fr3.ik import IKSettings, solve_ik
 from teachfit.robot.fr3.params import DQ_MAX, DTAU_MAX, Q_MAX, Q_MIN, READY_Q, TAU_MAX, FR3Params
 from teachfit.robot.fr3.sensing import JointTorqueObserver, WristFT
-from teachfit.robot.interface import law_fault
+from teachfit.robot.interface import law_fault, reseed
 from teachfit.tasks.base import Task
 
 TORQUE_TRACES = 16  # executions whose joint torques are kept (FR3Robot.torque_traces)
@@ -274,6 +274,11 @@ class FR3Robot:
             ctl.wrench[:] = law.compute(d.time, pos, quat, v, w)
             if kernel.tick_post(fns, m_ptr, d_ptr, ctl.wrench, dat, bufs, obs, lim, sc):
                 self._check_limits()
+
+    def seed_noise(self, seed: int) -> None:
+        """Restart the sensors' noise from ``seed``; the next :meth:`reset` draws its first
+        block from it (:class:`~teachfit.robot.interface.NoiseSeeded`)."""
+        reseed(self.rng, seed)
 
     def _next_noise(self) -> None:
         self.observer.draw_noise()
