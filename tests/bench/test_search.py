@@ -82,3 +82,22 @@ def test_parallel_jobs_match_inline_jobs():
     pooled = run_jobs(jobs, workers=2)
     assert [r.success for r in inline] == [r.success for r in pooled]
     assert np.allclose([r.path_length for r in inline], [r.path_length for r in pooled])
+
+
+def test_a_job_reads_the_same_noise_whatever_its_worker_ran_before():
+    """A worker's robot restarts its noise from each job's seed: a job's draws do not depend
+    on which jobs the pool handed that worker first."""
+    from teachfit.bench import search_jobs
+    from teachfit.bench.search import _jobs, _peg_setup
+    from teachfit.tasks.registry import get_task
+
+    overrides, _, model = _peg_setup(0, 0.0005)
+    task = get_task("peg2d", **overrides)
+    starts = [task.contact_pose([0.001, 0.0]), task.contact_pose([0.0, 0.001])]
+    jobs = _jobs("peg2d", overrides, model, starts, "tshix", 20, [7, 8])
+    robot = search_jobs._robot("peg2d", jobs[0].overrides, 0, jobs[0].robot)
+    alone = run_jobs(jobs[1:], workers=0)[0]
+    drawn_alone = robot.rng.bit_generator.state
+    after = run_jobs(jobs, workers=0)[1]
+    assert robot.rng.bit_generator.state == drawn_alone  # the same draws, none left over
+    assert (alone.success, alone.reason) == (after.success, after.reason)

@@ -3,7 +3,9 @@
 Ehlers et al.'s protocols run hundreds of independent executions; each :class:`SearchJob` carries
 everything it needs as plain values (task name and overrides, the model as its JSON document,
 the start pose, the generator and its seed), so a worker process rebuilds the task, robot and
-model from it without pickling any user object. Workers cache the robot per task.
+model from it without pickling any user object. Workers cache the robot per task; a simulated
+robot's sensor noise restarts from the job's ``traj_seed`` (its trajectory's seed), so a job reads
+the same noise whichever jobs its worker ran before (any ``--workers``, the same table).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from teachfit.core.geometry import Pose
 from teachfit.execution.batch import run_batch
 from teachfit.execution.search import plan_search, run_search
 from teachfit.models.search_model import SearchModel
-from teachfit.robot.interface import Robot
+from teachfit.robot.interface import NoiseSeeded, Robot
 from teachfit.robot.registry import make_robot
 from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task
@@ -90,6 +92,8 @@ def run_job(job: SearchJob) -> JobResult:
     """Plan and execute one job (in this process)."""
     task = _task(job.task, job.overrides)
     robot = _robot(job.task, job.overrides, job.robot_seed, job.robot)
+    if isinstance(robot, NoiseSeeded):  # the job's own noise, whichever worker ran what before
+        robot.seed_noise(job.traj_seed)
     model = _model(job.model_json)
     rng = np.random.default_rng(job.traj_seed)
     t0 = time.perf_counter()
