@@ -70,3 +70,18 @@ def test_a_skill_without_a_context_parameter_the_task_gives_still_sets_up(tmp_pa
     assert "pass_end" not in old.params.context
     setup = peg_in_hole_setup(task, seed=0, n_starts=1, skill=old)
     assert setup.skill.params.context == old.params.context  # none it does not declare
+
+
+def test_a_trial_reads_the_same_noise_whatever_the_worker_ran_before() -> None:
+    """The noise restarts from the trial's own values: a study's trial does not depend on
+    which trials its worker evaluated first; other values read other noise."""
+    import numpy as np
+
+    from teachfit.execution.skill_trial import SkillTrial
+
+    trial = SkillTrial(peg_in_hole_setup(get_task("peg2d"), seed=0, n_starts=1))
+    values = {"force": 6.0}
+    first = trial(values).traces[0].log.wrench
+    trial({"force": 9.0})  # another trial in between draws noise of its own
+    np.testing.assert_array_equal(trial(values).traces[0].log.wrench, first)
+    assert trial.noise_seed(values) != trial.noise_seed({"force": 6.5})

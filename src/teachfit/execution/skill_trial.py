@@ -9,11 +9,14 @@ skill with one set of learned values from every start and reports the mean cost:
 
 :class:`SkillTrial` keeps one robot across trials (building a simulated robot's MuJoCo model
 is the slow part) and hands it fresh controller settings (data) at each reset, built from the
-adaptive meta-parameters among the learned values.
+adaptive meta-parameters among the learned values. A simulated robot's sensor noise restarts
+at each trial from the trial's values (:meth:`SkillTrial.noise_seed`).
 """
 
 from __future__ import annotations
 
+import json
+import zlib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, TypeVar
@@ -23,6 +26,7 @@ import numpy as np
 from teachfit.core.geometry import Pose
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
 from teachfit.execution.metric import LearningMetric
+from teachfit.robot.interface import NoiseSeeded
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole
 from teachfit.skills.controllers import controller_spec
@@ -137,6 +141,7 @@ class SkillTrial:
         self.metric = metric or LearningMetric(time_limit=t_max.value if t_max else 5.0)
         self.config = config or ExecConfig()
         self.robot = make_robot(robot, setup.task, seed=seed, **robot_options)
+        self.seed = int(seed)
 
     def run(
         self, learned: Mapping[str, float] | None, start: Pose, frame: Pose | None = None
@@ -157,6 +162,13 @@ class SkillTrial:
             controller=controller_spec(self.controller, values),
         )
 
+    def noise_seed(self, learned: Mapping[str, float] | None) -> int:
+        """The sensor-noise seed of a trial with ``learned`` values: the robot's ``seed`` and
+        the values' digest (CRC-32 of their sorted JSON), so that a trial reads the same noise
+        whichever trials its worker ran before (a study does not depend on its scheduling)."""
+        doc = json.dumps(sorted((k, float(v)) for k, v in (learned or {}).items()))
+        return (self.seed << 32) + zlib.crc32(doc.encode())
+
     def __call__(
         self, learned: Mapping[str, float] | None = None, starts: Sequence[Pose] | None = None
     ) -> TrialOutcome:
@@ -166,6 +178,8 @@ class SkillTrial:
             runs = [(st, s.frame(i)) for i, st in enumerate(s.starts)]
         else:
             runs = [(st, None) for st in starts]
+        if isinstance(self.robot, NoiseSeeded):
+            self.robot.seed_noise(self.noise_seed(learned))
         traces, retries = [], 0
         for st, fr in runs:
             trace = self.run(learned, st, fr)
