@@ -59,6 +59,33 @@ def test_joined_graph_and_its_learned_switches(peg):
         get_skill("peg-in-hole+search:/nonexistent.model")
 
 
+def test_an_insert_stalled_in_the_hole_is_pushed_once_more(peg):
+    """A stall with the part dropped in leaves ``insert`` for ``realign`` -> ``reinsert`` (not
+    the error); a stall above the hole, or a second one, is still the error."""
+    _, model = peg
+    sk = peg_in_hole_search.build(model, "impedance")
+    edges = {(t.source, t.target) for t in sk.transitions}
+    assert {("insert", "realign"), ("realign", "reinsert")} <= edges
+    assert not any(t.source == "reinsert" for t in sk.transitions)
+    values = sk.resolve({})
+    deep = 2 * values["drop_depth"]
+    n = int(values["stall_time"] / 0.1) + 3
+
+    def fired(node: str, depth: float) -> bool:
+        check = sk.node(node).error.compile(values)
+        pc = Percept(Pose(np.zeros(3)), 0.1)
+        pc.p[2] = -depth
+        hits = []
+        for i in range(n):
+            pc.t_node = 0.1 * i
+            hits.append(check(pc))
+        return any(hits)
+
+    assert fired("insert", 0.0) and not fired("insert", deep)
+    assert fired("reinsert", deep)
+    assert sk.node("realign").primitive == sk.node("align").primitive
+
+
 def test_search_recovers_a_hole_beyond_the_lateral_reach(peg):
     """5 mm taught-hole error across the lateral move: the plain skill fails; the joined
     skill searches from where it gave up and inserts."""

@@ -11,6 +11,8 @@ The graph is :func:`teachfit.skills.peg_in_hole.build`'s with one more node, ``s
                               +-----------------> search <-----+
                                       dropped in: drop_depth -> align
 
+    insert --stalled after dropping in--> realign -> reinsert  (a stall there: error)
+
 ``lateral`` gives up after the learned ``t_switch`` (or on leaving the region of interest)
 instead of failing, but not before ``t_reach``, the time the move needs to reach the taught
 hole (0 for Johannsmeier et al.'s short move; a task that knows its fit starts the move a part's
@@ -23,7 +25,9 @@ which ends with the part caught in the hole (``drop_depth`` below the entry) -> 
 ``insert``, or with ``t_search`` over -> error -> ``retract`` (a tour that ends without a catch
 is followed by a fresh one from where it ended, ``search_repeat``: a tight sharp-edged fit is
 caught only within about its clearance of the hole's axis, and one tour of the default points
-took 7-8 s of the 15 s on the parts suite's 8 mm round part; 0: the tour done ends it).
+took 7-8 s of the 15 s on the parts suite's 8 mm round part; 0: the tour done ends it). An
+``insert`` that stalls with the part already dropped in is aligned and pushed once more from
+where the part stands (``realign``, ``reinsert``; :func:`_insert_once_more` says why).
 
 With ``search_tilt`` > 0 (a sharp-edged part whose fit the task knows,
 :mod:`teachfit.skills.fit_context`) the search follows its tours tilted, with two more
@@ -47,7 +51,9 @@ from teachfit.core.params import ParamDomain
 from teachfit.models.search_model import SearchModel
 from teachfit.skills import peg_in_hole
 from teachfit.skills.conditions import (
+    Condition,
     DepthAbove,
+    DepthStalled,
     Done,
     ForceAbove,
     LateralAbove,
@@ -92,6 +98,19 @@ LEARNED: dict[str, LearnedParam] = {
 
 #: the lateral moves of the base skill's passes (the extra two only for a task that knows its fit)
 LATERALS = ("lateral", "lateral_2", "lateral_3")
+#: the base skill's nodes run once more, from where the part stalled in the hole
+SEAT = ("align", "insert")
+
+
+def _insert_once_more(node: Node, stalled_in: Condition) -> Node:
+    """``insert`` whose stall in the hole (``stalled_in``) is no error but the way to
+    ``realign`` -> ``reinsert``: the part fell in during the push, away from the set-point the
+    push started from (its oscillation centred there, the adaptive law's stiffness growing on
+    the offset the walls hold: the part jams short of the success depth); from where it stands
+    now it is pushed in once more. Other nodes unchanged."""
+    if node.name != "insert" or node.error is None:
+        return node
+    return replace(node, error=node.error & ~stalled_in)
 
 
 def build(model: SearchModel, controller: str = "adaptive") -> Skill:
@@ -101,9 +120,11 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
         dict(base.params.context) | CONTEXT, dict(base.params.learned) | dict(LEARNED)
     )
     dropped = DepthAbove("drop_depth")
+    stalled = DepthStalled("stall_depth", "stall_time")
     nodes = tuple(
         replace(n, error=TimeAbove("t_lateral")) if n.name in LATERALS else n for n in base.nodes
     )
+    nodes = tuple(_insert_once_more(n, stalled & dropped) for n in nodes)
     # a resistance away from where the far wall is expected: the hole is off by more than
     # the fit's sigma (pushing on reaches f_max), so search from here
     stopped = TimeAbove("t_settle") & ForceAbove("f_lateral_rev", axis="+x")
@@ -121,10 +142,13 @@ def build(model: SearchModel, controller: str = "adaptive") -> Skill:
         Transition("insert", "search", TimeAbove("t_stuck") & ~dropped),
         Transition("search", "align", dropped),
         *tilted,
+        Transition("insert", "realign", stalled & dropped),
+        Transition("realign", "reinsert", Done()),
     )
+    again = tuple(replace(n, name="re" + n.name) for n in base.nodes if n.name in SEAT)
     return Skill(
         name=NAME,
-        nodes=nodes + (search, *phases),
+        nodes=nodes + (search, *phases, *again),
         transitions=transitions,
         start=base.start,
         params=params,
