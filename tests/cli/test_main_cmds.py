@@ -215,6 +215,11 @@ def test_learn_plan_run_search(tmp_path):
     model = tmp_path / "peg.model"
     res = invoke("learn", "search", demos, "--out", model)
     assert res.exit_code == 0, res.output
+    even = invoke("learn", "search", demos, "--out", tmp_path / "x.model", "--mirror", "x")
+    assert even.exit_code == 0 and "2 component(s)" in even.output, even.output
+    bad = invoke("learn", "search", demos, "--out", tmp_path / "rz.model", "--mirror", "rz")
+    assert bad.exit_code == 2 and "cannot mirror ['rz']" in bad.output
+    assert not (tmp_path / "rz.model").exists()
     res = invoke(
         "search", "plan", model, "--method", "tshix", "-n", "50", "--plot", tmp_path / "plan.png"
     )

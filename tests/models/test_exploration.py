@@ -127,3 +127,21 @@ def test_diagonal_covariance_drops_correlations_and_keeps_variances():
     assert two.covs.shape == (2, 2, 2) and np.all(two.covs[:, 0, 1] == 0.0)
     with pytest.raises(ModelError):
         fit_exploration(x, ("x", "y"), covariance="spherical")
+
+
+def test_mirrored_is_even_in_the_mirrored_dofs_only():
+    rng = np.random.default_rng(4)
+    x = rng.multivariate_normal([0.002, -0.001, 0.25], np.diag([1e-5, 4e-6, 0.1]), size=500)
+    e = fit_exploration(x, ("x", "y", "rz"))
+    m = e.mirrored(["rz"])
+    assert m.n_components == 2 * e.n_components
+    flip = np.array([1.0, 1.0, -1.0])
+    s = e.sample(50, np.random.default_rng(5))
+    np.testing.assert_allclose(m.pdf(s), m.pdf(s * flip), rtol=1e-9)
+    np.testing.assert_allclose(m.pdf(s), 0.5 * (e.pdf(s) + e.pdf(s * flip)), rtol=1e-9)
+    # the turn's mean goes to zero and its variance takes the mean's square; x, y unchanged
+    np.testing.assert_allclose(m.mean, [e.mean[0], e.mean[1], 0.0], atol=1e-15)
+    assert m.cov[2, 2] == pytest.approx(e.cov[2, 2] + e.mean[2] ** 2)
+    assert e.mirrored([]) is e
+    with pytest.raises(ModelError, match=r"cannot mirror \['z'\]"):
+        e.mirrored(["z"])

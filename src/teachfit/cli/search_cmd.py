@@ -55,6 +55,13 @@ def learn_search(
         ),
     ] = "auto",
     seed: Annotated[int, o.seed("the mixture fit")] = 0,
+    mirror: Annotated[
+        str,
+        typer.Option(
+            help="DOFs, comma-separated (e.g. rz), whose sign the search treats as unknown: "
+            "the exploration density plus its mirror image (demonstrations from one side)"
+        ),
+    ] = "",
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
     from teachfit.demonstrations.dataset import read_demos
@@ -73,6 +80,7 @@ def learn_search(
         n_components=n_comp,
         seed=seed,
         covariance=covariance,  # type: ignore[arg-type]
+        mirror=tuple(d.strip() for d in mirror.split(",") if d.strip()),
     )
     model.save(out)
     e = model.exploration

@@ -192,6 +192,27 @@ class ExplorationDistribution(GaussianMixture):
         sd = np.sqrt(np.diagonal(self.covs, axis1=1, axis2=2))
         return (self.means - n_sigma * sd).min(axis=0), (self.means + n_sigma * sd).max(axis=0)
 
+    def mirrored(self, dims: Sequence[str]) -> ExplorationDistribution:
+        """The even mixture of p_e and its mirror image with the DOFs ``dims`` negated:
+
+            p_m(s) = (p_e(s) + p_e(F s)) / 2,   F = diag(-1 on dims, +1 elsewhere)
+
+        (2K components). A search relative to its start does not know which way the start
+        is off; demonstrations started on one side teach the way back from that side only
+        (rz on socket3d: ``docs/notes/variant-samples.md``). ``dims`` empty: unchanged."""
+        unknown = sorted(set(dims) - set(self.dims))
+        if unknown:
+            raise ModelError(f"cannot mirror {unknown}: the model's DOFs are {list(self.dims)}")
+        if not dims:
+            return self
+        f = np.array([-1.0 if d in dims else 1.0 for d in self.dims])
+        return ExplorationDistribution(
+            self.dims,
+            np.concatenate([self.weights, self.weights]) / 2.0,
+            np.concatenate([self.means, self.means * f]),
+            np.concatenate([self.covs, self.covs * np.outer(f, f)[None]]),
+        )
+
     def scaled(self, factors: np.ndarray) -> ExplorationDistribution:
         """The distribution of ``diag(factors) s`` (e.g. rz in metres via a length scale)."""
         f = np.asarray(factors, dtype=float)

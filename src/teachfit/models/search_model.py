@@ -144,14 +144,16 @@ class SearchModel:
         rel_floor: float = 0.05,
         seed: int = 0,
         covariance: Literal["auto", "full", "diag"] = "auto",
+        mirror: Sequence[str] = (),
     ) -> SearchModel:
         """Learn p_e and the dynamics from demonstrations (see :func:`search_data`).
 
         ``dims`` defaults to the task's search DOFs; ``covariance`` is p_e's covariance type
         (:func:`fit_exploration`), ``"auto"`` choosing it by leave-one-demonstration-out
         likelihood (:mod:`teachfit.models.covariance_choice`; recorded in
-        ``covariance_choice``). Raises ModelError for too few or degenerate samples, or a
-        teacher who never moved.
+        ``covariance_choice``); ``mirror``: DOFs whose sign p_e is made even in
+        (:meth:`~teachfit.models.exploration.ExplorationDistribution.mirrored`). Raises
+        ModelError for too few or degenerate samples, or a teacher who never moved.
         """
         dims = dims_for_task(task) if dims is None else validate_dims(dims)
         demos = [demos] if hasattr(demos, "pos") else list(demos)
@@ -169,7 +171,7 @@ class SearchModel:
             )
 
         choice = _covariance_choice(covariance, demos, dims, data.rate_hz, fit)
-        expl = fit(data.states, choice.covariance)
+        expl = fit(data.states, choice.covariance).mirrored(mirror)
         dyn = _fit_dynamics(data, dims, dynamics_components, max_components, rel_floor, seed)
         if data.speed <= 0:
             raise ModelError("the demonstrations never move in the search plane")
