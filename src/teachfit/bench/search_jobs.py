@@ -22,7 +22,7 @@ from teachfit.core.geometry import Pose
 from teachfit.execution.batch import run_batch
 from teachfit.execution.search import plan_search, run_search
 from teachfit.models.search_model import SearchModel
-from teachfit.robot.interface import NoiseSeeded, Robot
+from teachfit.robot.interface import Robot, restart_noise
 from teachfit.robot.registry import make_robot
 from teachfit.tasks.base import Task
 from teachfit.tasks.registry import get_task
@@ -92,8 +92,7 @@ def run_job(job: SearchJob) -> JobResult:
     """Plan and execute one job (in this process)."""
     task = _task(job.task, job.overrides)
     robot = _robot(job.task, job.overrides, job.robot_seed, job.robot)
-    if isinstance(robot, NoiseSeeded):  # the job's own noise, whichever worker ran what before
-        robot.seed_noise(job.traj_seed)
+    restart_noise(robot, job.traj_seed)  # the job's own, whichever worker ran what before
     model = _model(job.model_json)
     rng = np.random.default_rng(job.traj_seed)
     t0 = time.perf_counter()

@@ -42,7 +42,7 @@ from teachfit.execution.batch import episode_rng, episode_seed, run_batch
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
 from teachfit.execution.search import task_follow_config
 from teachfit.models.search_model import SearchModel
-from teachfit.robot.interface import NoiseSeeded, Robot
+from teachfit.robot.interface import Robot, restart_noise
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole, peg_in_hole_search
 from teachfit.skills.conditions import DepthAbove, Detected, Done, TimeAbove
@@ -248,8 +248,7 @@ def run_assembly_job(job: AssemblyJob) -> AssemblyTrial:
     """Run one trial in this process (task, robot and model cached per process)."""
     task = _task(job.task, job.overrides)
     robot = _robot(job.task, job.overrides, job.robot, job.robot_options)
-    if isinstance(robot, NoiseSeeded):  # the trial's own noise, whatever ran before it here
-        robot.seed_noise(episode_seed(job.seed, job.index))
+    restart_noise(robot, episode_seed(job.seed, job.index))  # whatever ran before it here
     rng = episode_rng(job.seed, job.index)
     taught = taught_hole(task, job.hole_error, job.yaw_error, rng)
     base = method_skill(job.method, _model(job.model_json), job.skill, job.controller, task)

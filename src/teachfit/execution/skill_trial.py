@@ -26,7 +26,7 @@ import numpy as np
 from teachfit.core.geometry import Pose
 from teachfit.execution.engine import ExecConfig, ExecutionResult, execute
 from teachfit.execution.metric import LearningMetric
-from teachfit.robot.interface import NoiseSeeded
+from teachfit.robot.interface import restart_noise
 from teachfit.robot.registry import make_robot
 from teachfit.skills import peg_in_hole
 from teachfit.skills.controllers import controller_spec
@@ -178,8 +178,7 @@ class SkillTrial:
             runs = [(st, s.frame(i)) for i, st in enumerate(s.starts)]
         else:
             runs = [(st, None) for st in starts]
-        if isinstance(self.robot, NoiseSeeded):
-            self.robot.seed_noise(self.noise_seed(learned))
+        restart_noise(self.robot, self.noise_seed(learned))
         traces, retries = [], 0
         for st, fr in runs:
             trace = self.run(learned, st, fr)

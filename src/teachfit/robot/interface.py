@@ -105,6 +105,13 @@ class NoiseSeeded(Protocol):
         ...
 
 
+def restart_noise(robot: object, seed: int) -> None:
+    """Restart ``robot``'s sensor noise from ``seed`` if it is :class:`NoiseSeeded` (a
+    simulated robot); a real arm is left as it is. Batches call it before each trial."""
+    if isinstance(robot, NoiseSeeded):
+        robot.seed_noise(seed)
+
+
 def reseed(rng: np.random.Generator, seed: int) -> None:
     """Restart ``rng`` in place (every holder of the generator sees it) on the noise stream of
     ``seed``: the child ``(1,)`` of its :class:`numpy.random.SeedSequence`, apart from the draws
