@@ -50,11 +50,19 @@ def test_table3_rows_and_their_order_on_socket3d():
         "tshix-1demo",
         "tshix-2demo",
         "tshix-2demo-diag",
+        "tshix-2demo-auto",
         "ergodic-3d-2demo",
     )
     # every row but the spiral (its length is set by the distribution's radius, not by N: a
     # 98 s execution here); the rows in table order whatever order they were asked in
-    asked = ["ergodic-3d-2demo", "random-walk", "tshix-1demo", "tshix-2demo", "tshix-2demo-diag"]
+    asked = [
+        "ergodic-3d-2demo",
+        "random-walk",
+        "tshix-1demo",
+        "tshix-2demo",
+        "tshix-2demo-diag",
+        "tshix-2demo-auto",
+    ]
     rows = table3(seed=0, n_starts=1, n_points=8, workers=0, methods=asked)
     assert [r.method for r in rows] == [m for m in TABLE3_METHODS if m != "spiral"]
     assert rows[0].paper == PAPER_TABLE3["random-walk"] and rows[-1].paper is None

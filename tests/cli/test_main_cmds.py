@@ -217,6 +217,7 @@ def test_learn_plan_run_search(tmp_path):
     assert res.exit_code == 0, res.output
     even = invoke("learn", "search", demos, "--out", tmp_path / "x.model", "--mirror", "x")
     assert even.exit_code == 0 and "2 component(s)" in even.output, even.output
+    assert "made even in x" in even.output and "made even" not in res.output
     bad = invoke("learn", "search", demos, "--out", tmp_path / "rz.model", "--mirror", "rz")
     assert bad.exit_code == 2 and "cannot mirror ['rz']" in bad.output
     assert not (tmp_path / "rz.model").exists()

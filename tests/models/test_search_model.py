@@ -103,3 +103,15 @@ def test_with_demonstration_type():
     np.testing.assert_allclose(
         np.trace(m.exploration.covs[0]), np.trace(m_arr.exploration.covs[0]), rtol=1e-6
     )
+
+
+def test_a_searched_yaw_is_made_even_by_default_and_offsets_are_not():
+    demos = [make_demo(0), make_demo(1)]
+    even = SearchModel.fit(demos, "socket3d")  # rz searched: auto mirror in rz
+    plain = SearchModel.fit(demos, "socket3d", mirror=())
+    e, p = even.exploration, plain.exploration
+    assert e.n_components == 2 * p.n_components
+    assert e.mean[2] == pytest.approx(0.0, abs=1e-12) and abs(p.mean[2]) > 1e-3
+    np.testing.assert_allclose(e.mean[:2], p.mean[:2])  # x, y keep their side
+    flat = SearchModel.fit(demos, "peg2d")  # no rz: nothing mirrored
+    assert flat.exploration.n_components == p.n_components

@@ -91,8 +91,8 @@ def bench_search(
         typer.Option(
             help="methods, comma-separated: the rows of --table 1 or 3 to run (default: all; "
             "Table I: tshix, tshix-iid, ergodic; Table III: random-walk, spiral, tshix-1demo, "
-            "tshix-2demo, tshix-2demo-diag, ergodic-3d-2demo; with --variants: tshix, ergodic, "
-            "where tshix alone, the goal's method, halves the executions)"
+            "tshix-2demo, tshix-2demo-diag, tshix-2demo-auto, ergodic-3d-2demo; with --variants: "
+            "tshix, ergodic, where tshix alone, the goal's method, halves the executions)"
         ),
     ] = None,
 ) -> None:

@@ -59,13 +59,14 @@ def learn_search(
         str,
         typer.Option(
             help="DOFs, comma-separated (e.g. rz), whose sign the search treats as unknown: "
-            "the exploration density plus its mirror image (demonstrations from one side)"
+            "the exploration density plus its mirror image (demonstrations from one side); "
+            "'auto': rz where it is searched; 'none': no mirror"
         ),
-    ] = "",
+    ] = "auto",
 ) -> None:
     """Learn the exploration distribution and the dynamics model from demonstrations."""
     from teachfit.demonstrations.dataset import read_demos
-    from teachfit.models.search_model import SearchModel
+    from teachfit.models.search_model import SearchModel, auto_mirror
 
     if components != "bic" and not (components.isdigit() and int(components) >= 1):
         raise TeachfitError(f"--components wants a number >= 1 or 'bic', got {components!r}")
@@ -74,14 +75,16 @@ def learn_search(
     if len(tasks) != 1:
         raise TeachfitError(f"{demos} mixes tasks {sorted(tasks)}; learn one task at a time")
     n_comp: int | Literal["bic"] = "bic" if components == "bic" else int(components)
+    chosen = _mirror_dims(mirror)
     model = SearchModel.fit(
         demo_list,
         tasks.pop(),
         n_components=n_comp,
         seed=seed,
         covariance=covariance,  # type: ignore[arg-type]
-        mirror=tuple(d.strip() for d in mirror.split(",") if d.strip()),
+        mirror=chosen,
     )
+    even = auto_mirror(model.dims) if chosen == "auto" else chosen
     model.save(out)
     e = model.exploration
     mean = ", ".join(
@@ -97,8 +100,16 @@ def learn_search(
             if model.covariance_choice is not None
             else ""
         )
+        + (f"\nmade even in {', '.join(even)} (its mirror image added)" if even else "")
         + f"\nmodel -> {out}"
     )
+
+
+def _mirror_dims(text: str) -> tuple[str, ...] | Literal["auto"]:
+    """``--mirror``'s value: ``auto``, ``none`` or comma-separated DOF names."""
+    if text.strip() in ("auto", "none"):
+        return "auto" if text.strip() == "auto" else ()
+    return tuple(d.strip() for d in text.split(",") if d.strip())
 
 
 @search_app.command("plan")
