@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
@@ -20,6 +21,7 @@ from teachfit.cli.common import (
     guarded,
 )
 from teachfit.cli.tables import print_table
+from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT
 
@@ -106,6 +108,13 @@ def twin(
             "in lock-step with a client without a real-time kernel)"
         ),
     ] = True,
+    trace: Annotated[
+        Path | None,
+        typer.Option(
+            help="CSV to write, one row per tick the held part touches anything: the "
+            "simulator's own contact force beside the served O_F_ext_hat_K"
+        ),
+    ] = None,
 ) -> None:
     """A digital twin of a Franka: the task's FR3 cell (the part in the hand) behind
     libfranka's protocol on 127.0.0.1, with the firmware's wrench estimate, reflexes and
@@ -120,8 +129,17 @@ def twin(
         ) from exc
     check_host(host)
     cell = get_task(task)
+    if trace is not None:
+        ensure_folder(trace.parent, "--trace's folder")
     try:
-        serve(cell, host, TwinParams(seed=seed), realtime=realtime, ready=_twin_ready(task))
+        serve(
+            cell,
+            host,
+            TwinParams(seed=seed),
+            realtime=realtime,
+            ready=_twin_ready(task),
+            trace=trace,
+        )
     except KeyboardInterrupt:
         err_console.print("twin stopped (Ctrl-C)")
         raise typer.Exit(130) from None

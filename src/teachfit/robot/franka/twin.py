@@ -31,12 +31,14 @@ stopped by its PID and group); ``teachfit robot twin`` runs :func:`serve` in the
 from __future__ import annotations
 
 import argparse
+import contextlib
 import ipaddress
 import os
 import signal
 import socket
 import sys
 from collections.abc import Callable
+from pathlib import Path
 
 from teachfit.core.errors import TeachfitError
 from teachfit.robot.franka.sim import HOST, PORT_TAKEN, ROBOT_PORT, SimServer, port_free
@@ -63,14 +65,17 @@ def serve(
     params: TwinParams | None = None,
     realtime: bool = True,
     ready: Callable[[str], None] = print,
+    trace: Path | None = None,
 ) -> None:
     """Serve ``task``'s cell on ``host`` (loopback) until Ctrl-C (``KeyboardInterrupt``) or
-    ``SystemExit``; calls ``ready(address)`` once it listens. :class:`TeachfitError` for a
+    ``SystemExit``; calls ``ready(address)`` once it listens; ``trace``: a CSV of the part's
+    contact ticks (:mod:`~teachfit.robot.franka.twin_trace`). :class:`TeachfitError` for a
     non-loopback host or a port already taken."""
     from teachfit.robot.franka.hand_channel import HandChannel
     from teachfit.robot.franka.sim import confine_to_loopback
     from teachfit.robot.franka.twin_cell import TwinSimulator
     from teachfit.robot.franka.twin_firmware import TwinSimulationServer
+    from teachfit.robot.franka.twin_trace import ContactTrace
 
     check_host(host)
     if not port_free(host, ROBOT_PORT):
@@ -78,7 +83,12 @@ def serve(
         raise TeachfitError(why)
     confine_to_loopback()
     sim = TwinSimulator(task, params)
-    with HandChannel(host, sim.hand.take), sim, TwinSimulationServer(sim, host, realtime) as server:
+    with contextlib.ExitStack() as stack:
+        if trace is not None:
+            sim.trace = stack.enter_context(ContactTrace(trace))
+        stack.enter_context(HandChannel(host, sim.hand.take))
+        stack.enter_context(sim)
+        server = stack.enter_context(TwinSimulationServer(sim, host, realtime))
         ready(host)
         server.run_forever()
 
@@ -97,6 +107,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--no-realtime", action="store_true")
     parser.add_argument("--start", type=float, nargs=3, default=TwinParams.start)
     parser.add_argument("--parent", type=int, default=None, help="end with this process")
+    parser.add_argument("--trace", type=Path, default=None, help="CSV of the contact ticks")
     args = parser.parse_args(argv)
     if args.parent is not None:  # SIGTERM (a clean stop) if the starter dies without stopping us
         from teachfit.core.process import die_with_parent
@@ -110,6 +121,7 @@ def main(argv: list[str] | None = None) -> None:
             params=TwinParams(start=tuple(args.start), seed=args.seed),
             realtime=not args.no_realtime,
             ready=lambda host: print(f"{READY} {host}", flush=True),
+            trace=args.trace,
         )
     except TeachfitError as exc:
         print(f"error: teachfit.robot.franka.twin: {exc}", file=sys.stderr, flush=True)

@@ -50,6 +50,7 @@ from teachfit.robot.fr3.sensing import JointTorqueObserver
 from teachfit.robot.franka.frames import DEFAULT_BASE2WORLD
 from teachfit.robot.franka.hand import HandParams
 from teachfit.robot.franka.twin_hand import TwinHand
+from teachfit.robot.franka.twin_trace import ContactTrace
 from teachfit.tasks.base import Task
 
 #: libfranka's F_T_EE translation for the Franka Hand (m along the flange axis)
@@ -146,6 +147,11 @@ class TwinSimulator(BaseSimulator):
             self.params.output_cutoff,
         )
         self._hand = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, fr3_model.HAND)
+        #: the hand's body and the part's tip (ids), for :mod:`~teachfit.robot.franka.twin_trace`
+        self.hand_body = self._hand
+        self.tcp_site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, fr3_model.TCP_SITE)
+        #: a contact trace written every tick (``teachfit robot twin --trace``), or None
+        self.trace: ContactTrace | None = None
         self._kernel_args = self._observer_args()
         # the fr3 robot's joint constants, for the Stribeck term of each step (no limit checks)
         self._joints = (np.zeros(0), np.zeros(0), np.zeros(0), *cell.stribeck())
@@ -195,6 +201,8 @@ class TwinSimulator(BaseSimulator):
         self.hand.apply()  # a person's push: external, so the observer sees it
         kernel.step_physics(fns, m_ptr, d_ptr, dat, self._joints)
         kernel.observe(fns, m_ptr, d_ptr, dat, bufs, sc)
+        if self.trace is not None:
+            self.trace.record(self)
 
     def joints(self) -> tuple[np.ndarray, np.ndarray]:
         """The arm's joint angles (7,) (rad) and speeds (7,) (rad/s)."""
