@@ -119,7 +119,7 @@ def robot_options(
 #: command runs (a new command's output option named otherwise is added here)
 OUTPUT_OPTIONS = frozenset(
     {"out", "plot", "render", "markdown", "save", "strip", "keyposes", "toml", "traces",
-     "best_plot", "benchmarks", "workdir", "log", "rrd", "columns_out"}
+     "best_plot", "benchmarks", "workdir", "log", "rrd", "columns_out", "trace"}
 )  # fmt: skip
 
 
