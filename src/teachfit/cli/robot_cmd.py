@@ -21,7 +21,6 @@ from teachfit.cli.common import (
     guarded,
 )
 from teachfit.cli.tables import print_table
-from teachfit.core.atomic import ensure_folder
 from teachfit.core.errors import TeachfitError
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT
 
@@ -129,8 +128,6 @@ def twin(
         ) from exc
     check_host(host)
     cell = get_task(task)
-    if trace is not None:
-        ensure_folder(trace.parent, "--trace's folder")
     try:
         serve(
             cell,

@@ -107,9 +107,10 @@ def learn_search(
 
 def _mirror_dims(text: str) -> tuple[str, ...] | Literal["auto"]:
     """``--mirror``'s value: ``auto``, ``none`` or comma-separated DOF names."""
-    if text.strip() in ("auto", "none"):
-        return "auto" if text.strip() == "auto" else ()
-    return tuple(d.strip() for d in text.split(",") if d.strip())
+    word = text.strip()
+    if word == "auto":
+        return "auto"
+    return () if word == "none" else tuple(d.strip() for d in word.split(",") if d.strip())
 
 
 @search_app.command("plan")

@@ -147,8 +147,7 @@ class TwinSimulator(BaseSimulator):
             self.params.output_cutoff,
         )
         self._hand = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, fr3_model.HAND)
-        #: the hand's body and the part's tip (ids), for :mod:`~teachfit.robot.franka.twin_trace`
-        self.hand_body = self._hand
+        #: the part's tip (site id), for :mod:`~teachfit.robot.franka.twin_trace`
         self.tcp_site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, fr3_model.TCP_SITE)
         #: a contact trace written every tick (``teachfit robot twin --trace``), or None
         self.trace: ContactTrace | None = None
@@ -159,6 +158,11 @@ class TwinSimulator(BaseSimulator):
         #: a scripted hand (:mod:`teachfit.robot.franka.twin_hand`), idle until a guide comes
         self.hand = TwinHand(self.model, self.data, task, HandParams())
 
+    @property
+    def hand_body(self) -> int:
+        """The hand's body id (the held part hangs below it)."""
+        return int(self._hand)
+
     def start_q(self) -> np.ndarray:
         """Joint angles (rad) placing the TCP at ``params.start`` from the hole's contact pose."""
         pose = self.task.contact_pose(np.zeros(2)).translated(list(self.params.start))
@@ -168,8 +172,7 @@ class TwinSimulator(BaseSimulator):
     def _observer_args(self) -> tuple[Any, ...]:
         """The compiled observer's arguments (the fr3 robot's layout; no wrist sensor here)."""
         m, d, obs = self.model, self.data, self.observer
-        tcp = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, fr3_model.TCP_SITE)
-        dat = kernel.data_views(d, tcp)
+        dat = kernel.data_views(d, self.tcp_site)
         z6 = np.zeros(6)
         bufs = (*obs.bufs, 0, z6, obs.coef, obs.tau_out, obs.tau_z, np.zeros(6), np.zeros((2, 6)))
         sc = np.zeros(kernel.N_SCALARS)
