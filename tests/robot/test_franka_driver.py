@@ -233,3 +233,31 @@ def test_reset_from_inside_a_hole_lifts_along_its_axis_before_moving_sideways(
     # leaves the TCP a few mm off a set-point: TOL); the sideways move came after
     assert np.abs(path[:lifted, 0]).max() < TOL
     assert path[-1, 0] > 0.05 - TOL
+
+
+def test_finish_execution_stops_the_press_at_once_and_the_reset_goes_on_from_there(
+    franka_sim: object,
+) -> None:
+    """A skill's last command still driving the TCP down the hole's axis is ended by
+    ``finish_execution``, not by the next reset: the TCP is braked within a few millimetres
+    and stays; the reset then leaves from where it was let go (one release per reset)."""
+    from teachfit.robot.franka.reset_path import ResetCell
+
+    cell = ResetCell(Pose(np.array([0.0, 0.0, 0.07])), clear_height=0.05)
+    params = FrankaParams(frames=_params().frames, reset_cell=cell)
+    with FrankaRobot("127.0.0.1", params=params, realtime=False) as robot:
+        s = robot.reset(Pose(np.array([0.0, 0.0, 0.11])))  # below the clearance plane
+        down = np.array([0.0, 0.0, -0.1])  # m/s: the skill's set-point sliding down
+        robot.command(
+            ImpedanceCommand(s.pos, s.quat, lin_vel=down, stiffness=STIFF, expires_after=1.0)
+        )
+        s = robot.step(150)
+        assert s.lin_vel[2] < -0.05  # moving down the axis when the execution ends
+        robot.finish_execution()
+        stopped = robot.state()
+        assert abs(stopped.lin_vel[2]) < 0.01 and s.pos[2] - stopped.pos[2] < 0.004
+        held = robot.step(300)  # the skill's set-point would have gone 30 mm further
+        assert abs(held.pos[2] - stopped.pos[2]) < 0.001
+        robot.reset(Pose(np.array([0.05, 0.0, 0.08])))
+        assert robot.reset_guard is not None and len(robot.reset_guard.peaks) == 2
+        np.testing.assert_allclose(robot.state().pos, [0.05, 0.0, 0.08], atol=TOL)

@@ -7,6 +7,7 @@ from scipy.spatial.transform import Rotation
 from teachfit.core.errors import RobotFault, TeachfitError
 from teachfit.core.geometry import Pose, rotation_to_wxyz
 from teachfit.robot.franka.reset_path import (
+    BRAKE_RAMP,
     ResetCell,
     ResetGuard,
     brake_decel,
@@ -127,21 +128,27 @@ def test_the_skills_force_at_the_hand_over_is_kept_apart_from_the_resets_own():
     assert guard.peaks[-1] == pytest.approx(16.0)
 
 
-@pytest.mark.parametrize("speed", [-0.2, 0.05])
-def test_the_brake_stops_smoothly_at_most_at_its_deceleration(speed):
-    decel = 8.0
+@pytest.mark.parametrize("speed", [-0.2, 0.05, 0.004])
+def test_the_brake_stops_smoothly_at_most_at_its_deceleration_and_jerk(speed):
+    decel, ramp = 8.0, BRAKE_RAMP
     big_t = brake_time(speed, decel)
-    t = np.linspace(0.0, big_t, 2001)
+    t = np.linspace(0.0, big_t, 4001)
     dist, vel, acc = np.array([brake_profile(speed, decel, ti) for ti in t]).T
     # from the part's speed with no step in the force (zero acceleration) to rest, at rest after
     assert vel[0] == speed and acc[0] == 0.0 and vel[-1] == pytest.approx(0.0, abs=1e-12)
     assert acc[-1] == pytest.approx(0.0, abs=1e-12)
-    assert np.max(np.abs(acc)) == pytest.approx(decel, rel=1e-4)
+    peak = min(decel, abs(speed) / ramp)  # a slow part is stopped more gently
+    assert np.max(np.abs(acc)) == pytest.approx(peak, rel=1e-3)
+    assert np.max(np.abs(np.diff(acc))) <= decel / ramp * (t[1] - t[0]) * (1 + 1e-6)
     assert np.all(acc * speed <= 0.0)  # against the motion only
     assert dist[-1] == pytest.approx(speed * big_t / 2)
+    if peak == decel:  # the shortest stop at that jerk and deceleration
+        assert dist[-1] == pytest.approx(
+            np.sign(speed) * (speed**2 / (2 * decel) + abs(speed) * ramp / 2)
+        )
     # the parts agree: the distance is the speed's integral, the speed the acceleration's
     np.testing.assert_allclose(np.gradient(dist, t), vel, atol=1e-3 * abs(speed))
-    np.testing.assert_allclose(np.gradient(vel, t), acc, atol=2e-2 * decel)
+    np.testing.assert_allclose(np.gradient(vel, t), acc, atol=2e-2 * peak)
     assert brake_profile(speed, decel, 2 * big_t) == (dist[-1], 0.0, 0.0)
     assert brake_profile(0.0, decel, 0.1) == (0.0, 0.0, 0.0)
 

@@ -75,6 +75,9 @@ class _AfterReset:
     def step(self, n: int = 1) -> RobotState:
         return self.robot.step(n)
 
+    def finish_execution(self) -> None:
+        self.robot.finish_execution()
+
     def close(self) -> None:
         self.robot.close()
 

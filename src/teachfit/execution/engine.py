@@ -342,12 +342,16 @@ class _Run:
         """Close the last visit, judge the end state, run the recovery node after an error
         condition, and build the result."""
         t_end = self.pc.t
+        recover = self.by_error and self.recovery is not None and self.cfg.recovery_time > 0
+        if not recover:  # a real arm's loop runs on: the skill's press ends now
+            self.robot.finish_execution()
         if self.outcome is not Outcome.PRECONDITION:
             self.visits.append(NodeVisit(self.active.name, self.t_enter, t_end, self.reason))
         remaining = float(np.linalg.norm(self.last_pos - self.goal))
         detected, truth = self._judge_end()
-        if self.by_error and self.recovery is not None and self.cfg.recovery_time > 0:
-            self.visits.append(self._recover(self.recovery))
+        if recover:
+            self.visits.append(self._recover(self.recovery))  # type: ignore[arg-type]
+            self.robot.finish_execution()
         return ExecutionResult(
             skill=self.skill.name,
             outcome=self.outcome,

@@ -221,6 +221,9 @@ class FloatingToolRobot:
         """None: the blind teacher guides the free tool as the paper's teacher guided the arm."""
         return NO_TEACHER_HINTS
 
+    def finish_execution(self) -> None:
+        """Nothing to do: the simulation's time runs only in :meth:`step`."""
+
     def close(self) -> None:
         """Nothing to release but the simulator's memory (kept until garbage collection)."""
         self._cmd = None

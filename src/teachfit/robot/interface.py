@@ -77,6 +77,14 @@ class Robot(Protocol):
         """
         ...
 
+    def finish_execution(self) -> None:
+        """The execution commanding the robot has ended: stop acting on its last command now.
+
+        A simulated robot's time runs only in :meth:`step`: nothing to do. A real arm's control
+        loop runs on while the caller judges and logs the execution, so the skill's press would
+        go on (the Franka lets the part go and holds it at rest in the hole)."""
+        ...
+
     def close(self) -> None:
         """Release the robot (stop the control loop, free the connection or the simulator)."""
         ...

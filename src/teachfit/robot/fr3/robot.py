@@ -306,6 +306,9 @@ class FR3Robot:
             return cls.TEACHER_HINTS.then(cls.TEACHER_RZ_HINTS)
         return cls.TEACHER_HINTS
 
+    def finish_execution(self) -> None:
+        """Nothing to do: the simulation's time runs only in :meth:`step`."""
+
     def close(self) -> None:
         """Nothing to release but the simulator's memory (kept until garbage collection)."""
         self._cmd = None

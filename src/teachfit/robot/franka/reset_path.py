@@ -45,6 +45,9 @@ from teachfit.core.errors import NeedsAPerson, TeachfitError
 from teachfit.core.geometry import Pose
 from teachfit.core.state import ImpedanceCommand
 
+#: s over which the brake's deceleration rises and falls (:func:`brake_profile`)
+BRAKE_RAMP = 0.01
+
 
 @dataclass(frozen=True)
 class ResetCell:
@@ -100,27 +103,52 @@ def leave_stiffness(cell: ResetCell, along: float) -> np.ndarray:
     return k
 
 
-def brake_time(speed: float, decel: float) -> float:
-    """How long (s) :func:`brake_profile` takes to stop ``speed`` (m/s) at most ``decel`` (m/s²)."""
-    return 1.5 * abs(speed) / decel
+def brake_time(speed: float, decel: float, ramp: float = BRAKE_RAMP) -> float:
+    """How long (s) :func:`brake_profile` takes to stop ``speed`` (m/s) at most ``decel``
+    (m/s²), its deceleration rising and falling over ``ramp`` (s)."""
+    if speed == 0.0:
+        return 0.0
+    peak = min(decel, abs(speed) / ramp)
+    return abs(speed) / peak + ramp
 
 
-def brake_profile(speed: float, decel: float, t: float) -> tuple[float, float, float]:
+def brake_profile(
+    speed: float, decel: float, t: float, ramp: float = BRAKE_RAMP
+) -> tuple[float, float, float]:
     """Distance (m), speed (m/s) and acceleration (m/s²) along an axis ``t`` s into a stop from
     ``speed`` (m/s, signed along the axis) at most ``decel`` (m/s²).
 
-    The speed falls as a smoothstep, ``v = speed (1 - 3u² + 2u³)`` with ``u = t / T`` and
-    ``T`` = :func:`brake_time`: the acceleration starts and ends at zero (the hand-over's force
-    has no step) and peaks at ``decel``; the stop takes ``speed T / 2``. After ``T``: at rest
-    there."""
-    big_t = brake_time(speed, decel)
+    The deceleration rises linearly to its peak ``a = min(decel, |speed| / ramp)`` over
+    ``ramp`` s, holds, and falls back to zero over the last ``ramp`` s (a jerk of at most
+    ``decel / ramp``: no step in the force at the hand-over, nor in the joint torques' rate), so
+    the stop takes ``T = |speed| / a + ramp`` (:func:`brake_time`) and covers ``speed T / 2``:
+    ``speed² / 2a + speed ramp / 2``, the shortest at that jerk and deceleration. After ``T``:
+    at rest there."""
+    big_t = brake_time(speed, decel, ramp)
     if big_t <= 0.0:
         return 0.0, 0.0, 0.0
-    u = min(max(t / big_t, 0.0), 1.0)
-    dist = speed * big_t * (u - u**3 + 0.5 * u**4)
-    vel = speed * (1.0 - 3.0 * u * u + 2.0 * u**3)
-    acc = -6.0 * speed * u * (1.0 - u) / big_t
-    return dist, vel, acc
+    sign, peak = float(np.sign(speed)), min(decel, abs(speed) / ramp)
+    jerk = peak / ramp
+    hold = big_t - 2.0 * ramp  # >= 0 s at the peak deceleration
+
+    def rising(s: float) -> tuple[float, float, float]:  # s in [0, ramp]: a = -jerk s
+        return abs(speed) * s - jerk * s**3 / 6.0, abs(speed) - jerk * s * s / 2.0, -jerk * s
+
+    t = min(max(t, 0.0), big_t)
+    if t <= ramp:
+        dist, vel, acc = rising(t)
+    else:
+        d1, v1, _ = rising(ramp)
+        s = min(t - ramp, hold)
+        dist, vel, acc = d1 + v1 * s - peak * s * s / 2.0, v1 - peak * s, -peak
+        if t > ramp + hold:  # falling: a = -peak + jerk s
+            s = t - ramp - hold
+            dist += vel * s - peak * s * s / 2.0 + jerk * s**3 / 6.0
+            vel += -peak * s + jerk * s * s / 2.0
+            acc = -peak + jerk * s
+    if t >= big_t:
+        vel, acc = 0.0, 0.0
+    return sign * dist, sign * vel, sign * acc
 
 
 def release_command(
