@@ -87,3 +87,30 @@ def test_a_lagging_part_is_pushed_along_the_motion_slowly_and_bounded():
     assert f[-1, 0] == 6.0  # clipped at the push force
     assert np.all(_drags(FollowConfig(track_feel=0.1), pressed=1.0) == 0.0)  # not pressed
     assert np.all(_drags(FollowConfig(), pressed=6.0) == 0.0)  # off by default
+
+
+def test_a_tilted_search_closes_the_lag_while_searching_only():
+    """Tilted, the part is pushed along the motion in the searching phases (a tilted part
+    held back by friction far from the hole lagged 5 mm for 10 s on the FR3); in the slide and
+    the align it stalls at the wall on purpose: no push there, and the loop starts afresh."""
+    from teachfit.skills.follower import Follower
+    from teachfit.skills.tilt import TiltConfig
+
+    t = np.array([0.0, 10.0])
+    pos = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    traj = SetpointTrajectory.from_path(t, pos, np.tile([1.0, 0, 0, 0], (2, 1)))
+    follower = Follower(traj, FollowConfig(track_feel=0.1, tilt=TiltConfig()))
+    pc = Percept(Pose(np.zeros(3)), 0.01)
+    follower.start(pc)
+
+    def along(k: int, searching: bool) -> float:
+        pc.f[2], pc.t = 6.0, 0.01 * k
+        pc.p[:] = 0.0  # stuck: the set-point runs ahead
+        cmd = MPCommand()
+        follower.track(pc, cmd, pc.t, searching)
+        return float(cmd.wrench[0])
+
+    pushed = [along(k, True) for k in range(20)]
+    assert pushed[-1] > 0.0 and np.all(np.diff(pushed) >= 0.0)
+    assert along(20, False) == 0.0 and follower.track_correction == 0.0  # sliding: none
+    assert 0.0 < along(21, True) < pushed[-1]  # searching again: from zero

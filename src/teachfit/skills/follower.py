@@ -49,7 +49,7 @@ class FollowConfig:
     part (a hand that felt the drop also relaxes sideways). ``tilt`` (None: upright): search
     with the part tilted, and on the drop slide it to the hole's wall and align it upright
     (:mod:`teachfit.skills.tilt`: a skill graph of its own; its align node is a hold, with
-    ``hold_stiffness``). ``track_feel`` (s), when positive and upright, closes a slow loop on
+    ``hold_stiffness``). ``track_feel`` (s), when positive and searching, closes a slow loop on
     the lag along the motion, as a person who feels the part drag pushes harder: while the
     part is pressed on a surface, a force along the motion grows by ``stiffness_along`` times
     the set-point's lead over the TCP along it, integrated over ``track_feel`` (clipped to
@@ -129,9 +129,12 @@ class Follower:
         self.press_correction = self.track_correction = 0.0
         self.z0, self.hold = float(pc.p[2]), None
 
-    def track(self, pc: Percept, out: MPCommand, t_traj: float) -> np.ndarray:
+    def track(
+        self, pc: Percept, out: MPCommand, t_traj: float, searching: bool = True
+    ) -> np.ndarray:
         """The set-point, its velocity and the feed-forward wrench with the push, at time
-        ``t_traj`` (s) on the trajectory; returns the trajectory's orientation there."""
+        ``t_traj`` (s) on the trajectory; returns the trajectory's orientation there.
+        ``searching``: a tilted search's searching phase (the lag loop runs there only)."""
         cfg = self.cfg
         pos, quat, vel, ff = self.traj.sample(t_traj)
         pc.p_d[:] = pos + self.offset
@@ -149,8 +152,10 @@ class Follower:
                 lim = 0.5 * cfg.push_force
                 self.press_correction = min(lim, max(-lim, self.press_correction + step))
             out.wrench[2] -= self.press_correction
-        if cfg.track_feel > 0.0 and cfg.tilt is None:
+        if cfg.track_feel > 0.0 and searching:
             self._track_loop(pc, out)
+        else:
+            self.track_correction = 0.0
         return quat
 
     def _track_loop(self, pc: Percept, out: MPCommand) -> None:

@@ -98,12 +98,12 @@ class TiltContext:
             xy += self.blend * (1.0 - (t - self.blend_t0) / self.blend_time)
         return xy
 
-    def track(self, pc: Percept, out: MPCommand) -> tuple[np.ndarray, float]:
+    def track(self, pc: Percept, out: MPCommand, searching: bool) -> tuple[np.ndarray, float]:
         """Follow the trajectory at its clock: the set-point (with the blend), velocity,
         feed-forward and push; returns the trajectory's orientation and time there."""
         t = self.time(pc)
         t_traj = t - self.paused
-        quat = self.follower.track(pc, out, t_traj)
+        quat = self.follower.track(pc, out, t_traj, searching)
         if t - self.blend_t0 < self.blend_time:
             pc.p_d[:2] += self.blend * (1.0 - (t - self.blend_t0) / self.blend_time)
         return quat, t_traj

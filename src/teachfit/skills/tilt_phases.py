@@ -52,7 +52,7 @@ class _PhaseRun(PrimitiveRun):
     def command(self, pc: Percept, out: MPCommand) -> None:
         ctx = self.ctx
         assert ctx is not None, "enter() first"
-        quat, t_traj = ctx.track(pc, out)
+        quat, t_traj = ctx.track(pc, out, self.searching)
         ctx.tick(pc, self.searching)
         self.steer(ctx, pc, out, quat)
         ctx.follower.stiffness(out)
