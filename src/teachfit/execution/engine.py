@@ -342,15 +342,15 @@ class _Run:
         """Close the last visit, judge the end state, run the recovery node after an error
         condition, and build the result."""
         t_end = self.pc.t
-        recover = self.by_error and self.recovery is not None and self.cfg.recovery_time > 0
-        if not recover:  # a real arm's loop runs on: the skill's press ends now
+        recovery = self.recovery if self.by_error and self.cfg.recovery_time > 0 else None
+        if recovery is None:  # a real arm's loop runs on: the skill's press ends now
             self.robot.finish_execution()
         if self.outcome is not Outcome.PRECONDITION:
             self.visits.append(NodeVisit(self.active.name, self.t_enter, t_end, self.reason))
         remaining = float(np.linalg.norm(self.last_pos - self.goal))
         detected, truth = self._judge_end()
-        if recover:
-            self.visits.append(self._recover(self.recovery))  # type: ignore[arg-type]
+        if recovery is not None:
+            self.visits.append(self._recover(recovery))
             self.robot.finish_execution()
         return ExecutionResult(
             skill=self.skill.name,
