@@ -7,7 +7,6 @@ plans the same path on every machine. Lengths in m, times in s, forces in N.
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
 
 from teachfit.core.geometry import Pose, quat_from_rz
 from teachfit.core.setpoints import SetpointTrajectory
@@ -119,6 +118,10 @@ def hand_noise(st: TeacherStyle, rng: np.random.Generator, n: int, dt: float) ->
     t = dt * np.arange(n)
     tremor = st.tremor_amplitude * np.sin(2 * np.pi * st.tremor_frequency * t[:, None] + phase)
     if st.hand_smoothing > 0:  # the same draws through a hand of lower bandwidth
+        # imported here: scipy.signal (and the scipy.stats it loads) is 0.5-1 s of every
+        # command's start-up, and only a smoothed hand needs it
+        from scipy.signal import lfilter
+
         c = np.exp(-dt / st.hand_smoothing)
         return lfilter([1.0 - c], [1.0, -c], w + tremor, axis=0)
     return w + tremor

@@ -28,14 +28,17 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import manifold3d
 import numpy as np
-import trimesh
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from teachfit.core.errors import TaskError
+
+if TYPE_CHECKING:  # trimesh is imported where a mesh is built: 0.4 s of every command's start
+    import trimesh
 
 __all__ = [
     "PARTS",
@@ -133,6 +136,8 @@ def _union(boxes: list[Corners]) -> tuple[np.ndarray, trimesh.Trimesh]:
 
 def _to_trimesh(solid: manifold3d.Manifold) -> trimesh.Trimesh:
     # manifold3d does the boolean algebra (exact, watertight output); trimesh carries the result.
+    import trimesh
+
     mesh = solid.to_mesh()
     out = trimesh.Trimesh(
         vertices=np.asarray(mesh.vert_properties)[:, :3].astype(float),
