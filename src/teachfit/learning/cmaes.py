@@ -11,12 +11,17 @@ random mean with the initial step size, so a trial budget is always used up.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-import cma
 import numpy as np
 
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import GenerationalLearner
+
+if (
+    TYPE_CHECKING
+):  # cma is imported where a strategy is made: it loads scipy.stats and pyplot (1-2 s)
+    import cma
 
 
 class CMAES(GenerationalLearner):
@@ -62,6 +67,8 @@ class CMAES(GenerationalLearner):
         self._es = self._make_es(self._x0)
 
     def _make_es(self, x0: np.ndarray) -> cma.CMAEvolutionStrategy:
+        import cma
+
         rng = self._rng
         opts = {
             "bounds": [0.0, 1.0],
