@@ -4,25 +4,24 @@ and together they finish exactly the budget -- on SQLite and on a real PostgreSQ
 from __future__ import annotations
 
 import json
-import os
+import multiprocessing
 import signal
 import subprocess
 import sys
 import time
 from collections.abc import Callable
+from multiprocessing.process import BaseProcess
 from pathlib import Path
 
 import pytest
 import sqlalchemy as sa
 
-import teachfit
 from teachfit.learning import Study, TrialResult, run_study
 from teachfit.learning.claims import CLAIMS, HOST, Claims, Verdict
 
 from .share_worker import SPACE, cost, open_shared
 
-WORKER = Path(__file__).with_name("share_worker.py")
-SRC = str(Path(teachfit.__file__).resolve().parents[1])
+FORK = multiprocessing.get_context("fork")
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])
@@ -55,52 +54,68 @@ def _claim_pids(url: str) -> set[int]:
         engine.dispose()
 
 
+def _share(url: str, budget: int, sleep_s: float, out: Path, mark: Path | None) -> None:
+    """A process of the shared study (forked from the test's: no second import): runs it to
+    ``budget`` and writes how many trials it finished to ``out``."""
+
+    def objective(p: dict[str, float]) -> tuple[float, bool]:
+        if mark is not None:
+            with mark.open("a") as fh:
+                fh.write("trial\n")
+        return cost(p, sleep_s)
+
+    rep = run_study(open_shared(url, "cmaes"), objective, budget, workers=0)
+    out.write_text(f"finished={rep.finished} restored={rep.restored}")
+
+
 def test_four_processes_share_one_study_and_one_is_killed(shared_url: str, tmp_path: Path) -> None:
     budget = 16  # 4 whole CMA-ES generations of 4
     ref = open_shared(f"sqlite:///{tmp_path / 'ref.db'}", "cmaes")
     run_study(ref, cost, budget, workers=0)
     expected = sorted((t.key, t.cost) for t in ref.trials())
-
-    base = dict(os.environ, PYTHONPATH=SRC)
     mark = tmp_path / "victim.marks"
 
     def begun() -> int:
         return len(mark.read_text().splitlines()) if mark.exists() else 0
 
-    def start(sleep_s: str, **extra: str) -> subprocess.Popen[str]:
-        cmd = [sys.executable, str(WORKER), shared_url, str(budget), "cmaes", sleep_s]
-        out = {"stdout": subprocess.PIPE, "stderr": subprocess.STDOUT, "text": True}
-        return subprocess.Popen(cmd, env=dict(base, **extra), **out)  # type: ignore[call-overload]
+    def start(i: int, sleep_s: float, marks: Path | None = None) -> BaseProcess:
+        args = (shared_url, budget, sleep_s, tmp_path / f"out{i}", marks)
+        proc = FORK.Process(target=_share, args=args)
+        proc.start()
+        return proc
 
     def wait_for(what: str, cond: Callable[[], bool], timeout: float = 180.0) -> None:
         deadline = time.monotonic() + timeout
         while not cond():
-            if time.monotonic() > deadline or victim.poll() is not None:
+            if time.monotonic() > deadline or not victim.is_alive():
                 victim.kill()
-                pytest.fail(f"{what} did not happen: {victim.communicate()[0]}")
+                pytest.fail(f"{what} did not happen: the victim exited {victim.exitcode}")
             time.sleep(0.05)
 
     # the victim's trials never end by themselves (600 s), so it is killed in its first one
     # whatever the machine's load: no race between its next claim and the others' trials
-    victim = start("600.0", SHARE_WORKER_MARK=str(mark))
+    victim = start(0, 600.0, mark)
     procs = [victim]
     try:
         wait_for("a first trial of the victim", lambda: begun() > 0)
-        procs += [start("0.05") for _ in range(3)]
+        procs += [start(i, 0.05) for i in (1, 2, 3)]
         others = {p.pid for p in procs[1:]}
         wait_for("a claim of the others", lambda: bool(_claim_pids(shared_url) & others))
         # what it holds as it dies (read before the kill: a survivor on this host takes a dead
         # owner's claim over at once, so afterwards the claim may already be another's)
-        held = _running_claims(shared_url, victim.pid)
-        victim.send_signal(signal.SIGKILL)
-        victim.wait(timeout=10)
-        outs = [p.communicate(timeout=300)[0] for p in procs[1:]]
+        held = _running_claims(shared_url, victim.pid)  # type: ignore[arg-type]
+        victim.kill()
+        victim.join(10)
+        for p in procs[1:]:
+            p.join(300)
     finally:
         for p in procs:
-            if p.poll() is None:
+            if p.is_alive():
                 p.kill()
-                p.wait()
-    assert all(p.returncode == 0 for p in procs[1:]), outs
+                p.join()
+    assert victim.exitcode == -signal.SIGKILL
+    assert all(p.exitcode == 0 for p in procs[1:]), [p.exitcode for p in procs]
+    outs = [(tmp_path / f"out{i}").read_text() for i in (1, 2, 3)]
 
     final = open_shared(shared_url, "cmaes")
     trials = final.trials()
