@@ -24,7 +24,11 @@ pytest.importorskip("franky_sim", reason="needs the franka extra (franky-sim)")
 
 from teachfit.core.geometry import Pose  # noqa: E402
 from teachfit.core.state import ImpedanceCommand  # noqa: E402
-from teachfit.robot.franka import DEFAULT_BASE2WORLD, franka_for_task  # noqa: E402
+from teachfit.robot.franka import (  # noqa: E402
+    DEFAULT_BASE2WORLD,
+    FrankaLimits,
+    franka_for_task,
+)
 from teachfit.robot.franka.check import check_robot  # noqa: E402
 from teachfit.robot.franka.frames import (  # noqa: E402
     approach_waypoints,
@@ -346,13 +350,19 @@ def test_a_part_handed_over_still_sliding_into_the_hole_is_stopped_under_5_n(
     assert guard.peaks[-1] <= 5.0 and guard.handover_peaks[-1] <= 5.0, guard
 
 
+#: the TCP 30 mm beside the hole, 2 mm above the plate (:data:`BESIDE_BOSS`), and 10 mm above
+#: the boss's top there, over the reset's clearance plane (5 mm): a reset from there to
+#: ``_BESIDE`` goes straight down, one from below the plane out of it and back
+_BESIDE = TASK.contact_pose(np.zeros(2)).translated(list(BESIDE_BOSS))
+_OVER_BESIDE = (BESIDE_BOSS[0], BESIDE_BOSS[1], 0.01)
+
+
 def _press_down(robot: Any, depth: float, ticks: int) -> Any:
-    """Hold the TCP ``depth`` m below the plate beside the boss at 2000 N/m (about
-    2000 * depth N down once it rests on the plate); the last state."""
-    above = TASK.contact_pose(np.zeros(2)).translated(list(BESIDE_BOSS))  # 2 mm above
-    robot.reset(above)
-    below = Pose(above.pos - [0.0, 0.0, 0.002 + depth], above.quat)
-    for pose in approach_waypoints(above, below, 0.02, 0.3, 0.01):
+    """From :data:`_BESIDE` (where the caller reset the arm), hold the TCP ``depth`` m below
+    the plate at 2000 N/m (about 2000 * depth N down once it rests on the plate); the last
+    state."""
+    below = Pose(_BESIDE.pos - [0.0, 0.0, 0.002 + depth], _BESIDE.quat)
+    for pose in approach_waypoints(_BESIDE, below, 0.02, 0.3, 0.01):
         robot.command(ImpedanceCommand.hold(pose, stiffness=2000.0))
         state = robot.step(10)
     for _ in range(ticks // 10):
@@ -365,18 +375,28 @@ def test_the_driver_sets_the_collision_reflex_above_its_force_limit_a_low_one_st
     franka_twin: Twin,
 ) -> None:
     """libfranka's default 20 N would stop a 30 N press; the driver's default (75 N) does not,
-    and a reflex force of 10 N set through the driver makes the same press a reflex."""
+    and a reflex force of 10 N set through the driver makes the same press a reflex.
+
+    The resets only place the arm (above the clearance plane between the two drivers, so that
+    neither has to leave the plate's clearance and come back), at 3x the default reset speed;
+    they run outside ``pytest.raises``: the reflex must come from the press."""
     from teachfit.core.errors import ReflexFault
 
-    franka_twin(start=BESIDE_BOSS)
-    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+    fast = FrankaLimits(reset_speed=0.15)
+    franka_twin(start=_OVER_BESIDE)
+    over = TASK.contact_pose(np.zeros(2)).translated(list(_OVER_BESIDE))
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False, limits=fast) as robot:
         assert robot.reflex is not None and robot.reflex.upper_force[:3] == (75.0,) * 3
-        state = _press_down(robot, depth=0.015, ticks=600)
-        robot.reset(TASK.contact_pose(np.zeros(2)).translated(list(BESIDE_BOSS)))  # off it
+        robot.reset(_BESIDE)
+        state = _press_down(robot, depth=0.015, ticks=300)
+        robot.reset(over)  # off the plate, over the clearance plane
     assert state.wrench[2] > 25.0, state.wrench  # the plate pushes back past 20 N: no reflex
-    with franka_for_task(TASK, host="127.0.0.1", realtime=False, reflex_force=10.0) as robot:
+    with franka_for_task(
+        TASK, host="127.0.0.1", realtime=False, reflex_force=10.0, limits=fast
+    ) as robot:
+        robot.reset(_BESIDE)
         with pytest.raises(ReflexFault, match="cartesian_reflex"):
-            _press_down(robot, depth=0.015, ticks=600)
+            _press_down(robot, depth=0.015, ticks=300)
 
 
 def test_the_hand_answers_while_the_driver_holds_the_arm_in_lock_step(franka_twin: Twin) -> None:
@@ -420,7 +440,8 @@ def test_the_laws_apparent_mass_is_the_arms_at_the_reset_pose(franka_twin: Twin)
     from teachfit.robot.franka.twin_cell import TwinSimulator
 
     franka_twin()
-    with franka_for_task(TASK, host="127.0.0.1", realtime=False) as robot:
+    fast = FrankaLimits(reset_speed=0.15)  # the reset only places the arm: at 3x its speed
+    with franka_for_task(TASK, host="127.0.0.1", realtime=False, limits=fast) as robot:
         robot.reset(TASK.contact_pose(np.zeros(2)).translated([0.0, 0.0, 0.02]))
         mass, q = robot.apparent_mass, robot.joint_positions
     sim = TwinSimulator(TASK)
