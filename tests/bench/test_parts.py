@@ -38,7 +38,7 @@ def test_search_and_assemble_run_on_the_robot_asked_for(round12: Path) -> None:
     from teachfit.bench import search as bs
 
     task = round12
-    sizes = bp.Sizes(starts=1, points=50)
+    sizes = bp.Sizes(starts=1, points=10)
     rows = bp.bench_part("round12", task, "fr3", sizes, methods=["search", "assemble"])
     assert [(r.robot, r.method, r.summary.trials) for r in rows] == [
         ("fr3", "search", 1), ("fr3", "assemble", 1)
@@ -58,8 +58,8 @@ def test_the_search_rows_come_from_the_same_starts_as_bench_search_task(round12:
 
     task = round12
     demos = task_demos(str(task), 0)
-    res = run_jobs(task_jobs(str(task), demos, 0, n_starts=1, n_points=50), workers=0)
-    rows = task_table(str(task), demos, 0, n_starts=1, n_points=50, workers=0)
+    res = run_jobs(task_jobs(str(task), demos, 0, n_starts=1, n_points=10), workers=0)
+    rows = task_table(str(task), demos, 0, n_starts=1, n_points=10, workers=0)
     assert [r.method for r in rows] == ["tshix", "ergodic"]
     assert rows[0].ours.successes == sum(r.success for r in res)
     assert rows[0].length == pytest.approx(res[0].path_length)  # the same planned path

@@ -16,9 +16,12 @@ from teachfit.bench.search import (
 from teachfit.bench.search_jobs import run_jobs
 from teachfit.core.errors import TeachfitError
 
+# seed 1: the teacher's recording of peg2d that the CLI and execution tests make too (cached)
+SEED = 1
+
 
 def test_table1_protocol_runs_every_method_on_the_same_starts():
-    rows = table1(seed=0, n_starts=1, n_points=20, workers=0)
+    rows = table1(seed=SEED, n_starts=1, n_points=20, workers=0)
     assert [r.method for r in rows] == ["tshix", "tshix-iid", "ergodic"]
     for r in rows:
         assert r.ours.trials == 1
@@ -30,7 +33,7 @@ def test_table1_protocol_runs_every_method_on_the_same_starts():
 
 
 def test_table2_and_ablation_rows_line_up_with_the_paper():
-    rows, abl = table2(seed=0, sizes=(20, 40), n_traj=1, ablation=(20,), workers=0)
+    rows, abl = table2(seed=SEED, sizes=(20, 40), n_traj=1, ablation=(20,), workers=0)
     assert [r.method for r in rows] == ["N=20", "N=40"]
     assert [r.method for r in abl] == ["N=20 no-ff"]
     assert all(r.ours.trials == 1 for r in rows + abl)
@@ -63,7 +66,8 @@ def test_table3_rows_and_their_order_on_socket3d():
         "tshix-2demo-diag",
         "tshix-2demo-auto",
     ]
-    rows = table3(seed=0, n_starts=1, n_points=8, workers=0, methods=asked)
+    # seed 2: three of the TSHIX rows insert, the other executions run to their end
+    rows = table3(seed=2, n_starts=1, n_points=8, workers=0, methods=asked)
     assert [r.method for r in rows] == [m for m in TABLE3_METHODS if m != "spiral"]
     assert rows[0].paper == PAPER_TABLE3["random-walk"] and rows[-1].paper is None
     assert all(r.ours.trials == 1 for r in rows)
@@ -82,10 +86,10 @@ def test_parallel_jobs_match_inline_jobs():
     from teachfit.bench.search import _jobs, _peg_setup
     from teachfit.tasks.registry import get_task
 
-    overrides, demo, model = _peg_setup(0, 0.0005)
+    overrides, demo, model = _peg_setup(SEED, 0.0005)
     task = get_task("peg2d", **overrides)
     starts = task.protocol.protocol_starts("table1", 2, np.random.default_rng(3))
-    jobs = _jobs("peg2d", overrides, model, starts, "tshix", 10, [1, 2])
+    jobs = _jobs("peg2d", overrides, model, starts, "tshix", 5, [3, 5])  # one inserts, one not
     inline = run_jobs(jobs, workers=0)
     pooled = run_jobs(jobs, workers=2)
     assert [r.success for r in inline] == [r.success for r in pooled]
@@ -99,10 +103,10 @@ def test_a_job_reads_the_same_noise_whatever_its_worker_ran_before():
     from teachfit.bench.search import _jobs, _peg_setup
     from teachfit.tasks.registry import get_task
 
-    overrides, _, model = _peg_setup(0, 0.0005)
+    overrides, _, model = _peg_setup(SEED, 0.0005)
     task = get_task("peg2d", **overrides)
     starts = [task.contact_pose([0.001, 0.0]), task.contact_pose([0.0, 0.001])]
-    jobs = _jobs("peg2d", overrides, model, starts, "tshix", 20, [7, 8])
+    jobs = _jobs("peg2d", overrides, model, starts, "tshix", 10, [7, 8])
     robot = search_jobs._robot("peg2d", jobs[0].overrides, 0, jobs[0].robot)
     alone = run_jobs(jobs[1:], workers=0)[0]
     drawn_alone = robot.rng.bit_generator.state

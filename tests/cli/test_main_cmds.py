@@ -165,7 +165,7 @@ def test_quickstart_small(tmp_path):
         "--starts",
         "2",
         "--points",
-        "20",
+        "10",
     )
     assert res.exit_code == 0, res.output
     out = _flat(res.output)

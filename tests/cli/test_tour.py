@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[2]
 runner = CliRunner()
 
 #: option -> the small value the test runs with
-SMALL = {"--count": "1", "--starts": "1", "--points": "30", "--trials": "2"}
+SMALL = {"--count": "1", "--starts": "1", "--points": "30", "--trials": "2", "--setups": "2"}
 #: extra options per command (in-process trials: no worker start-up)
 EXTRA = {("learn", "skill"): ["--workers", "0"]}
 #: commands tested elsewhere (rendering, benchmarks, video capture and what depends on it)
