@@ -14,6 +14,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from media_checks import read_video
 from typer.testing import CliRunner
 
 from teachfit.cli import app
@@ -23,8 +24,11 @@ runner = CliRunner()
 
 #: option -> the small value the test runs with
 SMALL = {"--count": "1", "--starts": "1", "--points": "30", "--trials": "2", "--setups": "2"}
-#: extra options per command (in-process trials: no worker start-up)
-EXTRA = {("learn", "skill"): ["--workers", "0"]}
+#: extra options per command (in-process trials: no worker start-up; small videos)
+EXTRA = {
+    ("learn", "skill"): ["--workers", "0"],
+    ("assemble", "--task"): ["--fps", "5", "--width", "160", "--height", "120"],  # a small video
+}
 #: commands tested elsewhere (rendering, benchmarks, video capture and what depends on it)
 ELSEWHERE = (
     ("bench",),
@@ -91,3 +95,4 @@ def test_the_tour_runs_from_a_clean_folder(tmp_path: Path, monkeypatch: pytest.M
     assert {d.source for d in read_dataset("log.h5")} == {"imported"}
     for name in ("peg.model", "demos.png", "plan.png", "skill.png", "puzzle.toml"):
         assert Path(name).stat().st_size > 0, name
+    assert read_video(Path("trial.mp4")).shape[1:3] == (120, 160)  # assemble's --width/--height

@@ -87,6 +87,9 @@ def assemble(
     render: Annotated[
         Path | None, typer.Option("--render", help="video (mp4) of that trial")
     ] = None,
+    fps: o.Fps = 30,
+    width: o.Width = 640,
+    height: o.Height = 480,
     robot: RobotOpt = "floating",
     host: HostOpt = None,
     realtime: RealtimeOpt = True,
@@ -104,11 +107,12 @@ def assemble(
 
     err, yaw, task_name = _checked(task, demo, hole_error, yaw_error, robot)
     check_recording_targets(log, rrd)
+    frames = (fps, width, height)
     if task in PLANNED_PARTS:
         ang = parse_quantity(angle_error, "deg", "--angle-error")
         rec = (log, rrd, {"task": task, "demo": demo, "hole_error": hole_error,
                "angle_error": angle_error, "trials": trials, "seed": seed})  # fmt: skip
-        _assemble_plan(task, demo, err, ang, trials, seed, plot, render, rec)
+        _assemble_plan(task, demo, err, ang, trials, seed, plot, render, rec, frames)
         return
     arm = tuple(robot_options(host, realtime, confirm, reflex_force).items())
     if arm and workers:
@@ -141,7 +145,7 @@ def assemble(
         write_recordings(log, rrd, [t.result for t in out], info, opts)
     if (plot is None and render is None) or not finished.complete:
         return end_run(finished, faulted, "trial")
-    _trial_figures(shown_trial(out), task, plot, render, robot)
+    _trial_figures(shown_trial(out), task, plot, render, robot, frames)
     exit_if_faulted(faulted)
 
 
@@ -192,9 +196,15 @@ def _report_trials(out: list[AssemblyTrial]) -> bool:
 
 
 def _trial_figures(
-    pick: AssemblyTrial, task: str, plot: Path | None, video: Path | None, robot: str
+    pick: AssemblyTrial,
+    task: str,
+    plot: Path | None,
+    video: Path | None,
+    robot: str,
+    frames: tuple[int, int, int],
 ) -> None:
-    """``--plot`` (phases over time) and ``--render`` (a video) of trial ``pick``."""
+    """``--plot`` (phases over time) and ``--render`` (a video, ``frames``: its fps, width and
+    height) of trial ``pick``."""
     assert pick.result is not None
     if plot is not None:
         from teachfit.viz.assembly_figures import plot_phases
@@ -206,7 +216,17 @@ def _trial_figures(
 
         log = pick.result.log
         with console.status("rendering"):
-            path = render_motion(get_task(task), log.t, log.pos, log.quat, video, robot=robot)
+            path = render_motion(
+                get_task(task),
+                log.t,
+                log.pos,
+                log.quat,
+                video,
+                robot=robot,
+                fps=frames[0],
+                width=frames[1],
+                height=frames[2],
+            )
         console.print(f"video of trial {pick.index} -> {path}")
 
 
@@ -361,9 +381,11 @@ def _assemble_plan(
     plot: Path | None,
     video: Path | None,
     rec: tuple[Path | None, Path | None, Mapping[str, object]] = (None, None, {}),
+    frames: tuple[int, int, int] = (30, 640, 480),
 ) -> None:
     """demonstration -> plan -> path executed in contact -> seating skill, over trials;
-    ``rec``: the run log and Rerun targets and the options they record."""
+    ``rec``: the run log and Rerun targets and the options they record; ``frames``: the
+    video's fps, width and height."""
     import numpy as np
 
     from teachfit.execution.assembly_run import capture_ranges, planned_path
@@ -401,7 +423,7 @@ def _assemble_plan(
         write_recordings(rec[0], rec[1], [t.result for t in out], info, rec[2])
     if not finished.complete:
         return end_run(finished, faulted, "trial")
-    _plan_figures(out[0], plot, video, part, seed, ranges)
+    _plan_figures(out[0], plot, video, part, seed, ranges, frames)
     exit_if_faulted(faulted)
 
 
@@ -442,8 +464,10 @@ def _plan_figures(
     part: str,
     seed: int,
     ranges: dict[str, tuple[float, float]],
+    frames: tuple[int, int, int],
 ) -> None:
-    """``--plot`` (phases over time) and ``--render`` (a video in its cell) of trial 0."""
+    """``--plot`` (phases over time) and ``--render`` (a video in its cell; ``frames``: its
+    fps, width and height) of trial 0."""
     if plot is not None:
         from teachfit.viz.assembly_figures import plot_phases
 
@@ -455,5 +479,14 @@ def _plan_figures(
         log = pick.result.log
         cell = trial_cell(part, seed, 0, **ranges)
         with console.status("rendering"):
-            path_mp4 = render_motion(cell, log.t, log.pos, log.quat, video)
+            path_mp4 = render_motion(
+                cell,
+                log.t,
+                log.pos,
+                log.quat,
+                video,
+                fps=frames[0],
+                width=frames[1],
+                height=frames[2],
+            )
         console.print(f"video of trial 0 -> {path_mp4}")
