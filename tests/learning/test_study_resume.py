@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import gc
 import os
 import signal
+import threading
 from pathlib import Path
 
 import pytest
+import sqlalchemy as sa
 
 from teachfit.learning import (
     LearningError,
@@ -16,6 +19,7 @@ from teachfit.learning import (
     StudyMismatchError,
     run_study,
 )
+from teachfit.learning.claims import CLAIMS
 
 SPACE = ParamSpace({"a": ParamDomain(-1.0, 1.0), "b": ParamDomain(0.0, 2.0)})
 
@@ -145,3 +149,30 @@ def test_a_cell_that_needs_a_person_stops_the_run_and_charges_no_trial(tmp_path:
     assert len(stored) == 3 and all(r.outcome != "error" for r in stored)
     report = run_study(open_study(db), rosenbrock, 10, workers=0)
     assert report.finished == 7 and len(open_study(db).trials()) == 10
+
+
+def test_a_study_collected_in_anothers_transaction_releases_its_claims_after_it(
+    tmp_path: Path,
+) -> None:
+    """A Study dropped without ``close()`` is finalized by the garbage collector in whatever
+    thread it interrupts, here one inside a write transaction on the same SQLite file (as a
+    resume in the same process can be): its claims are released once that transaction ends.
+    Released inside it, the release waited for its own thread until the busy timeout (120 s)
+    and then failed, leaving the claim behind."""
+    db = tmp_path / "gc.db"
+    old = open_study(db)
+    cand = old.ask(10)
+    assert cand is not None
+    old.cycle = old  # type: ignore[attr-defined]  # freed by the cyclic collector only
+    del old
+    new = open_study(db)
+    held = sa.select(CLAIMS.c.key).where(CLAIMS.c.key == cand.key)
+    with new._claims.engine.begin() as conn:
+        gc.collect()  # the old study's finalizer runs here, inside the write transaction
+        assert conn.execute(held).all() != []  # not released inside it
+    for thread in threading.enumerate():
+        if thread.name == "teachfit-claims-close":
+            thread.join(60)
+    with new._claims.engine.connect() as conn:
+        assert conn.execute(held).all() == []  # released after it
+    new.close()

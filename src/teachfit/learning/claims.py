@@ -359,6 +359,16 @@ class Claims:
         )
         self._beat.start()
 
+    def close_in_background(self) -> None:
+        """:meth:`close` in a thread of its own, for a finalizer. The garbage collector runs
+        finalizers in whichever thread it interrupts, maybe one inside a write transaction on
+        the same SQLite file: a release there would wait for that very thread, up to the busy
+        timeout (120 s), then give up."""
+        try:
+            threading.Thread(target=self.close, name="teachfit-claims-close", daemon=True).start()
+        except RuntimeError:  # the interpreter is exiting: no transaction of ours is open
+            self.close()
+
     def close(self) -> None:
         """Stop the heartbeat and release unfinished running claims (best effort: claims
         left behind die with this process anyway)."""

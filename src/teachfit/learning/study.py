@@ -225,7 +225,7 @@ class Study:
         self.n_here = 0
         self._seen = {str(t.user_attrs["key"]) for t in finished}
         self._claims = Claims(self.url, name, claim_timeout)
-        weakref.finalize(self, self._claims.close)
+        weakref.finalize(self, self._claims.close_in_background)
         self._running: dict[str, tuple[Candidate, bool]] = {}  # claimed here: (cand, own)
         self._retry: list[tuple[Candidate, bool]] = []  # to claim (again)
         self._elsewhere: dict[str, Candidate] = {}  # claimed by other processes
