@@ -5,7 +5,6 @@ from __future__ import annotations
 import gc
 import os
 import signal
-import threading
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,7 @@ from teachfit.learning import (
     StudyMismatchError,
     run_study,
 )
-from teachfit.learning.claims import CLAIMS
+from teachfit.learning.claims import CLAIMS, release_dropped
 
 SPACE = ParamSpace({"a": ParamDomain(-1.0, 1.0), "b": ParamDomain(0.0, 2.0)})
 
@@ -156,9 +155,9 @@ def test_a_study_collected_in_anothers_transaction_releases_its_claims_after_it(
 ) -> None:
     """A Study dropped without ``close()`` is finalized by the garbage collector in whatever
     thread it interrupts, here one inside a write transaction on the same SQLite file (as a
-    resume in the same process can be): its claims are released once that transaction ends.
-    Released inside it, the release waited for its own thread until the busy timeout (120 s)
-    and then failed, leaving the claim behind."""
+    resume in the same process can be): its claims are released after that transaction, by
+    the next study made or asked. Released inside it, the release waited for its own thread
+    until the busy timeout (120 s) and then failed, leaving the claim behind."""
     db = tmp_path / "gc.db"
     old = open_study(db)
     cand = old.ask(10)
@@ -170,9 +169,7 @@ def test_a_study_collected_in_anothers_transaction_releases_its_claims_after_it(
     with new._claims.engine.begin() as conn:
         gc.collect()  # the old study's finalizer runs here, inside the write transaction
         assert conn.execute(held).all() != []  # not released inside it
-    for thread in threading.enumerate():
-        if thread.name == "teachfit-claims-close":
-            thread.join(60)
+    release_dropped()  # as the next study made or asked does
     with new._claims.engine.connect() as conn:
         assert conn.execute(held).all() == []  # released after it
     new.close()

@@ -24,6 +24,7 @@ owner's ``storing`` claim is resolved by :meth:`Claims.resolve` against the stor
 
 from __future__ import annotations
 
+import atexit
 import json
 import os
 import socket
@@ -359,15 +360,14 @@ class Claims:
         )
         self._beat.start()
 
-    def close_in_background(self) -> None:
-        """:meth:`close` in a thread of its own, for a finalizer. The garbage collector runs
-        finalizers in whichever thread it interrupts, maybe one inside a write transaction on
-        the same SQLite file: a release there would wait for that very thread, up to the busy
-        timeout (120 s), then give up."""
-        try:
-            threading.Thread(target=self.close, name="teachfit-claims-close", daemon=True).start()
-        except RuntimeError:  # the interpreter is exiting: no transaction of ours is open
-            self.close()
+    def drop(self) -> None:
+        """For a finalizer (a study dropped unclosed): stop the heartbeat now and release the
+        claims at the next :func:`release_dropped`. The garbage collector runs finalizers in
+        whichever thread it interrupts, maybe one inside a write transaction on the same
+        SQLite file: a release there would wait for that very thread, up to the busy timeout
+        (120 s), then fail and leave the claims behind."""
+        self._stop.set()
+        _DROPPED.append(self)
 
     def close(self) -> None:
         """Stop the heartbeat and release unfinished running claims (best effort: claims
@@ -381,3 +381,18 @@ class Claims:
             pass  # the database is gone (e.g. a server stopped first)
         finally:
             self.engine.dispose()
+
+
+#: claims of studies dropped unclosed (:meth:`Claims.drop`), to release where it is safe
+_DROPPED: list[Claims] = []
+
+
+def release_dropped() -> None:
+    """Release the claims of studies dropped unclosed (:meth:`Claims.drop`). Called where this
+    thread holds no transaction: a study's creation and each ``ask``, and at exit."""
+    while _DROPPED:
+        _DROPPED.pop().close()
+
+
+# at exit after the finalizers, which register later (atexit runs last in, first out)
+atexit.register(release_dropped)

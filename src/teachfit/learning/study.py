@@ -41,7 +41,14 @@ from sqlalchemy.exc import DBAPIError
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import Candidate, Finished, Learner, TrialResult
 from teachfit.learning.bo import BayesOpt
-from teachfit.learning.claims import Claim, Claims, Verdict, engine_kwargs, serialise_sqlite
+from teachfit.learning.claims import (
+    Claim,
+    Claims,
+    Verdict,
+    engine_kwargs,
+    release_dropped,
+    serialise_sqlite,
+)
 from teachfit.learning.cmaes import CMAES
 from teachfit.learning.lhs import LatinHypercube
 from teachfit.learning.pso import PSO
@@ -203,6 +210,7 @@ class Study:
             raise LearningError(f"penalty must be finite, got {penalty}")
         if not claim_timeout > 0:
             raise LearningError(f"claim_timeout must be > 0 s, got {claim_timeout}")
+        release_dropped()  # studies dropped unclosed, before this one reads the claims
         self.url = storage_url(storage)
         #: the storage as a person reads it (a file's path; a URL without its password)
         self.where = shown(self.url)
@@ -225,7 +233,7 @@ class Study:
         self.n_here = 0
         self._seen = {str(t.user_attrs["key"]) for t in finished}
         self._claims = Claims(self.url, name, claim_timeout)
-        weakref.finalize(self, self._claims.close_in_background)
+        weakref.finalize(self, self._claims.drop)
         self._running: dict[str, tuple[Candidate, bool]] = {}  # claimed here: (cand, own)
         self._retry: list[tuple[Candidate, bool]] = []  # to claim (again)
         self._elsewhere: dict[str, Candidate] = {}  # claimed by other processes
@@ -304,6 +312,7 @@ class Study:
         """Claim and return the next candidate, or ``None`` if none can be claimed now: the
         learner waits for trials running (here or elsewhere), the budget is taken by finished
         and running trials, or the learner is exhausted (:meth:`settled` tells which)."""
+        release_dropped()  # studies dropped unclosed: outside any transaction, here
         if time.monotonic() - self._synced > SYNC_S:
             self.sync()
         cand = self._next(budget)
