@@ -380,8 +380,8 @@ def _assemble_plan(
     seed: int,
     plot: Path | None,
     video: Path | None,
-    rec: tuple[Path | None, Path | None, Mapping[str, object]] = (None, None, {}),
-    frames: tuple[int, int, int] = (30, 640, 480),
+    rec: tuple[Path | None, Path | None, Mapping[str, object]],
+    frames: tuple[int, int, int],
 ) -> None:
     """demonstration -> plan -> path executed in contact -> seating skill, over trials;
     ``rec``: the run log and Rerun targets and the options they record; ``frames``: the

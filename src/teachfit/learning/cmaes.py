@@ -18,9 +18,8 @@ import numpy as np
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import GenerationalLearner
 
-if (
-    TYPE_CHECKING
-):  # cma is imported where a strategy is made: it loads scipy.stats and pyplot (1-2 s)
+# cma is imported where a strategy is made: it loads scipy.stats and pyplot (1-2 s)
+if TYPE_CHECKING:
     import cma
 
 
