@@ -1,10 +1,15 @@
 """The peg-in-hole skill on the FR3 arm with its default parameters; the key's task context."""
 
 import numpy as np
+import pytest
 
+from teachfit.core.errors import SkillError
+from teachfit.core.geometry import Pose
 from teachfit.core.outcome import Outcome
 from teachfit.execution.skill_trial import SkillTrial, peg_in_hole_setup
 from teachfit.skills import peg_in_hole
+from teachfit.skills.percept import MPCommand, Percept
+from teachfit.skills.primitive import Insert
 from teachfit.tasks import get_task
 
 
@@ -31,3 +36,20 @@ def test_key_context_fixes_the_tilt_and_learns_the_rest():
     skill = peg_in_hole_setup(key, seed=0, n_starts=1).skill
     assert "tilt" not in skill.space.names and skill.params.context["tilt"].value == 0.1
     assert "tilt" in peg_in_hole_setup(get_task("peg"), seed=0, n_starts=1).skill.space.names
+
+
+def test_the_insert_push_fades_with_the_parts_speed_into_the_hole():
+    # a part that comes free in the hole is not driven on (a real arm's reset must brake it
+    # in the millimetres left); a jammed one gets the whole push
+    run = Insert(force=10.0, depth=0.01, sink=0.02, v_press=0.05).compile({})
+    pc, out = Percept(Pose(np.zeros(3)), 0.001), MPCommand()
+    run.enter(pc)
+    pushes = []
+    for speed in (0.0, 0.05, 0.075, 0.1, 0.2, -0.05):  # m/s into the hole (-z)
+        pc.v[2] = -speed
+        run.command(pc, out)
+        pushes.append(-out.wrench[2])
+    assert pushes == pytest.approx([10.0, 10.0, 5.0, 0.0, 0.0, 10.0])
+    assert peg_in_hole.build().node("insert").primitive.v_press == "v_press"
+    with pytest.raises(SkillError, match="v_press"):
+        Insert(v_press=0.0).compile({})

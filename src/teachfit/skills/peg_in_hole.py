@@ -26,7 +26,7 @@ surface); the lateral move runs along its +x. Five primitives:
    the part's symmetry ``rz_period``) keeping contact with ``f_push``.
 5. ``insert``    push with the learned ``force`` while the set-point sinks to ``depth``,
    superposing translational (``a_t``, ``f_t``) and rotational (``a_r``, ``f_r``)
-   oscillations.
+   oscillations; the push fades out once the part slides in faster than ``v_press``.
 
 Success: ``depth`` reached below the estimated entry. Error: the time limit ``t_max`` (from
 the skill start), a force above ``f_max``, per-node time limits, leaving the region of
@@ -92,6 +92,9 @@ CONTEXT: dict[str, ContextParam] = {
     "v_contact": ContextParam(0.03, "m/s", "speed towards the surface"),
     "v_lateral": ContextParam(0.015, "m/s", "speed of the lateral move"),
     "v_insert": ContextParam(0.03, "m/s", "sinking speed of the set-point when inserting"),
+    "v_press": ContextParam(
+        0.05, "m/s", "insert: the push fades from this speed into the hole to none at twice it"
+    ),
     "f_contact": ContextParam(3.0, "N", "force that marks contact with the surface"),
     "f_push": ContextParam(4.0, "N", "pressing force while moving laterally and aligning"),
     "f_lateral": ContextParam(4.0, "N", "resistance that marks a constrained lateral move"),
@@ -260,6 +263,7 @@ def _insert_nodes(fast: _Speeds, roi: LateralAbove) -> tuple[Node, ...]:
                 f_t="f_t",
                 a_r="a_r",
                 f_r="f_r",
+                v_press="v_press",
                 stiffness=(400.0, 400.0, 200.0, 30.0, 30.0, 20.0),
             ),
             roi | DepthStalled("stall_depth", "stall_time"),
