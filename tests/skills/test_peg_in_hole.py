@@ -50,6 +50,7 @@ def test_the_insert_push_fades_with_the_parts_speed_into_the_hole():
         run.command(pc, out)
         pushes.append(-out.wrench[2])
     assert pushes == pytest.approx([10.0, 10.0, 5.0, 0.0, 0.0, 10.0])
-    assert peg_in_hole.build().node("insert").primitive.v_press == "v_press"
+    insert = peg_in_hole.build().node("insert").primitive
+    assert insert.v_press == "v_press" and "fading above v_press" in insert.describe()
     with pytest.raises(SkillError, match="v_press"):
         Insert(v_press=0.0).compile({})

@@ -356,8 +356,9 @@ class Insert(Primitive):
         return _InsertRun(r, _stiffness(values, self.stiffness))
 
     def describe(self) -> str:
+        fade = "" if self.v_press == math.inf else f", fading above {self.v_press}"
         return (
-            f"push {self.force} to depth {self.depth}; osc. a_t {self.a_t} @ {self.f_t}, "
+            f"push {self.force} to depth {self.depth}{fade}; osc. a_t {self.a_t} @ {self.f_t}, "
             f"a_r {self.a_r} @ {self.f_r}"
         )
 
