@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from typer.testing import CliRunner
 
@@ -21,13 +23,16 @@ def test_robot_check_prints_state_limits_and_timing(franka_sim: object) -> None:
     assert "ticks: 300 (0.3 s at 1000 Hz)" in text
 
 
-def test_bench_robot_reports_tick_percentiles(franka_sim: object) -> None:
+def test_bench_robot_reports_tick_percentiles(franka_sim: object, tmp_path: Path) -> None:
+    md = tmp_path / "loop.md"
+    arm = ["--host", "127.0.0.1", "--no-realtime", "--seconds", "0.5"]
     res = CliRunner().invoke(
-        app, ["bench", "robot", "--host", "127.0.0.1", "--no-realtime", "--seconds", "0.5"]
+        app, ["bench", "robot", *arm, "--controller", "adaptive", "--markdown", str(md)]
     )
     assert res.exit_code == 0, res.output
     text = " ".join(res.output.split())
     assert "ticks: 500" in text and "p50" in text and "p99" in text and "missed deadlines" in text
+    assert "through the robot's protocol, adaptive law" in md.read_text()
 
 
 def test_assemble_runs_its_trials_on_the_arm_one_at_a_time(franka_sim: object) -> None:

@@ -27,7 +27,7 @@ def test_measured_wrench_is_the_environments_on_the_tool_at_the_tcp(
     # libfranka: the robot pushes the environment along -x (and twists it about -z) at K = EE
     state.O_F_ext_hat_K = [-4.0, 0.0, 0.0, 0.0, 0.0, -0.3]  # type: ignore[attr-defined]
     tick.kinematics(state, model)
-    w = tick.raw_wrench(state)
+    w = tick.raw_wrench()
     o_t_ee = np.asarray(state.O_T_EE).reshape(4, 4, order="F")  # type: ignore[attr-defined]
     lever = o_t_ee[:3, :3] @ np.array([0.0, 0.0, -0.05])  # TCP -> EE (base = world rotation)
     np.testing.assert_allclose(w[:3], [4.0, 0.0, 0.0], atol=1e-6)
@@ -112,3 +112,71 @@ def test_operational_inertia_is_the_full_lambda_in_world_axes() -> None:
     np.testing.assert_allclose(lam, lam.T)
     # not diagonal: accelerating along z alone takes force along x and y too
     assert np.count_nonzero(np.abs(lam[:3, 2]) > 1e-6) == 3
+
+
+@pytest.mark.parametrize("adaptive", [False, True])
+def test_the_compiled_tick_gives_the_python_laws_torques(
+    state_and_model: tuple[object, object], adaptive: bool
+) -> None:
+    from teachfit.control import make_law
+    from teachfit.core.control import AdaptiveSpec, FixedGainSpec
+    from teachfit.core.geometry import Pose
+    from teachfit.core.state import ImpedanceCommand
+
+    state, model = state_and_model
+    frames, mass = FrankaFrames(ee2tcp=ee2tcp_for_part(0.05)), np.array([3, 3, 3, 0.1, 0.1, 0.1])
+    ticks = [TorqueTick(frames, FrankaLimits()) for _ in range(2)]
+    spec = AdaptiveSpec() if adaptive else FixedGainSpec()
+    laws = [make_law(spec, mass, 0.001) for _ in range(2)]
+    ticks[0].kinematics(state, model)
+    near = Pose(ticks[0].pos + [0.004, -0.002, 0.003], ticks[0].quat.copy())
+    # a moving set-point that expires between commands: extrapolation, spin and expiry
+    cmd = ImpedanceCommand.hold(
+        near, stiffness=[800, 800, 800, 30, 30, 30], lin_vel=[0.02, 0.0, -0.01],
+        ang_vel=[0.0, 0.0, 0.3], expires_after=0.006,
+    )  # fmt: skip
+    rng = np.random.default_rng(3)
+    dq0, ext0 = np.asarray(state.dq), np.asarray(state.O_F_ext_hat_K)  # type: ignore[attr-defined]
+    for n in range(40):
+        state.dq = (dq0 + rng.normal(0.0, 0.05, 7)).tolist()  # type: ignore[attr-defined]
+        state.O_F_ext_hat_K = (ext0 + rng.normal(0.0, 2.0, 6)).tolist()  # type: ignore[attr-defined]
+        t = 0.001 * (n + 1)
+        if n % 10 == 0:
+            ticks[0].command(laws[0], cmd, t)  # the compiled law's clock is in the tick
+            laws[1].set_command(cmd, t)
+        assert ticks[0].step(t, laws[0], state, model) == ""
+        ticks[1].kinematics(state, model)
+        python = ticks[1].torques(t, laws[1], state, model)
+        np.testing.assert_allclose(ticks[0].tau, python, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(laws[0].last_wrench, laws[1].last_wrench, atol=1e-9)
+    assert np.abs(ticks[0].tau).max() > 1.0  # the rate limit let the torques grow
+    if adaptive:
+        np.testing.assert_allclose(laws[0].feedforward, laws[1].feedforward, atol=1e-12)
+        assert np.abs(laws[0].feedforward).max() > 0.0
+
+
+def test_a_tick_over_the_speed_limit_computes_no_torques_and_says_why(
+    state_and_model: tuple[object, object],
+) -> None:
+    from teachfit.control import make_law
+    from teachfit.core.control import FixedGainSpec
+    from teachfit.core.state import ImpedanceCommand
+
+    state, model = state_and_model
+    tick = TorqueTick(FrankaFrames(), FrankaLimits(max_tcp_speed=0.1))
+    tick.kinematics(state, model)
+    law = make_law(FixedGainSpec(), np.ones(6), 0.001)
+    tick.command(law, ImpedanceCommand.hold(tick_pose(tick)), 0.0)
+    state.dq = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5]  # type: ignore[attr-defined]
+    assert tick.step(0.001, law, state, model) == ""  # the last joint turns the flange
+    before = tick.tau.copy()
+    state.dq = [0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0]  # type: ignore[attr-defined]
+    assert tick.step(0.002, law, state, model).startswith("TCP speed")
+    np.testing.assert_array_equal(tick.tau, before)
+    np.testing.assert_array_equal(tick.tau_prev, before)
+
+
+def tick_pose(tick: TorqueTick) -> object:
+    from teachfit.core.geometry import Pose
+
+    return Pose(tick.pos.copy(), tick.quat.copy())

@@ -170,29 +170,35 @@ def bench_robot(
     ] = 10.0,
     realtime: Annotated[bool, _REALTIME] = True,
     connect_timeout: ConnectTimeoutOpt = CONNECT_TIMEOUT,
+    controller: Annotated[
+        str, typer.Option(help="the law that holds the pose: impedance or adaptive")
+    ] = "impedance",
     markdown: o.Markdown = None,
 ) -> None:
     """Tick compute time p50/p99/max and missed deadlines of the 1 kHz loop, through the
     robot's protocol."""
     from teachfit.robot.franka.check import bench_loop
     from teachfit.robot.franka.driver import FrankaParams
+    from teachfit.skills.controllers import controller_spec
 
     if not seconds > 0:
         raise TeachfitError(f"--seconds must be > 0, got {seconds}")
+    spec = controller_spec(controller, {})
     address = _real(robot, host)
     params = FrankaParams(connect_timeout=connect_timeout)
     with _interruptible(address):
         timing = bench_loop(
-            address, seconds=seconds, params=params, realtime=realtime, out=console.print
-        )
+            address, seconds=seconds, params=params, realtime=realtime, out=console.print,
+            controller=spec,
+        )  # fmt: skip
     if markdown is not None:
-        text = _timing_markdown(timing, address)
+        text = _timing_markdown(timing, address, controller)
         console.print(f"markdown appended to {append_markdown(markdown, text)}")
 
 
-def _timing_markdown(t: LoopTiming, address: str) -> str:
+def _timing_markdown(t: LoopTiming, address: str, controller: str) -> str:
     """``bench robot``'s figures as a one-row markdown table (times in µs, the 1-minute load
-    average at the end of the run)."""
+    average at the end of the run) for the loop running ``controller``."""
     import os
 
     us = [f"{v * 1e6:.0f} µs" for v in (t.compute_p50, t.compute_p99, t.compute_max)]
@@ -200,7 +206,7 @@ def _timing_markdown(t: LoopTiming, address: str) -> str:
     row = [f"{os.getloadavg()[0]:.1f}", *us, str(t.overruns), str(t.missed_packets), rate]
     return "\n".join([
         f"**the 1 kHz loop of the robot at {address}**, {t.ticks} ticks "
-        f"({t.ticks * t.period:.1f} s), through the robot's protocol",
+        f"({t.ticks * t.period:.1f} s), through the robot's protocol, {controller} law",
         "",
         "| load | tick compute p50 | p99 | max | ticks over "
         f"{t.period * 1e3:.0f} ms | states never read | wall-clock rate |",

@@ -125,43 +125,21 @@ class FloatingKernel:
         self.law = law
         self.sc = np.zeros(c.N_SCALARS)
         self.sc[c.DT] = float(model.opt.timestep)
-        self.adaptive = isinstance(law, AdaptiveImpedance)  # the exact class: see supports
-        e = law._error  # the law's own buffers: the kernel updates them in place
-        bufs = (e._xd, e._qd, e._vd, e.err, e.derr, e._qtmp, e._rtmp, np.zeros(6))
-        self.law_bufs: tuple[np.ndarray, ...]
-        self.ad: tuple[np.ndarray, ...]
-        if isinstance(law, AdaptiveImpedance):
-            self.law_bufs = (law._k0, law._d0, law._fd, *bufs)
-            self.ad = (law._alpha, law._beta, law._gamma_a, law._gamma_b, law._kappa)
-            self.ad += (law._df_step, law._dk_step, law._f_max, law._ff_adapt, law._k_adapt)
-            self.ad += (law._k_room, law._k0_diag, law._sqrt_k0, law._sqrt_m2)
-        else:
-            self.law_bufs = (law._k, law._d, law._ff, *bufs)
-            self.ad = (np.zeros(6),) * 14
+        self.binding = c.LawBinding(law)
 
     @staticmethod
     def supports(law: object) -> TypeGuard[AdaptiveImpedance | CartesianImpedance]:
         """Whether ``law`` runs compiled (the two laws of :mod:`teachfit.control`)."""
-        return type(law) in (AdaptiveImpedance, CartesianImpedance)
+        return c.LawBinding.supports(law)
 
     def step(self, n: int, f_adr: int, ft: tuple) -> int:
         """``n`` ticks (``ft`` as for :func:`run`); the law's scalar state in and out around
         the compiled loop."""
-        law, sc = self.law, self.sc
-        e = law._error
-        sc[c.T0], sc[c.EXPIRY] = e._t0, e._expiry
-        sc[c.SPINNING], sc[c.LAPSED] = float(e._spinning), float(e.lapsed)
-        if isinstance(law, AdaptiveImpedance):
-            lim = law.impedance_limits
-            sc[c.MAX_F] = sc[c.MAX_T] = np.inf
-            sc[c.CLIP_F], sc[c.CLIP_T], sc[c.XI] = lim.max_force, lim.max_torque, law._xi
-        else:
-            sc[c.MAX_F], sc[c.MAX_T] = law.limits.max_force, law.limits.max_torque
+        b, sc = self.binding, self.sc
+        b.load(sc)
         done = run(
             n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
-            self.adaptive, self.state, self.law_bufs, self.ad, sc, ft, f_adr,
+            b.adaptive, self.state, b.bufs, b.ad, sc, ft, f_adr,
         )  # fmt: skip
-        e._t0, e._expiry = float(sc[c.T0]), float(sc[c.EXPIRY])
-        e._spinning, e.lapsed = bool(sc[c.SPINNING]), bool(sc[c.LAPSED])
-        law.last_wrench = self.law_bufs[-1].copy()
+        b.store(sc)
         return int(done)

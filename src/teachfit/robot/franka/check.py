@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from teachfit.core.control import ControllerSpec
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT
 from teachfit.robot.franka.driver import FrankaParams, FrankaRobot
 from teachfit.robot.franka.safety import FrankaLimits
@@ -95,9 +96,11 @@ def bench_loop(
     params: FrankaParams | None = None,
     realtime: bool = True,
     out: Callable[[str], None] | None = print,
+    controller: ControllerSpec | None = None,
 ) -> LoopTiming:
-    """Run the torque loop holding the current pose for ``seconds`` s and report its timing."""
-    with FrankaRobot(host, params=params, realtime=realtime) as robot:
+    """Run the torque loop holding the current pose for ``seconds`` s with ``controller``'s law
+    (the fixed-gain one by default) and report its timing."""
+    with FrankaRobot(host, params=params, realtime=realtime, controller=controller) as robot:
         robot.step(100)  # let the loop start up
         ticks = int(round(seconds / robot.control_period))
         start = time.perf_counter()

@@ -95,6 +95,9 @@ class ControlLoop:
         #: the last tick's pylibfranka ``RobotState`` (what the model's functions take)
         self.raw: Any = None
         self.fault: RobotFault | None = None
+        #: the tick count the earliest waiter waits for: the control thread wakes waiters then,
+        #: not every tick (a waiter woken every tick would take the GIL from it 1000 times a s)
+        self._wake_at = np.inf
         self.q = np.zeros(7)
         self._finish = False
         self._thread: threading.Thread | None = None
@@ -117,7 +120,7 @@ class ControlLoop:
         self.tick.kinematics(first, model)
         self.tick.tau_prev = np.zeros(7)
         self.law = law
-        self.latest = self.tick.robot_state(self.t_abs - self.t0, first)
+        self.latest = self.tick.robot_state(self.t_abs - self.t0)
         self.raw = first
         self.fault = None
         self._finish = False
@@ -151,6 +154,7 @@ class ControlLoop:
             target = self.ticks + n
             while self.ticks < target and self.fault is None:
                 before = self.ticks
+                self._wake_at = min(self._wake_at, target)
                 if not self.cond.wait(timeout=timeout) and self.ticks == before:
                     self.fault = ConnectionLost(
                         f"no control tick for {timeout} s: {self.robot} stopped answering"
@@ -179,30 +183,31 @@ class ControlLoop:
 
     # ------------------------------------------------------------------ the thread
     def _run(self, control: Any, model: Any, pf: Any) -> None:
-        tick, limits, period = self.tick, self.limits, self.period
+        tick, period = self.tick, self.period
         buf_c, buf_g, size = self.compute_times, self.read_gaps, len(self.compute_times)
         try:
             while True:
                 state, gap = control.readOnce()
                 start = time.perf_counter()
                 self.t_abs += period
-                self.q = np.asarray(state.q, dtype=float)
-                tick.kinematics(state, model)
                 if self._pending_law is not None or self._pending_cmd is not None:
                     self._adopt()
-                why = limits.check_motion(tick.pos, tick.lin_vel, tick.ang_vel)
+                if self._finish:
+                    tick.kinematics(state, model)
+                    why = ""
+                else:
+                    why = tick.step(self.t_abs, self.law, state, model)  # type: ignore[arg-type]
                 if why or self._finish:
                     if why:
                         self.fault = LimitViolation(why)
                     self._publish(state)
                     self._send_finish(control, pf)
                     return
-                tau = tick.torques(self.t_abs, self.law, state, model)  # type: ignore[arg-type]
                 i = self.ticks % size
                 buf_g[i] = gap.to_sec()
                 self._publish(state)
                 buf_c[i] = time.perf_counter() - start
-                control.writeOnce(pf.Torques(tau.tolist()))
+                control.writeOnce(pf.Torques(tick.tau.tolist()))
         except BaseException as exc:  # noqa: BLE001 - every loop failure is latched as a fault
             with self.cond:
                 self.fault = fault_from(exc, self.robot)
@@ -215,18 +220,22 @@ class ControlLoop:
             if self._pending_clock:
                 self.t0, self._pending_clock = self.t_abs - self.period, False
             if self._pending_cmd is not None:
-                self.law.set_command(self._pending_cmd, self.t_abs)  # type: ignore[union-attr]
+                self.tick.command(self.law, self._pending_cmd, self.t_abs)  # type: ignore[arg-type]
                 self._pending_cmd = None
 
     def _publish(self, state: Any) -> None:
-        latest = self.tick.robot_state(self.t_abs - self.t0, state)
+        latest = self.tick.robot_state(self.t_abs - self.t0)
+        q = self.tick.q.copy()
         with self.cond:
+            self.q = q
             self.latest = latest
             self.raw = state  # libfranka's state of this tick (for the model's mass)
             self.ticks += 1
             if self._tap_every and self.ticks % self._tap_every == 0:
                 self._tapped.append(latest)
-            self.cond.notify_all()
+            if self.ticks >= self._wake_at:
+                self._wake_at = np.inf
+                self.cond.notify_all()
 
     def _send_finish(self, control: Any, pf: Any) -> None:
         done = pf.Torques([0.0] * 7)

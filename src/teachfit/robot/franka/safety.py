@@ -123,28 +123,3 @@ class FrankaLimits:
         if not self.in_workspace(pos, self.workspace_margin):
             return f"TCP {np.round(pos, 4).tolist()} m left the workspace box"
         return ""
-
-
-def clip_wrench_norm(w: np.ndarray, max_force: float, max_torque: float) -> np.ndarray:
-    """Scale force and torque of ``w`` (6,) in place to at most the given norms; returns w."""
-    fn = float(np.sqrt(w[:3] @ w[:3]))
-    if fn > max_force:
-        w[:3] *= max_force / fn
-    tn = float(np.sqrt(w[3:] @ w[3:]))
-    if tn > max_torque:
-        w[3:] *= max_torque / tn
-    return w
-
-
-def limit_torque(
-    tau: np.ndarray, tau_prev: np.ndarray, max_rate: float, period: float, limits: np.ndarray
-) -> np.ndarray:
-    """Rate-limit ``tau`` (7,) against the last sent ``tau_prev`` to ``max_rate`` (N·m/s) over
-    ``period`` (s), then clip to ``±limits`` (N·m); in place, returns ``tau``."""
-    step = max_rate * period
-    # np.minimum/np.maximum: several times cheaper than np.clip at this size (1 kHz path)
-    np.minimum(tau, tau_prev + step, out=tau)
-    np.maximum(tau, tau_prev - step, out=tau)
-    np.minimum(tau, limits, out=tau)
-    np.maximum(tau, -limits, out=tau)
-    return tau
