@@ -3,9 +3,10 @@
 pylibfranka 0.21 exposes libfranka's active-control interface (``start_torque_control`` ->
 ``readOnce`` / ``writeOnce``) rather than the C++ callback, so this thread *is* the callback:
 ``readOnce`` blocks until the robot's next state packet, the tick computes torques
-(:class:`~teachfit.robot.franka.tick.TorqueTick`) and ``writeOnce`` sends them. Other threads
-never talk to the robot during control: they post a command (adopted at the next tick), install
-a new law, wait for ticks on a condition, and read the latched fault.
+(:class:`~teachfit.robot.franka.tick.TorqueTick`) and ``writeOnce`` sends them; then, while the
+robot works on its next packet, the tick's state is published. Other threads never talk to the
+robot during control: they post a command (adopted at the next tick), install a new law, wait
+for ticks on a condition (woken at the tick they wait for), and read the latched fault.
 
 After a fault no torque is commanded: when the driver's own limit trips (or a finish is asked)
 the loop sends libfranka's motion-finished message with zero torques and ends; a libfranka
@@ -103,7 +104,8 @@ class ControlLoop:
         self._thread: threading.Thread | None = None
         self._tap_every = 0
         self._tapped: list[RobotState] = []
-        #: per-tick compute time (s, read -> torques ready) and gap since the previous state (s)
+        #: per-tick compute time (s, state read -> torques ready to send) and gap since the
+        #: previous state (s)
         self.compute_times = np.zeros(buffer)
         self.read_gaps = np.zeros(buffer)
 
@@ -203,11 +205,12 @@ class ControlLoop:
                     self._publish(state)
                     self._send_finish(control, pf)
                     return
+                torques = pf.Torques(tick.tau.tolist())
                 i = self.ticks % size
-                buf_g[i] = gap.to_sec()
-                self._publish(state)
                 buf_c[i] = time.perf_counter() - start
-                control.writeOnce(pf.Torques(tick.tau.tolist()))
+                control.writeOnce(torques)
+                buf_g[i] = gap.to_sec()
+                self._publish(state)  # for the other threads, after the torques went out
         except BaseException as exc:  # noqa: BLE001 - every loop failure is latched as a fault
             with self.cond:
                 self.fault = fault_from(exc, self.robot)
