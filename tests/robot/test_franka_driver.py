@@ -109,6 +109,16 @@ def test_adaptive_law_runs_in_the_loop(robot: FrankaRobot) -> None:
     assert type(robot.law).__name__ == "CartesianImpedance"
 
 
+def test_the_loop_times_each_tick_since_a_tick_count(robot: FrankaRobot) -> None:
+    start = robot.ticks
+    robot.step(300)
+    compute, gaps = robot.timing_since(start)
+    assert 300 <= len(compute) <= robot.ticks - start
+    assert np.all(compute > 0) and np.all(compute < 0.5)  # filled, in seconds
+    assert np.all(gaps >= 0) and np.median(gaps) == pytest.approx(0.001)  # robot time, s
+    assert len(robot.timing_since(robot.ticks + 5)[0]) == 0
+
+
 def test_skill_like_sequence_follows_and_expires(robot: FrankaRobot) -> None:
     """A line at 2 cm/s commanded every 50 ms, then one moving command left to expire."""
     start = robot.reset(HOME)

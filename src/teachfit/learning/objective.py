@@ -17,7 +17,9 @@ skipped, as every execution starts from a reset) and ``wall_s``; on a real arm a
 :mod:`teachfit.robot.franka.reset_path`) and ``reset_handover_lateral_n`` (the largest the
 skill left at the hand-over to a reset: the reading at the take-over, the next, and those
 still falling from it in the reset's first 50 ms,
-:class:`~teachfit.robot.franka.reset_path.ResetGuard`).
+:class:`~teachfit.robot.franka.reset_path.ResetGuard`), ``loop_p99_us`` and ``loop_over_1ms``
+(the 1 kHz loop's 99th percentile compute time, µs, and its ticks over 1 ms, over the trial's
+last 120 s at most).
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from teachfit.core.params import LearningError, ParamSpace
 from teachfit.learning.base import TrialResult
@@ -188,6 +192,8 @@ class SkillObjective:
         tr = self.trial()
         guard = getattr(tr.robot, "reset_guard", None)  # a real arm's reset force watch
         seen = len(guard.peaks) if guard is not None else 0
+        timing = getattr(tr.robot, "timing_since", None)  # a real arm's loop timing
+        first_tick = tr.robot.ticks if timing is not None else 0
         out = self.outcome(params)
         period = float(tr.robot.control_period)
         sim_s = sum(t.steps for t in out.traces) * period
@@ -201,4 +207,7 @@ class SkillObjective:
         if guard is not None and len(guard.peaks) > seen:
             info["reset_peak_lateral_n"] = float(max(guard.peaks[seen:]))
             info["reset_handover_lateral_n"] = float(max(guard.handover_peaks[seen:]))
+        if timing is not None and len(compute := timing(first_tick)[0]):
+            info["loop_p99_us"] = float(np.percentile(compute, 99)) * 1e6
+            info["loop_over_1ms"] = float(np.sum(compute > 0.001))
         return TrialResult(out.cost, any(out.successes), info)

@@ -73,10 +73,8 @@ class RobotCheck:
 
 def loop_timing(robot: FrankaRobot, ticks: int) -> LoopTiming:
     """Timing of the last ``ticks`` ticks the driver ran (at most its ring buffer)."""
-    size = len(robot.compute_times)
-    n = min(ticks, robot.ticks, size)
-    idx = (np.arange(robot.ticks - n, robot.ticks)) % size
-    comp, gaps = robot.compute_times[idx], robot.read_gaps[idx]
+    comp, gaps = robot.timing_since(robot.ticks - ticks)
+    n = len(comp)
     period = robot.control_period
     missed = np.round(gaps / period) - 1
     return LoopTiming(

@@ -350,6 +350,14 @@ class FrankaRobot:
         """Ring buffer of robot time between consecutive states read (s)."""
         return self._loop.read_gaps
 
+    def timing_since(self, tick: int) -> tuple[np.ndarray, np.ndarray]:
+        """Compute times and read gaps (s) of the ticks run since tick count ``tick``
+        (:attr:`ticks`), oldest first; the last ring buffer's worth at most."""
+        size = len(self._loop.compute_times)
+        n = max(min(self.ticks - tick, self.ticks, size), 0)
+        idx = np.arange(self.ticks - n, self.ticks) % size
+        return self._loop.compute_times[idx], self._loop.read_gaps[idx]
+
     # ------------------------------------------------------------------ stopping
     def stop(self) -> None:
         """Hold the TCP where it is for ``stop_hold`` s, then finish the motion (Ctrl-C path)."""

@@ -76,7 +76,7 @@ class ControlLoop:
         tick: TorqueTick,
         limits: FrankaLimits,
         period: float,
-        buffer: int = 20000,
+        buffer: int = 120_000,
         robot: str = "the robot",
     ) -> None:
         self.robot = robot
