@@ -171,7 +171,7 @@ def bench_robot(
     realtime: Annotated[bool, _REALTIME] = True,
     connect_timeout: ConnectTimeoutOpt = CONNECT_TIMEOUT,
     controller: Annotated[
-        str, typer.Option(help="the law that holds the pose: impedance or adaptive")
+        str, typer.Option(help="controller that holds the pose: impedance or adaptive")
     ] = "impedance",
     markdown: o.Markdown = None,
 ) -> None:
