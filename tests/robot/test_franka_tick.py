@@ -9,6 +9,7 @@ pf = pytest.importorskip("pylibfranka", reason="needs the franka extra (pylibfra
 
 from teachfit.core.errors import ConnectionLost, LimitViolation, ReflexFault, RobotFault  # noqa: E402
 from teachfit.robot.franka import FrankaFrames, FrankaLimits, ee2tcp_for_part  # noqa: E402
+from teachfit.robot.franka import kernel as k  # noqa: E402
 from teachfit.robot.franka.loop import fault_from  # noqa: E402
 from teachfit.robot.franka.tick import TorqueTick  # noqa: E402
 
@@ -150,6 +151,8 @@ def test_the_compiled_tick_gives_the_python_laws_torques(
         np.testing.assert_allclose(ticks[0].tau, python, rtol=1e-9, atol=1e-9)
         np.testing.assert_allclose(laws[0].last_wrench, laws[1].last_wrench, atol=1e-9)
     assert np.abs(ticks[0].tau).max() > 1.0  # the rate limit let the torques grow
+    # compiled when the tick was made, for the types the loop passes: never on the loop's thread
+    assert len(k.tick_at.signatures) == 1 and len(k.torques_at.signatures) == 1
     if adaptive:
         np.testing.assert_allclose(laws[0].feedforward, laws[1].feedforward, atol=1e-12)
         assert np.abs(laws[0].feedforward).max() > 0.0

@@ -36,8 +36,10 @@ from functools import cache
 
 import numba
 import numpy as np
+from numba.core import types
 
 from teachfit.control import compiled as c
+from teachfit.control.compiled import array_at as _at
 from teachfit.robot.fr3 import kernel as k
 
 # slots of ``fs``: posture gains, torque step per tick (N·m), motion limits (m/s, rad/s),
@@ -231,42 +233,44 @@ def table(
 def _groups(tb):  # noqa: ANN001, ANN202
     """The buffers of table ``tb`` as views, grouped as the functions above take them (numba
     types a tuple by its length: each is written out whole)."""
-    v, r, g, k, q = c.array_at, _R, _G, _K, _T
+    r, g, k, q = _R, _G, _K, _T
     raw = (
-        v(tb[r], 16), v(tb[r + 1], 42), v(tb[r + 2], 7), v(tb[r + 3], 7), v(tb[r + 4], 7),
-        v(tb[r + 5], 6),
+        _at(tb[r], 16), _at(tb[r + 1], 42), _at(tb[r + 2], 7), _at(tb[r + 3], 7), _at(tb[r + 4], 7),
+        _at(tb[r + 5], 6),
     )  # fmt: skip
     geo = (
-        v(tb[g], (3, 3)), v(tb[g + 1], 3), v(tb[g + 2], (3, 3)), v(tb[g + 3], 3),
-        v(tb[g + 4], 3), v(tb[g + 5], 3), v(tb[g + 6], 3),
+        _at(tb[g], (3, 3)), _at(tb[g + 1], 3), _at(tb[g + 2], (3, 3)), _at(tb[g + 3], 3),
+        _at(tb[g + 4], 3), _at(tb[g + 5], 3), _at(tb[g + 6], 3),
     )  # fmt: skip
     kin = (
-        v(tb[k], (6, 7)), v(tb[k + 1], 3), v(tb[k + 2], (3, 3)), v(tb[k + 3], 4),
-        v(tb[k + 4], 6), v(tb[k + 5], 3), v(tb[k + 6], 6), v(tb[k + 7], 6), v(tb[k + 8], 6),
-        v(tb[k + 9], 6), v(tb[k + 10], (3, 3)),
+        _at(tb[k], (6, 7)), _at(tb[k + 1], 3), _at(tb[k + 2], (3, 3)), _at(tb[k + 3], 4),
+        _at(tb[k + 4], 6), _at(tb[k + 5], 3), _at(tb[k + 6], 6), _at(tb[k + 7], 6),
+        _at(tb[k + 8], 6), _at(tb[k + 9], 6), _at(tb[k + 10], (3, 3)),
     )  # fmt: skip
     tq = (
-        v(tb[q], 7), v(tb[q + 1], 7), v(tb[q + 2], 7), v(tb[q + 3], 7), v(tb[q + 4], 6),
-        v(tb[q + 5], 6), v(tb[q + 6], (6, 6)), v(tb[q + 7], 6), v(tb[q + 8], 7), v(tb[q + 9], 6),
+        _at(tb[q], 7), _at(tb[q + 1], 7), _at(tb[q + 2], 7), _at(tb[q + 3], 7), _at(tb[q + 4], 6),
+        _at(tb[q + 5], 6), _at(tb[q + 6], (6, 6)), _at(tb[q + 7], 6), _at(tb[q + 8], 7),
+        _at(tb[q + 9], 6),
     )  # fmt: skip
-    return tb[:N_FNS], raw, geo, kin, tq, v(tb[_F], N_SCALARS)
+    return tb[:N_FNS], raw, geo, kin, tq, _at(tb[_F], N_SCALARS)
 
 
 @numba.njit(cache=True, inline="always")
 def _law(tb):  # noqa: ANN001, ANN202
     """The law's buffers (``LawBinding.bufs``, ``.ad``) and scalars of table ``tb``."""
-    v, m, a = c.array_at, _L, _A
+    m, a = _L, _A
     law = (
-        v(tb[m], (6, 6)), v(tb[m + 1], (6, 6)), v(tb[m + 2], 6), v(tb[m + 3], 3),
-        v(tb[m + 4], 4), v(tb[m + 5], 6), v(tb[m + 6], 6), v(tb[m + 7], 6), v(tb[m + 8], 4),
-        v(tb[m + 9], 3), v(tb[m + 10], 6),
+        _at(tb[m], (6, 6)), _at(tb[m + 1], (6, 6)), _at(tb[m + 2], 6), _at(tb[m + 3], 3),
+        _at(tb[m + 4], 4), _at(tb[m + 5], 6), _at(tb[m + 6], 6), _at(tb[m + 7], 6),
+        _at(tb[m + 8], 4), _at(tb[m + 9], 3), _at(tb[m + 10], 6),
     )  # fmt: skip
     ad = (
-        v(tb[a], 6), v(tb[a + 1], 6), v(tb[a + 2], 6), v(tb[a + 3], 6), v(tb[a + 4], 6),
-        v(tb[a + 5], 6), v(tb[a + 6], 6), v(tb[a + 7], 6), v(tb[a + 8], 6), v(tb[a + 9], 6),
-        v(tb[a + 10], 6), v(tb[a + 11], 6), v(tb[a + 12], 6), v(tb[a + 13], 6),
+        _at(tb[a], 6), _at(tb[a + 1], 6), _at(tb[a + 2], 6), _at(tb[a + 3], 6), _at(tb[a + 4], 6),
+        _at(tb[a + 5], 6), _at(tb[a + 6], 6), _at(tb[a + 7], 6), _at(tb[a + 8], 6),
+        _at(tb[a + 9], 6), _at(tb[a + 10], 6), _at(tb[a + 11], 6), _at(tb[a + 12], 6),
+        _at(tb[a + 13], 6),
     )  # fmt: skip
-    return law, ad, v(tb[_SC], c.N_SCALARS)
+    return law, ad, _at(tb[_SC], c.N_SCALARS)
 
 
 @numba.njit(cache=True)
@@ -290,3 +294,14 @@ def torques_at(tb, w) -> None:  # noqa: ANN001
     """:func:`torques` for the wrench ``w`` (6,) on the buffers of table ``tb``."""
     fns, raw, geo, kin, tq, fs = _groups(tb)
     torques(fns, raw, geo, kin, w, tq, fs)
+
+
+def compile_entries() -> None:
+    """Compile the entry points above for the argument types the driver passes, or load them
+    from numba's cache, in the calling thread. Why: numba compiles on the first call, and a
+    first call from the control thread would stall the 1 kHz loop for the compile (10-20 s on a
+    busy 2-core machine: the robot's communication constraint, the driver's tick timeout)."""
+    table, vector = types.Array(types.int64, 1, "C"), types.Array(types.float64, 1, "C")
+    tick_at.compile((types.float64, table))
+    kinematics_at.compile((table,))
+    torques_at.compile((table, vector))

@@ -112,6 +112,7 @@ class TorqueTick:
         self._fs[k.TAU_STEP] = limits.max_torque_rate * period
         self._fs[k.V_MAX], self._fs[k.W_MAX] = limits.max_tcp_speed, limits.max_tcp_ang_speed
         self._fs[k.F_MAX], self._fs[k.T_MAX] = limits.max_force, limits.max_torque
+        k.compile_entries()  # here, not on the control thread's first tick
         self._sc = np.zeros(N_SCALARS)
         self._law: Controller | None = None
         self._binding: LawBinding | None = None
