@@ -8,6 +8,7 @@ import pytest
 pytest.importorskip("pylibfranka", reason="needs the franka extra (pylibfranka)")
 
 from teachfit.robot.franka.check import bench_loop, check_robot  # noqa: E402
+from teachfit.robot.franka.priority import probe  # noqa: E402
 from teachfit.robot.franka.safety import FrankaLimits  # noqa: E402
 
 
@@ -32,5 +33,6 @@ def test_bench_loop_prints_figures(franka_sim: object) -> None:
     timing = bench_loop("127.0.0.1", seconds=0.5, realtime=False, out=lines.append)
     assert timing.ticks == 500
     assert timing.overruns <= timing.ticks and timing.missed_packets >= 0
-    assert len(lines) == 4 and lines[0].startswith("ticks: 500")
+    assert len(lines) == 5 and lines[0].startswith("ticks: 500")
     assert timing.wall_rate > 0 and lines[3].startswith("wall-clock rate")
+    assert lines[4] == f"control thread: {probe().describe()}"  # SCHED_FIFO where allowed

@@ -29,7 +29,8 @@ class LoopTiming:
     ticks whose compute took longer than the period, ``missed_packets`` robot states the loop
     did not read (gaps between consecutive states over 1.5 periods, counted in periods),
     ``period`` (s), ``wall_rate`` ticks per wall-clock second (0: not measured; a real robot
-    runs at 1000, a simulator may run slower than real time).
+    runs at 1000, a simulator may run slower than real time), ``thread`` the control thread's
+    scheduling class (:meth:`~teachfit.robot.franka.priority.ThreadClass.describe`).
     """
 
     ticks: int
@@ -40,16 +41,23 @@ class LoopTiming:
     missed_packets: int
     period: float
     wall_rate: float = 0.0
+    thread: str = ""
 
     def lines(self) -> list[str]:
         """Human-readable figures."""
-        return [
-            f"ticks: {self.ticks} ({self.ticks * self.period:.1f} s at {1 / self.period:.0f} Hz)",
+        hz = 1 / self.period
+        out = [
+            f"ticks: {self.ticks} ({self.ticks * self.period:.1f} s at {hz:.0f} Hz)",
             f"tick compute time: p50 {self.compute_p50 * 1e6:.0f} µs, p99 "
             f"{self.compute_p99 * 1e6:.0f} µs, max {self.compute_max * 1e6:.0f} µs",
             f"missed deadlines: {self.overruns} ticks over {self.period * 1e3:.0f} ms, "
             f"{self.missed_packets} robot states never read",
-        ] + ([f"wall-clock rate: {self.wall_rate:.0f} ticks/s"] if self.wall_rate else [])
+        ]
+        if self.wall_rate:
+            out.append(f"wall-clock rate: {self.wall_rate:.0f} ticks/s")
+        if self.thread:
+            out.append(f"control thread: {self.thread}")
+        return out
 
 
 @dataclass(frozen=True)
@@ -85,6 +93,7 @@ def loop_timing(robot: FrankaRobot, ticks: int) -> LoopTiming:
         overruns=int(np.sum(comp > period)),
         missed_packets=int(np.sum(missed[gaps > 1.5 * period])),
         period=period,
+        thread=robot.thread_class.describe(),
     )
 
 

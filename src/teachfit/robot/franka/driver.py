@@ -45,6 +45,8 @@ from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints, col_m
 from teachfit.robot.franka.grasp import GraspWatch, connect_gripper
 from teachfit.robot.franka.load import PartLoad
 from teachfit.robot.franka.loop import ControlLoop, fault_from
+from teachfit.robot.franka.priority import ThreadClass, caller_class_kept
+from teachfit.robot.franka.priority import probe as probe_fifo
 from teachfit.robot.franka.reflex import ReflexThresholds, check_reflex_force, reflex_thresholds
 from teachfit.robot.franka.reset_path import (
     ResetCell,
@@ -133,8 +135,12 @@ class FrankaRobot:
         Law run after the first :meth:`reset` (default fixed-gain).
     params : FrankaParams or None
     realtime : bool
-        Enforce libfranka's real-time scheduling check (a real robot needs an RT kernel; the
-        simulator and the tests pass ``False``).
+        Enforce real time as libfranka's own control loop does: its check for a real-time
+        kernel, and the control thread in ``SCHED_FIFO`` at the highest priority
+        (:mod:`.priority`; :class:`RobotFault` when the process may not use it). A real robot
+        needs both; the simulator, the twin and the tests pass ``False``, where the control
+        thread still takes ``SCHED_FIFO`` if the process may (libfranka's behaviour). The
+        caller's threads keep their class.
     confirm : callable or None
         Called with each reset's goal before the arm moves (:mod:`.confirm`); raising stops.
     """
@@ -162,6 +168,13 @@ class FrankaRobot:
         self.params = params or FrankaParams()
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
         self._realtime = pf.RealtimeConfig.kEnforce if realtime else pf.RealtimeConfig.kIgnore
+        if realtime:
+            allowed = probe_fifo()
+            if not allowed.realtime:
+                raise RobotFault(
+                    f"the control thread may not run in SCHED_FIFO ({allowed.why}); "
+                    "or pass --no-realtime (a simulator or the twin)"
+                )
         self._robot: Any = None  # a pylibfranka.Robot (untyped) once connected
         self._connect()
         self.grasp, self.grasp_note = connect_gripper(pf, host)
@@ -331,6 +344,11 @@ class FrankaRobot:
         return self._loop.running
 
     @property
+    def thread_class(self) -> ThreadClass:
+        """The control thread's scheduling class (``SCHED_FIFO 99`` when real time is enforced)."""
+        return self._loop.thread_class
+
+    @property
     def ticks(self) -> int:
         """Control ticks run since the driver connected."""
         return self._loop.ticks
@@ -484,7 +502,8 @@ class FrankaRobot:
         pf = self._pf
         probe(self.host, self.params.connect_timeout)  # bounded: the connect below is not
         try:
-            self._robot = pf.Robot(self.host, self._realtime)
+            with caller_class_kept():  # pylibfranka's Robot() moves its caller to SCHED_FIFO
+                self._robot = pf.Robot(self.host, self._realtime)
             self._model = self._robot.load_model()
         except (pf.NetworkException, RuntimeError) as exc:
             raise ConnectionLost(f"cannot connect to the Franka at {self.host}: {exc}") from exc

@@ -29,6 +29,7 @@ from teachfit.core.errors import (
     RobotFault,
 )
 from teachfit.core.state import ImpedanceCommand, RobotState
+from teachfit.robot.franka.priority import ThreadClass, to_fifo
 from teachfit.robot.franka.safety import FrankaLimits
 from teachfit.robot.franka.tick import TorqueTick
 
@@ -69,6 +70,10 @@ class ControlLoop:
         Ticks of timing kept (ring buffers ``compute_times`` and ``read_gaps``, s).
     robot : str
         The robot, as faults name it (``"the Franka at 192.168.1.2"``).
+
+    The thread puts itself in ``SCHED_FIFO`` before its first tick where the process may
+    (:mod:`.priority`, as libfranka's own control loop does); :attr:`thread_class` says what it
+    got.
     """
 
     def __init__(
@@ -80,6 +85,8 @@ class ControlLoop:
         robot: str = "the robot",
     ) -> None:
         self.robot = robot
+        #: the control thread's scheduling class (set when its thread starts)
+        self.thread_class = ThreadClass("SCHED_OTHER", why="the loop has not started")
         self.tick = tick
         self.limits = limits
         self.period = period
@@ -185,6 +192,7 @@ class ControlLoop:
 
     # ------------------------------------------------------------------ the thread
     def _run(self, control: Any, model: Any, pf: Any) -> None:
+        self.thread_class = to_fifo()
         tick, period = self.tick, self.period
         buf_c, buf_g, size = self.compute_times, self.read_gaps, len(self.compute_times)
         try:
