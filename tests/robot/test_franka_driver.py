@@ -227,6 +227,24 @@ def test_gil_switch_interval_is_short_while_connected(franka_sim: object) -> Non
     assert sys.getswitchinterval() == before
 
 
+def test_what_exists_at_connect_is_out_of_the_collectors_scans_while_connected(
+    franka_sim: object,
+) -> None:
+    import gc
+
+    def tracked(obj: object) -> bool:  # in a generation a collection scans
+        return any(o is obj for o in gc.get_objects())
+
+    before: list[list[str]] = [["made before connecting"]]
+    assert tracked(before)
+    with FrankaRobot("127.0.0.1", params=_params(), realtime=False) as robot:
+        robot.step(5)
+        after: list[list[str]] = [["made while connected"]]
+        # a full collection stalls the control thread: it scans only what came since
+        assert not tracked(before) and tracked(after)
+    assert tracked(before) and gc.get_freeze_count() == 0
+
+
 def test_reset_from_inside_a_hole_lifts_along_its_axis_before_moving_sideways(
     franka_sim: object,
 ) -> None:

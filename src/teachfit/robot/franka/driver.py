@@ -26,6 +26,7 @@ Cartesian impedance approach with our own law.
 
 from __future__ import annotations
 
+import gc
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -178,6 +179,14 @@ class FrankaRobot:
         self._robot: Any = None  # a pylibfranka.Robot (untyped) once connected
         self._connect()
         self.grasp, self.grasp_note = connect_gripper(pf, host)
+        # A garbage collection runs in whichever thread allocates and holds the GIL throughout,
+        # so the control thread waits for it: a full one over everything a study process holds
+        # (its imports, the scene, the learner) stopped the loop for 105-128 ms against the
+        # twin, and a real arm stops itself after 20 ms without a command (communication
+        # constraints). What exists now lives as long as the connection: out of the
+        # collector's generations, the full collections scan what came since (a 22-27 ms
+        # stall in the same runs). Undone by close().
+        gc.freeze()
         # the control thread must get the GIL within a fraction of a tick when the caller's
         # thread runs Python: Python's default switch interval (5 ms) would let a busy caller
         # delay a tick by up to 5 periods. Process-wide; restored by close().
@@ -305,6 +314,7 @@ class FrankaRobot:
         self._loop.finish()
         self.grasp = None  # drops the gripper's connection
         sys.setswitchinterval(self._switch_interval)
+        gc.unfreeze()
         robot, self._robot = self._robot, None
         if robot is not None:
             try:
