@@ -41,13 +41,13 @@ from teachfit.core.errors import ConnectionLost, ControlError, LimitViolation, R
 from teachfit.core.geometry import Pose, wxyz_to_rotation
 from teachfit.core.state import ImpedanceCommand, RobotState
 from teachfit.core.teaching import NO_TEACHER_HINTS, TeacherHints
+from teachfit.robot.franka import priority
 from teachfit.robot.franka.connect import CONNECT_TIMEOUT, probe
 from teachfit.robot.franka.frames import FrankaFrames, approach_waypoints, col_major
 from teachfit.robot.franka.grasp import GraspWatch, connect_gripper
 from teachfit.robot.franka.load import PartLoad
 from teachfit.robot.franka.loop import ControlLoop, fault_from
-from teachfit.robot.franka.priority import ThreadClass, caller_class_kept
-from teachfit.robot.franka.priority import probe as probe_fifo
+from teachfit.robot.franka.priority import ThreadClass
 from teachfit.robot.franka.reflex import ReflexThresholds, check_reflex_force, reflex_thresholds
 from teachfit.robot.franka.reset_path import (
     ResetCell,
@@ -140,8 +140,8 @@ class FrankaRobot:
         kernel, and the control thread in ``SCHED_FIFO`` at the highest priority
         (:mod:`.priority`; :class:`RobotFault` when the process may not use it). A real robot
         needs both; the simulator, the twin and the tests pass ``False``, where the control
-        thread still takes ``SCHED_FIFO`` if the process may (libfranka's behaviour). The
-        caller's threads keep their class.
+        thread still takes ``SCHED_FIFO`` if the process may (libfranka's behaviour), as does
+        the caller's thread (pylibfranka's, :mod:`.priority`) until :meth:`close`.
     confirm : callable or None
         Called with each reset's goal before the arm moves (:mod:`.confirm`); raising stops.
     """
@@ -170,13 +170,15 @@ class FrankaRobot:
         self.controller_spec: ControllerSpec = controller or FixedGainSpec()
         self._realtime = pf.RealtimeConfig.kEnforce if realtime else pf.RealtimeConfig.kIgnore
         if realtime:
-            allowed = probe_fifo()
+            allowed = priority.probe()
             if not allowed.realtime:
                 raise RobotFault(
                     f"the control thread may not run in SCHED_FIFO ({allowed.why}); "
                     "or pass --no-realtime (a simulator or the twin)"
                 )
         self._robot: Any = None  # a pylibfranka.Robot (untyped) once connected
+        #: the caller's scheduling class before pylibfranka raised it, restored by close()
+        self._caller_class = priority.current()
         self._connect()
         self.grasp, self.grasp_note = connect_gripper(pf, host)
         # A garbage collection runs in whichever thread allocates and holds the GIL throughout,
@@ -315,6 +317,7 @@ class FrankaRobot:
         self.grasp = None  # drops the gripper's connection
         sys.setswitchinterval(self._switch_interval)
         gc.unfreeze()
+        priority.restore(self._caller_class)
         robot, self._robot = self._robot, None
         if robot is not None:
             try:
@@ -512,8 +515,7 @@ class FrankaRobot:
         pf = self._pf
         probe(self.host, self.params.connect_timeout)  # bounded: the connect below is not
         try:
-            with caller_class_kept():  # pylibfranka's Robot() moves its caller to SCHED_FIFO
-                self._robot = pf.Robot(self.host, self._realtime)
+            self._robot = pf.Robot(self.host, self._realtime)  # caller to SCHED_FIFO if allowed
             self._model = self._robot.load_model()
         except (pf.NetworkException, RuntimeError) as exc:
             raise ConnectionLost(f"cannot connect to the Franka at {self.host}: {exc}") from exc

@@ -14,11 +14,12 @@ group ``rtprio 99`` in ``/etc/security/limits.conf``). Without either, :func:`to
 and the thread keeps its class; with only a lower limit it takes that priority.
 
 On Linux ``sched_setscheduler(0, ...)`` sets the *calling thread's* class, not the process's:
-the caller's other threads keep theirs. pylibfranka's ``Robot()`` constructor, too, moves the
-thread that calls it to ``SCHED_FIFO`` 99 where the process may (measured with pylibfranka
-0.21.3); that thread is the driver's caller, which runs skills and learners, so the driver
-puts it back (:func:`caller_class_kept`): a busy ``SCHED_FIFO`` thread would keep every other
-process (a twin, a viewer) off its core.
+the caller's other threads keep theirs. pylibfranka's ``Robot()`` constructor moves the thread
+that calls it to ``SCHED_FIFO`` 99 where the process may (measured with pylibfranka 0.21.3):
+in the driver that is the caller's thread, which runs the skill engine. The driver leaves it
+there while connected: with only the control thread real-time, the engine, sharing the GIL
+with it, fell behind the loop, and on the twin every peg2d approach timed out (0/3 against 3/3
+with both real-time). :func:`restore` puts the caller back when the driver closes.
 """
 
 from __future__ import annotations
@@ -26,8 +27,6 @@ from __future__ import annotations
 import os
 import resource
 import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 #: how to allow the class, as :class:`ThreadClass` ``why`` and the driver's errors say it
@@ -91,18 +90,18 @@ def probe() -> ThreadClass:
     return got[0]
 
 
-@contextmanager
-def caller_class_kept() -> Iterator[None]:
-    """Restore the calling thread's scheduling class (policy and priority) on leaving."""
+def current() -> tuple[int, os.sched_param] | None:
+    """The calling thread's policy and parameters, for :func:`restore` (None: no such API)."""
     if not hasattr(os, "sched_getscheduler"):
-        yield
+        return None
+    return os.sched_getscheduler(0), os.sched_getparam(0)
+
+
+def restore(saved: tuple[int, os.sched_param] | None) -> None:
+    """Put the calling thread back in the class :func:`current` saved."""
+    if saved is None or (os.sched_getscheduler(0), os.sched_getparam(0)) == saved:
         return
-    policy, param = os.sched_getscheduler(0), os.sched_getparam(0)
     try:
-        yield
-    finally:
-        if (os.sched_getscheduler(0), os.sched_getparam(0)) != (policy, param):
-            try:
-                os.sched_setscheduler(0, policy, param)
-            except PermissionError:  # a class only ever goes down here, which Linux allows
-                pass
+        os.sched_setscheduler(0, *saved)
+    except PermissionError:  # only ever lowers the class here, which Linux allows
+        pass
