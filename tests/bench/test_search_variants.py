@@ -32,3 +32,10 @@ def test_without_ergodic_only_the_tshix_row_is_run():
     doc = json.loads(results_json([res]))  # what the CLI saves after each variant
     assert doc[0]["variant"] == "d20 c0.5 mu0.3 chamfered" and doc[0]["demos_kept"] == 1
     assert doc[0]["rates"]["tshix"]["trials"] == 1 and "ergodic" not in doc[0]["rates"]
+
+
+def test_passes_go_on_through_fresh_samples_from_the_same_first_tour():
+    v = variant("peg2d", peg_diameter_mm=20.0, clearance_mm=0.5, friction=0.3, chamfers=1.0)
+    one, two = (run_variant(v, 0, 1, 6, 0, None, ergodic=False, passes=k) for k in (1, 2))
+    # the second pass appends a tour of fresh samples: the planned path grows
+    assert two.rows[0].length > one.rows[0].length > 0

@@ -276,3 +276,5 @@ def test_bench_search_variants_refuses_what_it_cannot_run(tmp_path):
     bad = tmp_path / "fig.xyz"
     res = invoke("bench", "search", "--variants", "2", "--plot", bad)
     assert res.exit_code == 2 and "fig.xyz" in _flat(res.output) and not bad.exists()
+    res = invoke("bench", "search", "--table", "1", "--passes", "2")
+    assert res.exit_code == 2 and "--passes is for --variants" in _flat(res.output)

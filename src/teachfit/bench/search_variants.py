@@ -76,9 +76,12 @@ def run_variant(
     workers: int | None = None,
     progress: Progress = None,
     ergodic: bool = True,
+    passes: int = 1,
 ) -> VariantResult:
     """Record, fit and run one variant (see the module docstring); ``ergodic=False`` runs
-    the goal's TSHIX row only (half the executions)."""
+    the goal's TSHIX row only (half the executions); ``passes`` > 1: a TSHIX tour that ends
+    without the hole goes on through fresh samples (:meth:`TshixPlanner.extend`), up to that
+    many tours in all."""
     protocol, default_points, need = PROTOCOLS[variant.task]
     points = n_points or default_points
     demos, tried, why = variant_demos(variant, seed)
@@ -93,7 +96,8 @@ def run_variant(
     starts = task.protocol.protocol_starts(protocol, n_starts, rng, demos[0].start_pose)
     seeds = [episode_seed(seed, i) for i in range(n_starts)]
     ov = dict(variant.overrides)
-    res_t = run_jobs(_jobs(task.name, ov, model, starts, "tshix", points, seeds), workers, progress)
+    tshix = _jobs(task.name, ov, model, starts, "tshix", points, seeds, passes=passes)
+    res_t = run_jobs(tshix, workers, progress)
     rows = [_row("tshix", res_t, None)]
     if ergodic:
         length = float(np.mean([r.weighted_length for r in res_t]))
@@ -112,6 +116,7 @@ def run_variants(
     progress: Progress = None,
     ergodic: bool = True,
     on_variant: Callable[[VariantResult], None] | None = None,
+    passes: int = 1,
 ) -> list[VariantResult]:
     """:func:`run_variant` on ``n_variants`` grid points of ``task`` drawn with ``seed``;
     ``on_variant`` gets each variant's result as soon as it is done (to print and save it:
@@ -122,7 +127,7 @@ def run_variants(
         raise TeachfitError(f"number of starts must be >= 1, got {n_starts}")
     out = []
     for v in sample_variants(task, n_variants, seed):
-        out.append(run_variant(v, seed, n_starts, n_points, workers, progress, ergodic))
+        out.append(run_variant(v, seed, n_starts, n_points, workers, progress, ergodic, passes))
         if on_variant is not None:
             on_variant(out[-1])
     return out

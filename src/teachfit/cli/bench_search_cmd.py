@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -95,6 +96,14 @@ def bench_search(
             "tshix, ergodic, where tshix alone, the goal's method, halves the executions)"
         ),
     ] = None,
+    passes: Annotated[
+        int,
+        typer.Option(
+            min=1,
+            help="with --variants, TSHIX tours per start: a tour that ends without the hole "
+            "goes on through fresh samples (1: Ehlers et al.'s single tour)",
+        ),
+    ] = 1,
 ) -> None:
     """The search paper's experiments (Ehlers et al. 2019) in simulation, beside its numbers.
 
@@ -104,11 +113,14 @@ def bench_search(
     from teachfit.bench import search as bs
 
     todo, rows_of, ergodic = _check(table, task, demo, methods, variants)
+    if passes > 1 and not variants:
+        raise TeachfitError("--passes is for --variants: the paper's tables run one tour")
     bs.use_robot(robot)
     if variants:
         names = {"1": ["peg2d"], "3": ["socket3d"], "all": ["peg2d", "socket3d"]}[table]
+        run = VariantRun(starts or 20, points, workers, ergodic, passes)
         for name in names:
-            _variants(name, variants, seed, starts or 20, points, workers, markdown, plot, ergodic)
+            _variants(name, variants, seed, run, markdown, plot)
     elif task is not None:
         _task_table(task, demo, seed, starts or 10, points or 300, workers, markdown)
     else:
@@ -228,16 +240,20 @@ def _variant_cells(r: VariantResult) -> list[str]:
     return cells
 
 
+@dataclass(frozen=True)
+class VariantRun:
+    """How each variant runs: ``starts``, TSHIX ``points`` (None: the protocol's),
+    ``workers``, whether the ``ergodic`` row runs, TSHIX ``passes`` per start."""
+
+    starts: int
+    points: int | None
+    workers: int | None
+    ergodic: bool
+    passes: int
+
+
 def _variants(
-    task: str,
-    n: int,
-    seed: int,
-    starts: int,
-    points: int | None,
-    workers: int | None,
-    markdown: Path | None,
-    figure: Path,
-    ergodic: bool = True,
+    task: str, n: int, seed: int, run: VariantRun, markdown: Path | None, figure: Path
 ) -> None:
     from matplotlib.figure import Figure
 
@@ -248,9 +264,10 @@ def _variants(
     if figure.suffix.lower().lstrip(".") not in Figure().canvas.get_supported_filetypes():
         raise TeachfitError(f"cannot write figure {figure}: unknown image format; use .png")
     protocol, default_points, demos = sv.PROTOCOLS[task]
+    tours = "" if run.passes == 1 else f" x {run.passes} passes"
     title = (
-        f"{task} variants ({protocol} protocol, {demos} teacher demo(s), {starts} starts, "
-        f"{points or default_points} points, seed {seed})"
+        f"{task} variants ({protocol} protocol, {demos} teacher demo(s), {run.starts} starts, "
+        f"{run.points or default_points} points{tours}, seed {seed})"
     )
     out = figure.with_name(f"{figure.stem}_{task}{figure.suffix}")
     done: list[VariantResult] = []
@@ -263,10 +280,19 @@ def _variants(
         save_figure(success_by_parameter(sv.figure_data(done), title, sv.GOALS[task]), out)
 
     with progress_bar() as bar:
-        what = "TSHIX and ergodic" if ergodic else "TSHIX"
-        job = bar.add_task(f"{task} variants: {what}", total=(1 + ergodic) * n * starts)
+        what = "TSHIX and ergodic" if run.ergodic else "TSHIX"
+        job = bar.add_task(f"{task} variants: {what}", total=(1 + run.ergodic) * n * run.starts)
         results = sv.run_variants(
-            task, n, seed, starts, points, workers, lambda: bar.advance(job), ergodic, finished
+            task,
+            n,
+            seed,
+            run.starts,
+            run.points,
+            run.workers,
+            lambda: bar.advance(job),
+            run.ergodic,
+            finished,
+            run.passes,
         )
     cols = (*(k for k, _ in results[0].variant.values), "demos kept/tried", "TSHIX", "ergodic")
     lines = [_variant_cells(r) for r in results]
