@@ -4,8 +4,9 @@ Each variant (:mod:`teachfit.tasks.variants`) is run as a user would run it, not
 variant: the blind teacher records on that variant (one demonstration for ``peg2d``; two from
 opposite ends of the socket for ``socket3d``, as Table III), the model is ``learn search``'s
 default fit (:meth:`SearchModel.fit` without options), then TSHIX (a new trajectory per start,
-300 / 600 points) and one ergodic trajectory of about the mean TSHIX length, on the protocol's
-starts. A variant whose teacher recorded nothing gets no rows but its discard reasons.
+300 / 600 points; with ``passes`` > 1 a tour that ends without the hole goes on through fresh
+samples, as the joined skill's search does until its time limit) and one ergodic trajectory of
+about the mean TSHIX length, on the protocol's starts. A variant whose teacher recorded nothing gets no rows but its discard reasons.
 """
 
 from __future__ import annotations
