@@ -6,7 +6,8 @@ opposite ends of the socket for ``socket3d``, as Table III), the model is ``lear
 default fit (:meth:`SearchModel.fit` without options), then TSHIX (a new trajectory per start,
 300 / 600 points; with ``passes`` > 1 a tour that ends without the hole goes on through fresh
 samples, as the joined skill's search does until its time limit) and one ergodic trajectory of
-about the mean TSHIX length, on the protocol's starts. A variant whose teacher recorded nothing gets no rows but its discard reasons.
+about the mean TSHIX length, on the protocol's starts. A variant whose teacher recorded nothing
+gets no rows but its discard reasons.
 """
 
 from __future__ import annotations
