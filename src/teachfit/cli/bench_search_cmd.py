@@ -100,8 +100,8 @@ def bench_search(
         int,
         typer.Option(
             min=1,
-            help="with --variants, TSHIX tours per start: a tour that ends without the hole "
-            "goes on through fresh samples (1: Ehlers et al.'s single tour)",
+            help="TSHIX passes: with --variants, a tour that ends without the hole goes on "
+            "through fresh samples (1: Ehlers et al.'s single tour)",
         ),
     ] = 1,
 ) -> None:
