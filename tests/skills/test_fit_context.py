@@ -39,6 +39,8 @@ def test_a_sharp_tight_part_starts_beyond_three_sigma_with_a_small_tilt_and_a_li
     # the jam-free tilt is 0.22 rad; turned upright about the TCP the low rim rises <= 0.45 mm
     assert math.acos(0.004 / 0.0041) > math.asin(4.5e-4 / 0.004)
     assert domains["tilt"].high == pytest.approx(math.asin(4.5e-4 / 0.004))  # 0.11 rad
+    # a sharp rim that leans too little dips too little off the pass's line
+    assert domains["tilt"].low == pytest.approx(0.5 * domains["tilt"].high)
     # the joined skill's search of a sharp edge is tilted, retried at the jam-free tilt
     assert values["search_tilt"] == 0.25
     assert values["search_retry_tilt"] == pytest.approx(math.acos(0.004 / 0.0041))
@@ -56,6 +58,7 @@ def test_a_chamfered_loose_part_keeps_the_press_and_the_skill_s_tilt_domain() ->
     assert domains["tilt"].high == pytest.approx(math.asin(4.5e-4 / 0.005))  # the turn less
     _, wide_domains = fit_context(FitGeometry(0.001, 5e-4, 5e-4, 2e-4), DEFAULTS, 0.25, TILT)
     assert wide_domains["tilt"].high == 0.3  # a part 2 mm wide: the skill's own domain
+    assert domains["tilt"].low == wide_domains["tilt"].low == TILT.low  # a chamfer: as low
     # a top that ends nearer: the start stays over it
     near, _ = fit_context(FitGeometry(0.005, 5e-4, 5e-4, 2e-4, 0.008), DEFAULTS, 0.25, TILT)
     assert near["lateral_offset"] == -0.008
