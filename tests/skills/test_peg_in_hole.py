@@ -54,3 +54,33 @@ def test_the_insert_push_fades_with_the_parts_speed_into_the_hole():
     assert insert.v_press == "v_press" and "fading above v_press" in insert.describe()
     with pytest.raises(SkillError, match="v_press"):
         Insert(v_press=0.0).compile({})
+
+
+def test_an_extra_pass_approaches_an_arm_at_rest_a_little_short_of_its_pose() -> None:
+    from teachfit.robot.interface import RobotState
+
+    def pc_at(dx: float, speed: float) -> Percept:
+        pc = Percept(Pose(np.zeros(3)), 0.01)
+        state = RobotState(
+            0.0, np.array([dx, 0.0, 0.0]), np.array([1.0, 0, 0, 0]),
+            np.array([speed, 0.0, 0.0]), np.zeros(3), np.zeros(6),
+        )  # fmt: skip
+        pc.update(state, 0.0)
+        pc.goal[:] = 0.0
+        pc.done = True
+        return pc
+
+    def holds(suffix: str, dx: float, speed: float) -> bool:
+        check = peg_in_hole._at_approach_pose(suffix).compile({"v_still": 0.002})
+        pc = pc_at(dx, speed)
+        out = []
+        for k in range(15):
+            pc.t_node = 0.01 * k
+            out.append(check(pc))
+        return out[-1]
+
+    assert holds("", 5e-4, 0.0) and holds("_2", 5e-4, 0.05)  # within 1 mm: as before
+    assert not holds("", 0.0015, 0.0)  # the first approach still wants 1 mm
+    assert holds("_2", 0.0015, 0.0) and holds("_3", 0.0025, 0.0)  # an extra pass at rest
+    assert not holds("_2", 0.0015, 0.01)  # still moving there
+    assert not holds("_2", 0.0035, 0.0)  # too far
