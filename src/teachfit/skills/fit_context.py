@@ -197,7 +197,8 @@ def fit_context(
     big_r = fit.hole_half_width
     start = min(fit.half_width + big_r + 3.0 * fit.sigma, fit.reach)
     t_lateral = max(defaults["t_lateral"], (start + big_r) / (defaults["v_lateral"] * speed_low))
-    press = SHARP_PUSH if fit.tip_chamfer < fit.clearance else 1.0
+    sharp = fit.tip_chamfer < fit.clearance
+    press = SHARP_PUSH if sharp else 1.0
     pass_y = 2.0 * fit.sigma
     values = {
         "f_push": press * defaults["f_push"],
@@ -218,12 +219,12 @@ def fit_context(
         - defaults["t_lateral"]
         + 2.0 * (t_lateral + PASS_TIME),
     }
-    if fit.tip_chamfer < fit.clearance:
+    if sharp:
         values |= search_tilt_context(fit)
         if fit.corner > 0.0:
             values |= corner_context(fit, values, start)
     high = min(tilt.high, fit.max_tilt, fit.align_tilt)
-    low = min(high, max(tilt.low, SHARP_TILT_SHARE * high)) if press < 1.0 else tilt.low
+    low = min(high, max(tilt.low, SHARP_TILT_SHARE * high)) if sharp else tilt.low
     return values, {"tilt": ParamDomain(low, high)}
 
 
