@@ -61,13 +61,19 @@ def test_gp_bayesian_optimisation_is_the_default_and_learns(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     torch = pytest.importorskip("torch")
+    threadpoolctl = pytest.importorskip("threadpoolctl")
     learner = make_learner("bo", SPACE, seed=1, options={"n_startup": 4})
     sampler = learner._study.sampler
     assert type(sampler).__name__ == "GPSampler"
-    threads, fit = [], sampler.sample_relative
-    monkeypatch.setattr(
-        sampler, "sample_relative", lambda *a: threads.append(torch.get_num_threads()) or fit(*a)
-    )
+    threads, blas, fit = [], [], sampler.sample_relative
+
+    def counted(*a):  # noqa: ANN002, ANN202
+        threads.append(torch.get_num_threads())
+        blas.append(max(p["num_threads"] for p in threadpoolctl.threadpool_info()))
+        return fit(*a)
+
+    monkeypatch.setattr(sampler, "sample_relative", counted)
+    blas_before = threadpoolctl.threadpool_info()
     before = torch.get_num_threads()
     torch.set_num_threads(2)
     try:
@@ -78,6 +84,8 @@ def test_gp_bayesian_optimisation_is_the_default_and_learns(
     assert min(costs[4:]) < 0.02 < min(costs[:4])
     # the GP works on one thread (its tensors are small), and the caller keeps its count
     assert threads == [1] * 12 and after == 2
+    assert blas == [1] * 12  # BLAS and OpenMP too (a waiting OpenBLAS thread spins)
+    assert threadpoolctl.threadpool_info() == blas_before
 
 
 @pytest.mark.parametrize("method", ["cmaes", "pso", "lhs"])

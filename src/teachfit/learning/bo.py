@@ -25,19 +25,27 @@ from teachfit.learning.base import Candidate, Finished
 _CONSTRAINT = "failure"
 
 
+#: BLAS / OpenMP thread limits (threadpoolctl comes with scikit-learn; no type information)
+threadpool_limits = importlib.import_module("threadpoolctl").threadpool_limits
+
+
 @contextmanager
 def _one_thread() -> Iterator[None]:
-    """PyTorch on one thread while the GP is fitted and the acquisition maximised: its
-    tensors (at most a few hundred trials x 15 parameters) are too small to share out, and
-    two threads took 1.3 x the CPU time of one for the same points (85 vs 64 CPU-s for 70
-    asks on the 2-core machine, identical candidates), CPU the trials' workers need."""
+    """PyTorch, BLAS and OpenMP on one thread while the GP is fitted and the acquisition
+    maximised: its tensors and matrices (at most a few hundred trials x 15 parameters) are too
+    small to share out. Measured on the 2-core machine, identical candidates: PyTorch on two
+    threads took 1.3 x the CPU time of one (85 vs 64 CPU-s for 70 asks); OpenBLAS's second
+    thread, which spins while it waits, 1.8 x idle and 3.2 x beside two busy processes (60 asks:
+    9.9 vs 5.6 CPU-s, and 19.9 vs 6.3 CPU-s, 20.6 vs 9.1 s wall), CPU the trials' workers
+    need."""
     # imported here when not yet (the sampler imports it on its first GP step)
     import torch  # noqa: PLC0415
 
     before = torch.get_num_threads()
     torch.set_num_threads(1)
     try:
-        yield
+        with threadpool_limits(1):
+            yield
     finally:
         torch.set_num_threads(before)
 
