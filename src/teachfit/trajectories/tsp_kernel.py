@@ -41,7 +41,8 @@ of kicks, whether its segments were of any length, short or chosen along candida
 up to 300 points every second kick cuts at three long edges, each the longest of three drawn),
 local search from its six end nodes, kept when at most ``threshold`` longer (threshold
 accepting); the shortest tour seen is returned. Distances are read from a matrix when one is
-given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`).
+given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`). The functions called per node
+and per kick are compiled without numba's reference counts (``leaf`` in that module).
 """
 
 from __future__ import annotations
@@ -59,10 +60,11 @@ from teachfit.trajectories.tsp_moves import (
     _or_segment,
     _reverse,
     _tail_move,
+    leaf,
 )
 
 
-@njit(cache=True)
+@leaf
 def _push(queue: np.ndarray, inq: np.ndarray, head_tail: np.ndarray, v: int) -> None:
     if not inq[v]:
         m = queue.shape[0]
@@ -71,7 +73,7 @@ def _push(queue: np.ndarray, inq: np.ndarray, head_tail: np.ndarray, v: int) -> 
         inq[v] = True
 
 
-@njit(cache=True)
+@leaf
 def _push_ends(
     queue: np.ndarray, inq: np.ndarray, head_tail: np.ndarray, tour: np.ndarray, lo: int, hi: int
 ) -> None:
@@ -84,7 +86,7 @@ def _push_ends(
 # Long on purpose (> 60 lines): the innermost loop of the solver, compiled; the candidate scan,
 # the two move kinds' gains and the move share a dozen locals, which a split would pass through
 # calls on every candidate.
-@njit(cache=True)
+@leaf
 def _improve_node(
     x: np.ndarray,
     neigh: np.ndarray,
@@ -258,7 +260,7 @@ def _kick_cuts(
     return 1 + draws[r, 0] % (inner - lb - lc + 1), lb, lc
 
 
-@njit(cache=True)
+@leaf
 def _kick(
     x: np.ndarray, tour: np.ndarray, pos: np.ndarray, a: int, lb: int, lc: int, ends: np.ndarray
 ) -> float:

@@ -6,11 +6,28 @@ described in :mod:`teachfit.trajectories.tsp_kernel`.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numba import njit
+from numba.core.cpu import CPUTargetOptions
+
+#: Decorator of the kernel's functions that allocate nothing: compiled without numba's
+#: reference counting. Otherwise every array argument is counted up on entry and down on exit
+#: by an atomic instruction, which no pass removes across calls (numba issue #2345): in these
+#: small functions, called per node and per candidate, that was 45 % of the solver's CPU
+#: (``perf``, 300 points). The same tours, bit for bit; plain ``njit`` where numba lacks the
+#: option.
+_LEAF: dict[str, Any] = {"cache": True}
+if hasattr(CPUTargetOptions, "_nrt"):
+    _LEAF["_nrt"] = False
+leaf = njit(**_LEAF)
+#: the same, inlined into each caller (numba's IR inlining: LLVM left ``_d`` a call, 25 % of
+#: the solver's CPU)
+inlined_leaf = njit(inline="always", **_LEAF)
 
 
-@njit(cache=True)
+@inlined_leaf
 def _d(x: np.ndarray, a: int, b: int, dummy: int) -> float:
     """Distance of nodes ``a`` and ``b``: ``x[a, b]`` when ``x`` is the distance matrix (a row
     per node, the dummy's included: ``dummy + 1`` rows), else Euclidean between the rows of the
@@ -94,7 +111,7 @@ def merge_candidates(
     return out
 
 
-@njit(cache=True)
+@leaf
 def _reverse(tour: np.ndarray, pos: np.ndarray, i: int, j: int) -> None:
     """Reverse ``tour[i..j]`` in place and keep ``pos`` (node -> index) in step."""
     while i < j:
@@ -105,7 +122,7 @@ def _reverse(tour: np.ndarray, pos: np.ndarray, i: int, j: int) -> None:
         j -= 1
 
 
-@njit(cache=True)
+@leaf
 def _move_segment(
     tour: np.ndarray, pos: np.ndarray, s: int, e: int, q: int, flip: bool
 ) -> tuple[int, int]:
@@ -126,7 +143,7 @@ def _move_segment(
     return q + 1, e
 
 
-@njit(cache=True)
+@leaf
 def _flip(tour: np.ndarray, pos: np.ndarray, t1: int, t2: int, t3: int, flips: np.ndarray, k: int):
     """The 2-opt flip of a Lin-Kernighan step: remove ``(t1, t2)`` and ``(t3, t4)``, add
     ``(t2, t3)`` and ``(t4, t1)``, ``t4`` the neighbour of ``t3`` on ``t2``'s side; records the
@@ -151,7 +168,7 @@ def _flip(tour: np.ndarray, pos: np.ndarray, t1: int, t2: int, t3: int, flips: n
     return t4
 
 
-@njit(cache=True)
+@leaf
 def _best_step(
     x: np.ndarray,
     neigh: np.ndarray,
@@ -187,7 +204,7 @@ def _best_step(
 
 # Long on purpose (> 60 lines): one Lin-Kernighan chain, compiled; its depth loop keeps the
 # chain's partial gain, flips and best closing point in locals that a split would pass around.
-@njit(cache=True)
+@leaf
 def _lk_node(
     x: np.ndarray,
     neigh: np.ndarray,
@@ -263,7 +280,7 @@ def _lk_node(
     return 0.0, 0
 
 
-@njit(cache=True)
+@leaf
 def _insertion_gain(
     x: np.ndarray, tour: np.ndarray, b: int, p: int, q: int, dummy: int
 ) -> tuple[float, bool]:
@@ -278,7 +295,7 @@ def _insertion_gain(
 
 # Long on purpose (> 60 lines): compiled candidate scan of one move kind; its gains share the
 # locals of the two loops.
-@njit(cache=True)
+@leaf
 def _or_segment(
     x: np.ndarray, neigh: np.ndarray, tour: np.ndarray, pos: np.ndarray, a: int, eps: float
 ) -> tuple[float, int, int]:
@@ -321,7 +338,7 @@ def _or_segment(
     return 0.0, 0, 0
 
 
-@njit(cache=True)
+@leaf
 def _tail_move(
     x: np.ndarray, neigh: np.ndarray, tour: np.ndarray, pos: np.ndarray, a: int, eps: float
 ) -> tuple[float, int, int]:
