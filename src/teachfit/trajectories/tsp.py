@@ -124,6 +124,11 @@ _MIN_KICKS = 1500
 #: then 5 N again with the long-edge kicks and the new-end move: 4-7 % less CPU than 5.5 N
 #: before, as close to LKH as 5.5 N with them: 7 against 4 of 540 runs over 1.01 x LKH)
 _KICKS_PER_POINT = 5.0
+#: independent runs of the iterated local search up to _LK_FROM points, each from the
+#: nearest-neighbour path with its own kicks, the shortest kept: the per-run tail differs (600
+#: sets of 300 points x 3 kick seeds over 1.01 x LKH-3: one run of 5 N kicks 33 / 1800, of
+#: 10 N 8 / 1800, two runs of 5 N 4 / 1800 at the CPU of the 10 N run)
+_RUNS = 2
 #: up to this many nodes (the start and 300 points) the kernel reads a distance matrix: 15-19 %
 #: less CPU at 100 and 300 points, the same tours; slower at 600 and 1000 points (the matrix
 #: leaves the cache), so coordinates there (benchmarks/search_speed.py point sets)
@@ -145,22 +150,23 @@ def _distances(x: np.ndarray) -> np.ndarray:
 def _compiled(
     x: np.ndarray, rng: np.random.Generator, n_neighbours: int, n_kicks: int
 ) -> list[int]:
-    """Nearest-neighbour path improved by :func:`teachfit.trajectories.tsp_kernel.improve_tour`."""
+    """Nearest-neighbour path improved by :func:`teachfit.trajectories.tsp_kernel.improve_tour`,
+    :data:`_RUNS` times up to :data:`_LK_FROM` points, ``n_kicks`` each; the shortest path.
+    The first run draws its kicks from ``rng``, the others from children spawned from it, so
+    each run's kicks begin with those of any smaller ``n_kicks``."""
     from teachfit.trajectories.tsp_kernel import improve_tour
     from teachfit.trajectories.tsp_moves import nearest_neighbour_path
 
     n = x.shape[0]  # node 0 = start, 1..n-1 = points; dummy = n
     neigh = _candidates(x, n_neighbours)
     tour = np.append(nearest_neighbour_path(x, neigh), n)
-    draws = rng.integers(0, 1 << 30, size=(n_kicks, 3), dtype=np.int64)
+    small = n - 1 <= _LK_FROM
+    runs = _RUNS if small else 1
+    rngs = [rng, *rng.spawn(runs - 1)]
     scale = float(np.ptp(x, axis=0).max()) or 1.0
     d0 = np.linalg.norm(np.diff(x[tour[:-1]], axis=0), axis=1).mean()
-    small = n - 1 <= _LK_FROM
-    out = improve_tour(
-        _distances(x),
-        neigh,
-        tour,
-        draws,
+    dist = _distances(x)
+    options = (
         _WINDOW,
         1e-12 * scale,
         (_THRESHOLD_PLANE if small and x.shape[1] == 2 else _THRESHOLD) * d0,
@@ -169,7 +175,14 @@ def _compiled(
         small,
         _LONG_CUTS if small else 0,
     )
-    return [int(v) for v in out]
+    best, best_length = tour, np.inf
+    for run_rng in rngs:
+        draws = run_rng.integers(0, 1 << 30, size=(n_kicks, 3), dtype=np.int64)
+        out = improve_tour(dist, neigh, tour, draws, *options)
+        length = float(np.linalg.norm(np.diff(x[out[:-1]], axis=0), axis=1).sum())
+        if length < best_length:
+            best, best_length = out, length
+    return [int(v) for v in best]
 
 
 def _default_kicks(n: int) -> int:
