@@ -127,7 +127,7 @@ _KICKS_PER_POINT = 5.0
 #: independent runs of the iterated local search up to _LK_FROM points, each from the
 #: nearest-neighbour path with its own kicks, the shortest kept: the per-run tail differs (600
 #: sets of 300 points x 3 kick seeds over 1.01 x LKH-3: one run of 5 N kicks 33 / 1800, of
-#: 10 N 8 / 1800, two runs of 5 N 4 / 1800 at the CPU of the 10 N run)
+#: 10 N 8 / 1800, two runs of 5 N 5 / 1800 at the CPU of the 10 N run)
 _RUNS = 2
 #: up to this many nodes (the start and 300 points) the kernel reads a distance matrix: 15-19 %
 #: less CPU at 100 and 300 points, the same tours; slower at 600 and 1000 points (the matrix
