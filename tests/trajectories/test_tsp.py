@@ -180,18 +180,19 @@ def _path(x, tour):
 def test_new_end_move_keeps_a_path_and_gains_what_it_says():
     # the tail move on scrambled tours: a valid path (start and dummy fixed, pos in step), its
     # gain the length it saves
-    from teachfit.trajectories.tsp_moves import _tail_move
+    from teachfit.trajectories.tsp_moves import _tail_move, candidate_distances
 
     rng = np.random.default_rng(3)
     x = rng.uniform(size=(40, 2))  # node 0 the start, 40 = the dummy
     neigh = np.argsort(np.linalg.norm(x[:, None] - x[None], axis=2), axis=1)[:, 1:9]
+    nd = candidate_distances(x, neigh)
     applied = 0
     for _ in range(20):
         tour = np.concatenate([[0], 1 + rng.permutation(39), [40]]).astype(np.int64)
         pos = np.argsort(tour)
         for a in range(1, 40):
             before = _path(x, tour)
-            gain, lo, hi = _tail_move(x, neigh, tour, pos, a, 1e-12)
+            gain, lo, hi = _tail_move(x, neigh, nd, tour, pos, a, 1e-12)
             if gain > 0:
                 applied += 1
                 assert gain == pytest.approx(before - _path(x, tour))
@@ -212,3 +213,18 @@ def test_long_edge_kicks_cut_inside_the_path():
         a, lb, lc = _kick_cuts(x, tour, draws, r, 1 << 30, 3)
         if lb:
             assert a >= 1 and lc >= 1 and a + lb + lc - 1 <= 29  # B and C among the points
+
+
+def test_candidate_distances_are_the_kernels_distances_in_both_modes():
+    # the kernel's candidate scans read these instead of the matrix or the coordinates: the
+    # same values in both modes, so the same tours
+    from scipy.spatial.distance import cdist
+
+    from teachfit.trajectories.tsp import _candidates, _distances
+    from teachfit.trajectories.tsp_moves import candidate_distances
+
+    x = np.random.default_rng(5).uniform(size=(31, 2))
+    neigh = _candidates(x, 6)
+    exact = np.take_along_axis(cdist(x, x), neigh, axis=1)
+    np.testing.assert_array_equal(candidate_distances(_distances(x), neigh), exact)
+    np.testing.assert_allclose(candidate_distances(np.ascontiguousarray(x), neigh), exact)

@@ -41,7 +41,8 @@ of kicks, whether its segments were of any length, short or chosen along candida
 up to 300 points every second kick cuts at three long edges, each the longest of three drawn),
 local search from its six end nodes, kept when at most ``threshold`` longer (threshold
 accepting); the shortest tour seen is returned. Distances are read from a matrix when one is
-given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`). The functions called per node
+given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`), a node's distances to its
+candidates from a row computed once (``candidate_distances`` there). The functions called per node
 and per kick are compiled without numba's reference counts (``leaf`` in that module).
 """
 
@@ -60,6 +61,7 @@ from teachfit.trajectories.tsp_moves import (
     _or_segment,
     _reverse,
     _tail_move,
+    candidate_distances,
     leaf,
 )
 
@@ -90,6 +92,7 @@ def _push_ends(
 def _improve_node(
     x: np.ndarray,
     neigh: np.ndarray,
+    nd: np.ndarray,
     tour: np.ndarray,
     pos: np.ndarray,
     a: int,
@@ -110,8 +113,8 @@ def _improve_node(
             continue
         b = tour[i + 1] if side == 0 else tour[i - 1]
         dab = _d(x, a, b, dummy)
-        for c in neigh[a]:
-            dac = _d(x, a, c, dummy)
+        for kk in range(neigh.shape[1]):
+            c, dac = neigh[a, kk], nd[a, kk]
             if dab - dac <= eps:
                 break
             j = pos[c]
@@ -145,8 +148,9 @@ def _improve_node(
             continue
         for end in range(2):
             y = f if end == 0 else g
-            for c in neigh[y]:
-                if removed - _d(x, y, c, dummy) <= eps:
+            for kk in range(neigh.shape[1]):
+                c = neigh[y, kk]
+                if removed - nd[y, kk] <= eps:
                     break
                 j = pos[c]
                 if s <= j <= e:
@@ -170,6 +174,7 @@ def _improve_node(
 def _local_search(
     x: np.ndarray,
     neigh: np.ndarray,
+    nd: np.ndarray,
     tour: np.ndarray,
     pos: np.ndarray,
     seeds: np.ndarray,
@@ -195,11 +200,11 @@ def _local_search(
         inq[a] = False
         if a == dummy:
             continue
-        delta, lo, hi = _improve_node(x, neigh, tour, pos, a, eps)
+        delta, lo, hi = _improve_node(x, neigh, nd, tour, pos, a, eps)
         if delta <= 0.0 and segments:
-            delta, lo, hi = _tail_move(x, neigh, tour, pos, a, eps)
+            delta, lo, hi = _tail_move(x, neigh, nd, tour, pos, a, eps)
             if delta <= 0.0:
-                delta, lo, hi = _or_segment(x, neigh, tour, pos, a, eps)
+                delta, lo, hi = _or_segment(x, neigh, nd, tour, pos, a, eps)
         if delta > 0.0:
             gain += delta
             _push_ends(queue, inq, head_tail, tour, lo, hi)
@@ -207,7 +212,7 @@ def _local_search(
             continue
         if flips.shape[0] == 0:
             continue
-        delta, n_flips = _lk_node(x, neigh, tour, pos, a, eps, flips, breadth)
+        delta, n_flips = _lk_node(x, neigh, nd, tour, pos, a, eps, flips, breadth)
         if delta > 0.0:
             gain += delta
             for r in range(n_flips):
@@ -329,7 +334,8 @@ def improve_tour(
     inq = np.zeros(m, dtype=np.bool_)
     flips = np.zeros((depth, 2), dtype=np.int64)
     all_nodes = np.arange(m - 1)
-    _local_search(x, neigh, tour, pos, all_nodes, eps, queue, inq, flips, breadth, segments)
+    nd = candidate_distances(x, neigh)
+    _local_search(x, neigh, nd, tour, pos, all_nodes, eps, queue, inq, flips, breadth, segments)
     if m - 2 < 4:
         return tour
     window = min(window, m - 3)
@@ -345,7 +351,9 @@ def improve_tour(
         saved_tour[:] = tour
         saved_pos[:] = pos
         gain = _kick(x, tour, pos, a, lb, lc, ends)
-        gain += _local_search(x, neigh, tour, pos, ends, eps, queue, inq, flips, breadth, segments)
+        gain += _local_search(
+            x, neigh, nd, tour, pos, ends, eps, queue, inq, flips, breadth, segments
+        )
         if gain <= eps - threshold:  # longer than accepted: undo
             tour[:] = saved_tour
             pos[:] = saved_pos
