@@ -170,7 +170,7 @@ def _improve_node(
     return 0.0, 0, -1
 
 
-@njit(cache=True)
+@leaf
 def _local_search(
     x: np.ndarray,
     neigh: np.ndarray,
@@ -181,6 +181,7 @@ def _local_search(
     eps: float,
     queue: np.ndarray,
     inq: np.ndarray,
+    head_tail: np.ndarray,
     flips: np.ndarray,
     breadth: int,
     segments: bool,
@@ -188,7 +189,7 @@ def _local_search(
     """Local search from the nodes ``seeds`` until no move improves (2-opt and Or-opt of 1-3
     nodes, then with ``segments`` a new free end and Or-opt of any segment, then
     Lin-Kernighan chains when ``flips`` has rows); returns the total gain."""
-    head_tail = np.zeros(2, dtype=np.int64)
+    head_tail[:] = 0
     inq[:] = False
     for v in seeds:
         _push(queue, inq, head_tail, v)
@@ -221,7 +222,7 @@ def _local_search(
     return gain
 
 
-@njit(cache=True)
+@leaf
 def _long_edge_cuts(
     x: np.ndarray, tour: np.ndarray, draw: np.ndarray, samples: int
 ) -> tuple[int, int, int]:
@@ -230,8 +231,8 @@ def _long_edge_cuts(
     :func:`_kick_cuts`."""
     m = tour.shape[0]
     h = np.uint64(draw[0] * 1000003 + draw[1] * 7919 + draw[2])
-    cuts = np.empty(3, dtype=np.int64)
-    for k in range(3):
+    lo, hi, total = m, 0, 0  # the three cuts' least, largest and sum (no array: a leaf)
+    for _ in range(3):
         best_c, best_len = 1, -1.0
         for _ in range(samples):
             h ^= h << np.uint64(13)
@@ -241,14 +242,14 @@ def _long_edge_cuts(
             length = _d(x, tour[c - 1], tour[c], m - 1)
             if length > best_len:
                 best_c, best_len = c, length
-        cuts[k] = best_c
-    cuts.sort()
-    if cuts[0] == cuts[1] or cuts[1] == cuts[2]:
+        lo, hi, total = min(lo, best_c), max(hi, best_c), total + best_c
+    mid = total - lo - hi
+    if lo == mid or mid == hi:
         return 0, 0, 0
-    return cuts[0], cuts[1] - cuts[0], cuts[2] - cuts[1]
+    return lo, mid - lo, hi - mid
 
 
-@njit(cache=True)
+@leaf
 def _kick_cuts(
     x: np.ndarray, tour: np.ndarray, draws: np.ndarray, r: int, window: int, long_cuts: int
 ) -> tuple[int, int, int]:
@@ -332,10 +333,13 @@ def improve_tour(
         pos[tour[k]] = k
     queue = np.empty(m, dtype=np.int64)
     inq = np.zeros(m, dtype=np.bool_)
+    head_tail = np.zeros(2, dtype=np.int64)
     flips = np.zeros((depth, 2), dtype=np.int64)
     all_nodes = np.arange(m - 1)
     nd = candidate_distances(x, neigh)
-    _local_search(x, neigh, nd, tour, pos, all_nodes, eps, queue, inq, flips, breadth, segments)
+    _local_search(
+        x, neigh, nd, tour, pos, all_nodes, eps, queue, inq, head_tail, flips, breadth, segments
+    )
     if m - 2 < 4:
         return tour
     window = min(window, m - 3)
@@ -352,7 +356,7 @@ def improve_tour(
         saved_pos[:] = pos
         gain = _kick(x, tour, pos, a, lb, lc, ends)
         gain += _local_search(
-            x, neigh, nd, tour, pos, ends, eps, queue, inq, flips, breadth, segments
+            x, neigh, nd, tour, pos, ends, eps, queue, inq, head_tail, flips, breadth, segments
         )
         if gain <= eps - threshold:  # longer than accepted: undo
             tour[:] = saved_tour
