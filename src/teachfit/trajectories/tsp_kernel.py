@@ -62,11 +62,12 @@ from teachfit.trajectories.tsp_moves import (
     _reverse,
     _tail_move,
     candidate_distances,
+    inlined_leaf,
     leaf,
 )
 
 
-@leaf
+@inlined_leaf
 def _push(queue: np.ndarray, inq: np.ndarray, head_tail: np.ndarray, v: int) -> None:
     if not inq[v]:
         m = queue.shape[0]
@@ -88,7 +89,7 @@ def _push_ends(
 # Long on purpose (> 60 lines): the innermost loop of the solver, compiled; the candidate scan,
 # the two move kinds' gains and the move share a dozen locals, which a split would pass through
 # calls on every candidate.
-@leaf
+@inlined_leaf
 def _improve_node(
     x: np.ndarray,
     neigh: np.ndarray,
