@@ -42,8 +42,9 @@ up to 300 points every second kick cuts at three long edges, each the longest of
 local search from its six end nodes, kept when at most ``threshold`` longer (threshold
 accepting); the shortest tour seen is returned. Distances are read from a matrix when one is
 given (see ``_d`` in :mod:`teachfit.trajectories.tsp_moves`), a node's distances to its
-candidates from a row computed once (``candidate_distances`` there). The functions called per node
-and per kick are compiled without numba's reference counts (``leaf`` in that module).
+candidates from a row computed once (``candidate_distances`` there). The functions called per
+node and per kick are compiled without numba's reference counts (``leaf`` in that module), and
+the per-node moves are inlined into the local search's loop (``inlined_leaf``).
 """
 
 from __future__ import annotations
